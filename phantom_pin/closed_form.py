@@ -1,0 +1,212 @@
+"""The report's closed-form kinematics and dynamics (eqs 10-24, 80-94), corrected, in NumPy.
+
+Every function takes one state (shape (3,)) or a batch (shape (..., 3)) and returns
+fresh arrays with the same leading axes. Angles are the report's theta1..theta3 (rad);
+positions are in metres in the report's kinematic frame s (x left, y up, z forward,
+origin at the tip of the zero configuration); torques in N m. The printed equations
+contain typos; the corrections, and their evidence, are listed in docs/errata.md.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from phantom_pin.exceptions import UnreachableTargetError
+from phantom_pin.parameters import Parameters, load_parameters
+from phantom_pin.validation import as_states, same_batch
+
+#: Relative slack on the law-of-cosines arguments before a target counts as unreachable.
+_ACOS_SLACK = 1e-12
+
+
+@functools.lru_cache(maxsize=1)
+def shipped_parameters() -> Parameters:
+    """The parameters of the shipped description (robots/phantom_description/config)."""
+    return load_parameters()
+
+
+def _state(theta: object, name: str = "theta") -> tuple[np.ndarray, ...]:
+    array, _ = as_states(theta, name)
+    return array[..., 0], array[..., 1], array[..., 2]
+
+
+def forward_kinematics(theta: object, params: Parameters | None = None) -> np.ndarray:
+    """Pose g_st of the tool frame t in frame s, eq. 10: shape (..., 4, 4), metres."""
+    p = params or shipped_parameters()
+    t1, t2, t3 = _state(theta)
+    s1, c1, s2, c2, s3, c3 = np.sin(t1), np.cos(t1), np.sin(t2), np.cos(t2), np.sin(t3), np.cos(t3)
+    reach = p.l1 * c2 + p.l2 * s3
+    g = np.zeros(t1.shape + (4, 4))
+    g[..., 0, :] = np.stack([c1, -s1 * s3, c3 * s1, s1 * reach], axis=-1)
+    g[..., 1, :] = np.stack([0 * t1, c3, s3, p.l2 - p.l2 * c3 + p.l1 * s2], axis=-1)
+    g[..., 2, :] = np.stack([-s1, -c1 * s3, c1 * c3, -p.l1 + c1 * reach], axis=-1)
+    g[..., 3, 3] = 1.0
+    return g
+
+
+def inverse_kinematics(position: object, branch: str = "report",
+                       params: Parameters | None = None) -> np.ndarray:
+    """Joint angles (rad) that put the tip at ``position`` (m, frame s), eqs 11-20.
+
+    ``branch="report"`` is the report's elbow branch (gamma > 0, alpha > 0:
+    theta2 = gamma + beta, theta3 = theta2 + alpha - pi/2), the one the Phantom's
+    parallelogram reaches. ``branch="other"`` is the mirrored elbow
+    (theta2 = beta - gamma, theta3 = theta2 - alpha - pi/2). Raises
+    UnreachableTargetError when a target is farther from the shoulder than l1 + l2
+    or nearer than |l1 - l2|.
+    """
+    p = params or shipped_parameters()
+    if branch not in ("report", "other"):
+        raise ValueError(f"branch: expected 'report' or 'other', got {branch!r}")
+    target, _ = as_states(position, "position")
+    px, py, pz = target[..., 0], target[..., 1], target[..., 2]
+    theta1 = np.arctan2(px, pz + p.l1)                              # eq 11
+    horizontal = np.hypot(px, pz + p.l1)                            # eq 12
+    r = np.sqrt(horizontal**2 + (py - p.l2) ** 2)                   # eq 13
+    beta = np.arctan2(py - p.l2, horizontal)                        # eq 14
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cos_gamma = (p.l1**2 + r**2 - p.l2**2) / (2 * p.l1 * r)     # eq 16
+        cos_alpha = (p.l1**2 + p.l2**2 - r**2) / (2 * p.l1 * p.l2)  # eq 19
+    bad = ~(np.abs(cos_gamma) <= 1 + _ACOS_SLACK) | ~(np.abs(cos_alpha) <= 1 + _ACOS_SLACK)
+    if np.any(bad):
+        first = np.asarray(target)[bad][0] if target.ndim > 1 else target
+        raise UnreachableTargetError(
+            f"position: {np.array2string(first, precision=4)} m is outside the reachable "
+            f"shell {abs(p.l1 - p.l2):.4f} m <= distance from the shoulder <= {p.l1 + p.l2:.4f} m")
+    gamma = np.arccos(np.clip(cos_gamma, -1.0, 1.0))
+    alpha = np.arccos(np.clip(cos_alpha, -1.0, 1.0))
+    if branch == "report":
+        theta2 = gamma + beta                                       # eq 17
+        theta3 = theta2 + alpha - np.pi / 2                         # eq 20
+    else:
+        theta2 = beta - gamma
+        theta3 = theta2 - alpha - np.pi / 2
+    return np.stack([theta1, theta2, theta3], axis=-1)
+
+
+def spatial_jacobian(theta: object, params: Parameters | None = None) -> np.ndarray:
+    """Spatial manipulator Jacobian J^s, eq. 22: shape (..., 6, 3), twist order (v, omega).
+
+    Columns map joint rates (rad/s) to the spatial twist of the tool in frame s
+    (v in m/s: the velocity of the body point at the origin of s; omega in rad/s).
+    """
+    p = params or shipped_parameters()
+    t1, t2, t3 = _state(theta)
+    s1, c1, s2, c2 = np.sin(t1), np.cos(t1), np.sin(t2), np.cos(t2)
+    zero, one = 0 * t1, 0 * t1 + 1
+    rows = [
+        [p.l1 * one, -p.l1 * s1 * s2, s1 * (p.l2 + p.l1 * s2)],
+        [zero, p.l1 * c2, p.l1 * (c1 - c2)],
+        [zero, -p.l1 * c1 * s2, c1 * (p.l2 + p.l1 * s2)],
+        [zero, zero, -c1],
+        [one, zero, zero],
+        [zero, zero, s1],
+    ]
+    return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
+
+
+def body_jacobian(theta: object, params: Parameters | None = None) -> np.ndarray:
+    """Body manipulator Jacobian J^b, eq. 24: shape (..., 6, 3), twist order (v, omega).
+
+    Columns map joint rates (rad/s) to the tool's body twist in frame t (m/s, rad/s).
+    """
+    p = params or shipped_parameters()
+    t1, t2, t3 = _state(theta)
+    zero = 0 * t1
+    rows = [
+        [p.l1 * np.cos(t2) + p.l2 * np.sin(t3), zero, zero],
+        [zero, p.l1 * np.cos(t2 - t3), zero],
+        [zero, -p.l1 * np.sin(t2 - t3), p.l2 + zero],
+        [zero, zero, zero - 1],
+        [np.cos(t3), zero, zero],
+        [np.sin(t3), zero, zero],
+    ]
+    return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
+
+
+def _coefficients(p: Parameters) -> tuple[float, float, float, float]:
+    """K1, K2, K3, L of eqs 81-92 with the zz corrections of docs/errata.md (E5-E7)."""
+    k1 = (4 * p.Iayy + 4 * p.Iazz + 8 * p.Ibaseyy + 4 * p.Ibeyy + 4 * p.Ibezz + 4 * p.Icyy
+          + 4 * p.Iczz + 4 * p.Idfyy + 4 * p.Idfzz + 4 * p.l1**2 * p.ma + p.l2**2 * p.ma
+          + p.l1**2 * p.mc + 4 * p.l3**2 * p.mc) / 8
+    k2 = 4 * p.Ibeyy - 4 * p.Ibezz + 4 * p.Icyy - 4 * p.Iczz + p.l1**2 * (4 * p.ma + p.mc)
+    k3 = 4 * p.Iayy - 4 * p.Iazz + 4 * p.Idfyy - 4 * p.Idfzz - p.l2**2 * p.ma - 4 * p.l3**2 * p.mc
+    return k1, k2, k3, p.l1 * (p.l2 * p.ma + p.l3 * p.mc)
+
+
+def mass_matrix(theta: object, params: Parameters | None = None) -> np.ndarray:
+    """Joint-space inertia matrix M(theta), eqs 81-85 (corrected): (..., 3, 3), kg m^2.
+
+    Includes the motors' reflected rotor inertia, lumped by the report into Ibexx,
+    Idfxx and Ibaseyy.
+    """
+    p = params or shipped_parameters()
+    _, t2, t3 = _state(theta)
+    k1, k2, k3, lam = _coefficients(p)
+    m = np.zeros(t2.shape + (3, 3))
+    m[..., 0, 0] = k1 + k2 / 8 * np.cos(2 * t2) + k3 / 8 * np.cos(2 * t3) + lam * np.cos(t2) * np.sin(t3)
+    m[..., 1, 1] = p.Ibexx + p.Icxx + p.l1**2 * p.ma + p.l1**2 * p.mc / 4           # eq 82 (E8)
+    m[..., 1, 2] = m[..., 2, 1] = -lam / 2 * np.sin(t2 - t3)                        # eqs 83-84
+    m[..., 2, 2] = p.Iaxx + p.Idfxx + p.l2**2 * p.ma / 4 + p.l3**2 * p.mc           # eq 85
+    return m
+
+
+def coriolis_matrix(theta: object, dtheta: object, params: Parameters | None = None) -> np.ndarray:
+    """Coriolis/centrifugal matrix C(theta, dtheta), eqs 86-92 (corrected): (..., 3, 3).
+
+    In N m s/rad; C(theta, dtheta) @ dtheta is the velocity-product torque, and
+    dM/dt - 2C is skew-symmetric (C is built from the Christoffel symbols of M).
+    """
+    p = params or shipped_parameters()
+    _, t2, t3 = _state(theta)
+    d1, d2, d3 = _state(dtheta, "dtheta")
+    same_batch(("theta", "dtheta"), t2, d1)
+    _, k2, k3, lam = _coefficients(p)
+    a = k2 * np.sin(2 * t2) + 4 * lam * np.sin(t2) * np.sin(t3)
+    b = 4 * lam * np.cos(t2) * np.cos(t3) - k3 * np.sin(2 * t3)
+    c = np.zeros(t2.shape + (3, 3))
+    c[..., 0, 0] = (-a * d2 + b * d3) / 8                                           # eq 86
+    c[..., 0, 1] = -a * d1 / 8                                                      # eq 87
+    c[..., 0, 2] = b * d1 / 8                                                       # eq 88
+    c[..., 1, 0] = a * d1 / 8                                                       # eq 89
+    c[..., 1, 2] = lam / 2 * np.cos(t2 - t3) * d3                                   # eq 90
+    c[..., 2, 0] = -b * d1 / 8                                                      # eq 91
+    c[..., 2, 1] = -lam / 2 * np.cos(t2 - t3) * d2                                  # eq 92
+    return c
+
+
+def gravity(theta: object, params: Parameters | None = None) -> np.ndarray:
+    """Gravity torque N(theta), eqs 93-94: shape (..., 3), N m (N1 = 0)."""
+    p = params or shipped_parameters()
+    _, t2, t3 = _state(theta)
+    n = np.zeros(t2.shape + (3,))
+    n[..., 1] = p.g / 2 * (2 * p.l1 * p.ma + 2 * p.l5 * p.mbe + p.l1 * p.mc) * np.cos(t2)
+    n[..., 2] = p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf) * np.sin(t3)
+    return n
+
+
+def potential_energy(theta: object, params: Parameters | None = None) -> np.ndarray:
+    """Potential energy V = V_a + V_c + V_be + V_df (eqs 34, 45, 55, 65), J; zero at the shoulder."""
+    p = params or shipped_parameters()
+    _, t2, t3 = _state(theta)
+    s2, c3 = np.sin(t2), np.cos(t3)
+    return p.g * (p.ma * (p.l1 * s2 - p.l2 / 2 * c3) + p.mc * (p.l1 / 2 * s2 - p.l3 * c3)
+                  + p.mbe * p.l5 * s2 + p.mdf * p.l6 * c3)
+
+
+def inverse_dynamics(theta: object, dtheta: object, ddtheta: object,
+                     params: Parameters | None = None) -> np.ndarray:
+    """Joint torques tau = M ddtheta + C dtheta + N, eq. 80: shape (..., 3), N m.
+
+    theta in rad, dtheta in rad/s, ddtheta in rad/s^2.
+    """
+    p = params or shipped_parameters()
+    acc, _ = as_states(ddtheta, "ddtheta")
+    vel, _ = as_states(dtheta, "dtheta")
+    pos, _ = as_states(theta, "theta")
+    same_batch(("theta", "dtheta", "ddtheta"), pos, vel, acc)
+    m = mass_matrix(pos, p)
+    c = coriolis_matrix(pos, vel, p)
+    return (m @ acc[..., None])[..., 0] + (c @ vel[..., None])[..., 0] + gravity(pos, p)

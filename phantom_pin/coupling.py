@@ -1,0 +1,115 @@
+"""Adapter from a URDF's independent joints to its mimic-free tree model, read from <mimic> tags.
+
+A URDF with mimic joints loads in Pinocchio two ways: ``mimic=True`` gives the
+*reduced* model (one coordinate per independent joint), ``mimic=False`` the *tree*
+model (one coordinate per joint). With v_tree = G v_reduced for a constant matrix G,
+every quantity of the reduced system follows exactly from the tree model:
+M = G^T M_tree G, C = G^T C_tree G, tau = G^T tau_tree, J = J_tree G. This covers the
+algorithms that Pinocchio 4.1 refuses, or gets wrong, on mimic models (DEVELOPERS.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pinocchio as pin
+
+from phantom_pin.exceptions import ParameterFileError
+
+
+@dataclasses.dataclass(frozen=True)
+class Mimic:
+    """One <mimic> tag: angle(joint) = multiplier * angle(primary) + offset (rad or m)."""
+
+    joint: str
+    primary: str
+    multiplier: float
+    offset: float
+
+
+def read_mimic_tags(urdf_xml: str) -> dict[str, Mimic]:
+    """The <mimic> tags of a URDF document, keyed by the mimicking joint's name."""
+    try:
+        root = ET.fromstring(urdf_xml)
+    except ET.ParseError as error:
+        raise ParameterFileError(f"URDF is not well-formed XML: {error}") from error
+    mimics = {}
+    for joint in root.iter("joint"):
+        tag = joint.find("mimic")
+        if tag is not None:
+            name = joint.get("name")
+            mimics[name] = Mimic(name, tag.get("joint"), float(tag.get("multiplier", 1.0)),
+                                 float(tag.get("offset", 0.0)))
+    return mimics
+
+
+class Coupling:
+    """The constant coupling between a reduced (mimic) model and its tree model.
+
+    Attributes: ``tree`` and ``reduced`` (pinocchio.Model), ``matrix`` (G, shape
+    (tree.nv, reduced.nv)) and ``mimics`` (the URDF's tags). Tangent vectors and
+    matrices are mapped by G; configurations by ``configuration``.
+    """
+
+    def __init__(self, urdf_xml: str, root_joint: pin.JointModel | None = None) -> None:
+        args = (urdf_xml,) if root_joint is None else (urdf_xml, root_joint)
+        self.tree = pin.buildModelFromXML(*args, mimic=False)
+        self.reduced = pin.buildModelFromXML(*args, mimic=True)
+        self.mimics = read_mimic_tags(urdf_xml)
+        self.matrix = np.zeros((self.tree.nv, self.reduced.nv))
+        # (tree idx_q, tree nq, reduced idx_q, multiplier, offset) per mimic joint
+        self._mimic_slots: list[tuple[int, int, int, int, float, float]] = []
+        self._copy_slots: list[tuple[int, int, int]] = []   # (tree idx_q, reduced idx_q, nq)
+        for jid in range(1, self.tree.njoints):
+            name, joint = self.tree.names[jid], self.tree.joints[jid]
+            if name in self.mimics:
+                self._add_mimic(joint, self.mimics[name])
+            else:
+                source = self.reduced.joints[self.reduced.getJointId(name)]
+                self.matrix[joint.idx_v:joint.idx_v + joint.nv,
+                            source.idx_v:source.idx_v + joint.nv] = np.eye(joint.nv)
+                self._copy_slots.append((joint.idx_q, source.idx_q, joint.nq))
+
+    def _add_mimic(self, joint: pin.JointModel, tag: Mimic) -> None:
+        if tag.primary in self.mimics:
+            raise ParameterFileError(f"joint {tag.joint}: mimics {tag.primary}, itself a mimic")
+        if not self.reduced.existJointName(tag.primary):
+            raise ParameterFileError(f"joint {tag.joint}: mimics unknown joint {tag.primary}")
+        primary = self.reduced.joints[self.reduced.getJointId(tag.primary)]
+        if joint.nv != 1 or primary.nv != 1:
+            raise ParameterFileError(f"joint {tag.joint}: only 1-DoF mimic joints are supported")
+        self.matrix[joint.idx_v, primary.idx_v] = tag.multiplier
+        self._mimic_slots.append((joint.idx_q, joint.nq, primary.idx_q, primary.nq,
+                                  tag.multiplier, tag.offset))
+
+    def configuration(self, q_reduced: np.ndarray) -> np.ndarray:
+        """Tree configuration (tree.nq,) of a reduced configuration (reduced.nq,)."""
+        q = np.empty(self.tree.nq)
+        for tree_q, reduced_q, nq in self._copy_slots:
+            q[tree_q:tree_q + nq] = q_reduced[reduced_q:reduced_q + nq]
+        for tree_q, nq, primary_q, primary_nq, multiplier, offset in self._mimic_slots:
+            if primary_nq == 1:
+                angle = q_reduced[primary_q]
+            else:  # continuous joint stored as (cos, sin)
+                angle = np.arctan2(q_reduced[primary_q + 1], q_reduced[primary_q])
+            angle = multiplier * angle + offset
+            q[tree_q:tree_q + nq] = angle if nq == 1 else (np.cos(angle), np.sin(angle))
+        return q
+
+    def tangent(self, v_reduced: np.ndarray) -> np.ndarray:
+        """Tree velocity or acceleration (tree.nv,) of a reduced one: G v."""
+        return self.matrix @ v_reduced
+
+    def project(self, tree_matrix: np.ndarray) -> np.ndarray:
+        """G^T A G for a (tree.nv, tree.nv) matrix A (mass, Coriolis, derivatives)."""
+        return self.matrix.T @ tree_matrix @ self.matrix
+
+    def project_force(self, tree_torque: np.ndarray) -> np.ndarray:
+        """G^T tau: generalized force on the reduced coordinates."""
+        return self.matrix.T @ tree_torque
+
+    def project_jacobian(self, tree_jacobian: np.ndarray) -> np.ndarray:
+        """J G: a (k, tree.nv) Jacobian as a Jacobian of the reduced coordinates."""
+        return tree_jacobian @ self.matrix

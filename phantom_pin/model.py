@@ -1,0 +1,261 @@
+"""Phantom: the report's kinematics and dynamics, computed by Pinocchio on the URDF model."""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pinocchio as pin
+
+from phantom_pin.coupling import Coupling
+from phantom_pin.description import generate_srdf, generate_urdf
+from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
+from phantom_pin.parameters import Parameters, load_parameters
+from phantom_pin.paths import CONFIG_DIR, SRDF_PATH, URDF_PATH
+from phantom_pin.validation import as_states, same_batch
+
+#: Newton iterations and position tolerance (m) of inverse_kinematics.
+_IK_ITERATIONS, _IK_TOLERANCE = 60, 1e-13
+#: Largest Newton step (rad); seeds (theta2, theta3 in rad) for each elbow branch.
+_IK_MAX_STEP = 0.3
+_IK_SEEDS = {"report": ((0.35, 0.3), (0.9, 1.0)), "other": ((-0.35, -2.8), (0.9, -1.5))}
+
+
+class Phantom:
+    """The PHANToM 1.5 in the report's coordinates, computed by Pinocchio.
+
+    ``Phantom()`` loads the shipped URDF and SRDF. ``Phantom(config_dir=...)``, or
+    any of the xacro file arguments of ``parameters.PARAMETER_FILES`` (for example
+    ``Phantom(physical_parameters_file="mine.yaml")``), generates them through xacro
+    from modified parameter files.
+
+    Joint vectors are the report's theta1..theta3 (rad), which are the URDF's
+    joint1..joint3; rates in rad/s, accelerations in rad/s^2, torques in N m. Poses
+    are in the report's kinematic frame s (URDF frame ``report_s``: x left, y up,
+    z forward); the tool frame t is ``tip``. Every method takes one state, shape (3,),
+    or a batch, shape (N, 3), and returns fresh arrays.
+
+    Attributes: ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's rotor
+    inertias times ratio^2), ``data``, ``coupling`` (the mimic-free tree model and the
+    coupling matrix read from the URDF's mimic tags), ``parameters`` (the report's
+    numbers), ``threads`` (OpenMP threads of batched inverse dynamics).
+    """
+
+    def __init__(self, config_dir: Path | str | None = None, **files: Path | str) -> None:
+        if config_dir is None and not files:
+            self.parameters: Parameters = load_parameters()
+            urdf_xml, srdf_xml = URDF_PATH.read_text(), SRDF_PATH.read_text()
+        else:
+            config_dir = CONFIG_DIR if config_dir is None else config_dir
+            self.parameters = load_parameters(config_dir, **files)
+            urdf_xml = generate_urdf("", config_dir, **files)
+            srdf_xml = generate_srdf("", config_dir, **files)
+        self.coupling = Coupling(urdf_xml)
+        self.model: pin.Model = self.coupling.reduced
+        with tempfile.TemporaryDirectory() as folder:  # loadRotorParameters reads a file
+            srdf_path = Path(folder) / "phantom_1_5.srdf"
+            srdf_path.write_text(srdf_xml)
+            pin.loadRotorParameters(self.model, str(srdf_path), False)
+        self.data = self.model.createData()
+        self._tree_data = self.coupling.tree.createData()
+        self._frame_s = self.model.getFrameId("report_s")
+        self._frame_tip = self.model.getFrameId("tip")
+        pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
+        #: report_s is fixed to base_link: Ad(g_s^-1) maps world twists to frame s.
+        self._world_to_s = self.data.oMf[self._frame_s].inverse().action
+        self.threads = os.cpu_count() or 1
+        self._pool: pin.ModelPool | None = None
+
+    # -- helpers ---------------------------------------------------------------------
+    @staticmethod
+    def _each(function: Callable[..., np.ndarray], *arrays: np.ndarray) -> np.ndarray:
+        """Apply a one-state function over the leading axes of same-shaped arrays."""
+        if arrays[0].ndim == 1:
+            return function(*arrays)
+        flat = [a.reshape(-1, 3) for a in arrays]
+        out = np.stack([function(*row) for row in zip(*flat)]) if len(flat[0]) else None
+        if out is None:
+            out = np.empty((0,) + function(*(np.zeros(3) for _ in arrays)).shape)
+        return out.reshape(arrays[0].shape[:-1] + out.shape[1:])
+
+    def _states(self, names: tuple[str, ...], *values: object) -> list[np.ndarray]:
+        arrays = [as_states(v, n)[0] for n, v in zip(names, values)]
+        same_batch(names, *arrays)
+        return arrays
+
+    def _placement(self, theta: np.ndarray) -> pin.SE3:
+        """Pose of tip in report_s after forward kinematics at theta."""
+        pin.framesForwardKinematics(self.model, self.data, theta)
+        return self.data.oMf[self._frame_s].actInv(self.data.oMf[self._frame_tip])
+
+    def _symmetric_mass(self, theta: np.ndarray) -> np.ndarray:
+        upper = pin.crba(self.model, self.data, theta)
+        return np.triu(upper) + np.triu(upper, 1).T
+
+    # -- kinematics ------------------------------------------------------------------
+    def forward_kinematics(self, theta: object) -> np.ndarray:
+        """Pose g_st of the tool frame t in frame s (eq. 10): shape (..., 4, 4), metres."""
+        (q,) = self._states(("theta",), theta)
+        return self._each(lambda x: self._placement(x).homogeneous, q)
+
+    def inverse_kinematics(self, position: object, branch: str = "report") -> np.ndarray:
+        """Joint angles (rad) that put the tip at ``position`` (m, frame s).
+
+        Damped Newton iterations on Pinocchio's forward kinematics and frame Jacobian,
+        seeded on the requested elbow branch ("report": the report's gamma > 0,
+        alpha > 0, the branch the parallelogram reaches; "other": the mirrored elbow).
+        Raises UnreachableTargetError outside the reachable shell
+        |l1 - l2| <= distance from the shoulder <= l1 + l2.
+        """
+        if branch not in _IK_SEEDS:
+            raise InvalidInputError(f"branch: expected 'report' or 'other', got {branch!r}")
+        (target,) = self._states(("position",), position)
+        return self._each(lambda p: self._solve_ik(p, branch), target)
+
+    def _solve_ik(self, target: np.ndarray, branch: str) -> np.ndarray:
+        p = self.parameters
+        shoulder = np.array([0.0, p.l2, -p.l1])  # the shoulder in frame s (eqs 4-5)
+        distance = float(np.linalg.norm(target - shoulder))
+        if not abs(p.l1 - p.l2) * (1 - 1e-12) <= distance <= (p.l1 + p.l2) * (1 + 1e-12):
+            raise UnreachableTargetError(
+                f"position: {np.array2string(target, precision=4)} m is {distance:.4f} m from "
+                f"the shoulder, outside the reachable shell [{abs(p.l1 - p.l2):.4f}, "
+                f"{p.l1 + p.l2:.4f}] m")
+        for seed in _IK_SEEDS[branch]:
+            theta = self._newton(target, np.array([math.atan2(target[0], target[2] + p.l1), *seed]))
+            # the report's branch has the elbow open forwards: cos(theta3 - theta2) > 0
+            if theta is not None and (math.cos(theta[2] - theta[1]) > 0) == (branch == "report"):
+                return (theta + np.pi) % (2 * np.pi) - np.pi
+        raise UnreachableTargetError(
+            f"position: no {branch}-branch solution found for {target} m")
+
+    def _newton(self, target: np.ndarray, theta: np.ndarray) -> np.ndarray | None:
+        """Damped Newton on the tip position from ``theta``; None if it does not converge."""
+        for _ in range(_IK_ITERATIONS):
+            tip = self._placement(theta).translation
+            error = target - tip
+            if np.linalg.norm(error) < _IK_TOLERANCE:
+                return theta
+            jacobian = self._spatial_jacobian(theta)
+            # velocity of the tip point in s: v + omega x p (J^s is taken at s's origin)
+            linear = jacobian[:3] + np.cross(jacobian[3:].T, tip).T
+            step = np.linalg.solve(linear.T @ linear + 1e-12 * np.eye(3), linear.T @ error)
+            theta = theta + step * min(1.0, _IK_MAX_STEP / np.abs(step).max())
+        return None
+
+    def _spatial_jacobian(self, theta: np.ndarray) -> np.ndarray:
+        return self._world_to_s @ pin.computeFrameJacobian(self.model, self.data, theta,
+                                                            self._frame_tip, pin.WORLD)
+
+    def spatial_jacobian(self, theta: object) -> np.ndarray:
+        """Spatial Jacobian J^s (eq. 22): (..., 6, 3), twist (v, omega) in frame s.
+
+        Pinocchio's WORLD frame Jacobian of ``tip``, moved to frame s by Ad(g_s^-1).
+        """
+        (q,) = self._states(("theta",), theta)
+        return self._each(self._spatial_jacobian, q)
+
+    def body_jacobian(self, theta: object) -> np.ndarray:
+        """Body Jacobian J^b (eq. 24): (..., 6, 3), twist (v, omega) in the tool frame t."""
+        (q,) = self._states(("theta",), theta)
+
+        def one(x: np.ndarray) -> np.ndarray:
+            return pin.computeFrameJacobian(self.model, self.data, x, self._frame_tip, pin.LOCAL)
+        return self._each(one, q)
+
+    # -- dynamics --------------------------------------------------------------------
+    def mass_matrix(self, theta: object) -> np.ndarray:
+        """Joint-space inertia M(theta) (eqs 81-85), with the rotors' armature: (..., 3, 3)."""
+        (q,) = self._states(("theta",), theta)
+        return self._each(self._symmetric_mass, q)
+
+    def coriolis_matrix(self, theta: object, dtheta: object) -> np.ndarray:
+        """Coriolis matrix C(theta, dtheta) (eqs 86-92): (..., 3, 3), N m s/rad.
+
+        Pinocchio's computeCoriolisMatrix is silently wrong on mimic models, so it runs
+        on the tree model and is projected: C = G^T C_tree G.
+        """
+        q, v = self._states(("theta", "dtheta"), theta, dtheta)
+        tree, coupling = self.coupling.tree, self.coupling
+
+        def one(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+            c = pin.computeCoriolisMatrix(tree, self._tree_data, coupling.configuration(x),
+                                          coupling.tangent(dx))
+            return coupling.project(c)
+        return self._each(one, q, v)
+
+    def gravity(self, theta: object) -> np.ndarray:
+        """Gravity torque N(theta) (eqs 93-94): (..., 3), N m."""
+        (q,) = self._states(("theta",), theta)
+        return self._each(lambda x: pin.computeGeneralizedGravity(self.model, self.data, x).copy(), q)
+
+    def potential_energy(self, theta: object) -> np.ndarray:
+        """Potential energy V(theta) (J), zero with every centre of mass at shoulder height."""
+        (q,) = self._states(("theta",), theta)
+        tree, coupling = self.coupling.tree, self.coupling
+
+        def one(x: np.ndarray) -> np.ndarray:
+            return np.array(pin.computePotentialEnergy(tree, self._tree_data, coupling.configuration(x)))
+        return self._each(one, q)
+
+    def inverse_dynamics(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
+        """Joint torques tau = M ddtheta + C dtheta + N (eq. 80): (..., 3), N m.
+
+        One state: pinocchio.rnea on the mimic model. A batch (N, 3):
+        pinocchio.rneaInParallel over ``threads`` OpenMP threads.
+        """
+        q = np.asarray(theta, dtype=float)
+        if q.shape == (3,):
+            v, a = np.asarray(dtheta, dtype=float), np.asarray(ddtheta, dtype=float)
+            if v.shape == (3,) and a.shape == (3,):
+                tau = pin.rnea(self.model, self.data, q, v, a)
+                # NaN/inf in any input reaches tau[0] (joint1 carries every body); only
+                # then are the inputs inspected, to name the bad one.
+                if math.isfinite(tau[0]) and math.isfinite(tau[1]) and math.isfinite(tau[2]):
+                    return tau.copy()
+        q, v, a = self._states(("theta", "dtheta", "ddtheta"), theta, dtheta, ddtheta)
+        if q.ndim == 1:
+            return pin.rnea(self.model, self.data, q, v, a).copy()
+        if self._pool is None or self._pool.size() < self.threads:
+            self._pool = pin.ModelPool(self.model, self.threads)
+        shape = q.shape
+        tau = np.empty((3, math.prod(shape[:-1])), order="F")
+        pin.rneaInParallel(self.threads, self._pool, q.reshape(-1, 3).T, v.reshape(-1, 3).T,
+                           a.reshape(-1, 3).T, tau)
+        return tau.T.reshape(shape)
+
+    def forward_dynamics(self, theta: object, dtheta: object, tau: object) -> np.ndarray:
+        """Joint accelerations (rad/s^2) under torques ``tau`` (N m): M^-1 (tau - C dtheta - N).
+
+        pinocchio.aba refuses mimic models, so M (crba) and the bias torques
+        (nonLinearEffects) come from Pinocchio and the 3x3 system is solved by Cholesky.
+        """
+        q, v, t = self._states(("theta", "dtheta", "tau"), theta, dtheta, tau)
+
+        def one(x: np.ndarray, dx: np.ndarray, torque: np.ndarray) -> np.ndarray:
+            bias = pin.nonLinearEffects(self.model, self.data, x, dx)
+            factor = np.linalg.cholesky(self._symmetric_mass(x))
+            return np.linalg.solve(factor.T, np.linalg.solve(factor, torque - bias))
+        return self._each(one, q, v, t)
+
+    def inverse_dynamics_derivatives(self, theta: object, dtheta: object,
+                                     ddtheta: object) -> tuple[np.ndarray, np.ndarray]:
+        """(d tau / d theta, d tau / d dtheta), each (..., 3, 3), in N m/rad and N m s/rad.
+
+        Pinocchio's RNEA derivatives refuse mimic models; they run on the tree model
+        and are projected: d tau/d theta = G^T (d tau_tree/d q) G, and likewise for dtheta.
+        """
+        q, v, a = self._states(("theta", "dtheta", "ddtheta"), theta, dtheta, ddtheta)
+        tree, coupling = self.coupling.tree, self.coupling
+
+        def one(x: np.ndarray, dx: np.ndarray, ddx: np.ndarray) -> np.ndarray:
+            d_q, d_v, _ = pin.computeRNEADerivatives(
+                tree, self._tree_data, coupling.configuration(x), coupling.tangent(dx),
+                coupling.tangent(ddx))
+            return np.stack([coupling.project(d_q), coupling.project(d_v)])
+        both = self._each(one, q, v, a)
+        return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()

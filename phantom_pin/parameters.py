@@ -1,0 +1,147 @@
+"""The report's physical parameters, read from the description's config/*.yaml files."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import yaml
+
+from phantom_pin.exceptions import ParameterFileError
+from phantom_pin.paths import CONFIG_DIR
+
+#: The parameter files of robots/phantom_description/config, by xacro argument name.
+PARAMETER_FILES = {
+    "kinematics_file": "kinematics.yaml",
+    "physical_parameters_file": "physical_parameters.yaml",
+    "actuation_file": "actuation.yaml",
+    "joint_limits_file": "joint_limits.yaml",
+    "visual_parameters_file": "visual_parameters.yaml",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Parameters:
+    """Numbers of the report, SI units, named as in the report's appendix.
+
+    Lengths l1, l2, l3 (m, eqs 29-31), l5, l6 (m, COM offsets of BE and DF, eqs 63,
+    73); masses m* (kg); inertias I* (kg m^2) in the report's segment axes: A and C
+    about their COM, BE and DF about the shoulder, Ibaseyy about axis 1. As in the
+    report, Ibexx, Idfxx and Ibaseyy include the motors' reflected rotor inertia
+    ``rotor_inertia * ratio**2``. g is gravity (m/s^2), pointing along the report's -y.
+    ``lower`` and ``upper`` are the joint position limits (rad) of theta1..theta3.
+    """
+
+    l1: float
+    l2: float
+    l3: float
+    l5: float
+    l6: float
+    g: float
+    ma: float
+    Iaxx: float
+    Iayy: float
+    Iazz: float
+    mc: float
+    Icxx: float
+    Icyy: float
+    Iczz: float
+    mbe: float
+    Ibexx: float
+    Ibeyy: float
+    Ibezz: float
+    mdf: float
+    Idfxx: float
+    Idfyy: float
+    Idfzz: float
+    Ibaseyy: float
+    rotor_inertia: float
+    ratios: tuple[float, float, float]
+    lower: tuple[float, float, float]
+    upper: tuple[float, float, float]
+
+    @property
+    def armature(self) -> tuple[float, float, float]:
+        """Reflected rotor inertia of each joint, rotor_inertia * ratio^2 (kg m^2)."""
+        return tuple(self.rotor_inertia * r**2 for r in self.ratios)
+
+
+def _read(path: Path) -> dict:
+    try:
+        with open(path, encoding="utf-8") as stream:
+            data = yaml.safe_load(stream)
+    except OSError as error:
+        raise ParameterFileError(f"{path}: cannot read ({error.strerror})") from error
+    except yaml.YAMLError as error:
+        raise ParameterFileError(f"{path}: not valid YAML ({error})") from error
+    if not isinstance(data, dict):
+        raise ParameterFileError(f"{path}: expected a mapping at the top level")
+    return data
+
+
+def _number(data: dict, path: Path, *keys: str, positive: bool = False) -> float:
+    node: object = data
+    for depth, key in enumerate(keys):
+        if not isinstance(node, dict) or key not in node:
+            raise ParameterFileError(f"{path}: missing key {'.'.join(keys[:depth + 1])}")
+        node = node[key]
+    if isinstance(node, bool) or not isinstance(node, (int, float)) or not math.isfinite(node):
+        raise ParameterFileError(f"{path}: {'.'.join(keys)} must be a finite number, got {node!r}")
+    if positive and node <= 0:
+        raise ParameterFileError(f"{path}: {'.'.join(keys)} must be positive, got {node!r}")
+    return float(node)
+
+
+def parameter_paths(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str) -> dict[str, Path]:
+    """Paths of the five parameter files: ``config_dir``'s, or ``overrides`` by xacro arg name."""
+    unknown = set(overrides) - set(PARAMETER_FILES)
+    if unknown:
+        raise ParameterFileError(f"unknown parameter file argument(s): {sorted(unknown)}")
+    paths = {arg: Path(config_dir) / name for arg, name in PARAMETER_FILES.items()}
+    paths.update({arg: Path(p) for arg, p in overrides.items()})
+    return paths
+
+
+def load_parameters(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str) -> Parameters:
+    """Read and check the parameter files; raise ParameterFileError naming file and key."""
+    paths = parameter_paths(config_dir, **overrides)
+    kin_path, phys_path = paths["kinematics_file"], paths["physical_parameters_file"]
+    act_path, lim_path = paths["actuation_file"], paths["joint_limits_file"]
+    kin, phys, act, lim = (_read(p) for p in (kin_path, phys_path, act_path, lim_path))
+
+    def inertia(segment: str, axis: str) -> float:
+        return _number(phys, phys_path, segment, "inertia", axis, positive=True)
+
+    joints = ("joint1", "joint2", "joint3")
+    lower = tuple(_number(lim, lim_path, j, "lower") for j in joints)
+    upper = tuple(_number(lim, lim_path, j, "upper") for j in joints)
+    for joint, lo, hi in zip(joints, lower, upper):
+        if lo >= hi:
+            raise ParameterFileError(f"{lim_path}: {joint}.lower must be below {joint}.upper")
+    return Parameters(
+        l1=_number(kin, kin_path, "l1", positive=True),
+        l2=_number(kin, kin_path, "l2", positive=True),
+        l3=_number(kin, kin_path, "l3", positive=True),
+        l5=_number(phys, phys_path, "segment_be", "com"),
+        l6=_number(phys, phys_path, "segment_df", "com"),
+        g=_number(phys, phys_path, "gravity", positive=True),
+        ma=_number(phys, phys_path, "segment_a", "mass", positive=True),
+        Iaxx=inertia("segment_a", "xx"), Iayy=inertia("segment_a", "yy"),
+        Iazz=inertia("segment_a", "zz"),
+        mc=_number(phys, phys_path, "segment_c", "mass", positive=True),
+        Icxx=inertia("segment_c", "xx"), Icyy=inertia("segment_c", "yy"),
+        Iczz=inertia("segment_c", "zz"),
+        mbe=_number(phys, phys_path, "segment_be", "mass", positive=True),
+        Ibexx=inertia("segment_be", "xx"), Ibeyy=inertia("segment_be", "yy"),
+        Ibezz=inertia("segment_be", "zz"),
+        mdf=_number(phys, phys_path, "segment_df", "mass", positive=True),
+        Idfxx=inertia("segment_df", "xx"), Idfyy=inertia("segment_df", "yy"),
+        Idfzz=inertia("segment_df", "zz"),
+        Ibaseyy=_number(phys, phys_path, "segment_g", "inertia_yy", positive=True),
+        rotor_inertia=_number(act, act_path, "motor", "rotor_inertia", positive=True),
+        ratios=tuple(_number(act, act_path, "transmission_ratio", j, positive=True)
+                     for j in joints),
+        lower=lower,
+        upper=upper,
+    )

@@ -1,0 +1,204 @@
+"""The description package: generated files, names, prefixes, link numbers, and three tools."""
+
+import dataclasses
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yourdfpy
+
+import appendix
+from conftest import relative_error
+from phantom_pin import closed_form
+from phantom_pin.description import generate_srdf, generate_urdf
+from phantom_pin.paths import SRDF_PATH, URDF_PATH
+
+ACTUATED = ["joint1", "joint2", "joint3"]
+# (joint, primary, multiplier) of the parallelogram, as designed in urdf/phantom_1_5_macro.xacro
+PASSIVE = [("crank_pin_a", "joint3", -1.0), ("crank_pin_b", "joint2", 1.0),
+           ("forearm_pin_a", "joint2", -1.0), ("forearm_pin_b", "joint3", 1.0)]
+SEGMENT_LINKS = ["turret_link", "upper_arm_link", "crank_link", "lower_bar_link", "forearm_link"]
+
+
+@pytest.fixture(scope="module")
+def urdf_root():
+    return ET.parse(URDF_PATH).getroot()
+
+
+@pytest.fixture(scope="module")
+def mimic_model():
+    model = pin.buildModelFromUrdf(str(URDF_PATH), mimic=True)
+    pin.loadRotorParameters(model, str(SRDF_PATH), False)
+    return model
+
+
+def test_committed_files_match_a_fresh_xacro_run():
+    assert URDF_PATH.read_text() == generate_urdf(), "run the regeneration in robots/phantom_description/README.md"
+    assert SRDF_PATH.read_text() == generate_srdf()
+
+
+def test_prefix_reaches_every_name():
+    root = ET.fromstring(generate_urdf(prefix="left_"))
+    names = [e.get("name") for e in root.iter() if e.tag in ("link", "joint", "material") and e.get("name")]
+    assert names and all(n.startswith("left_") for n in names)
+    references = [e.get("link") for e in root.iter() if e.tag in ("parent", "child")]
+    references += [e.get("joint") for e in root.iter("mimic")]
+    assert all(r.startswith("left_") for r in references)
+    model = pin.buildModelFromXML(generate_urdf(prefix="left_"), mimic=True)
+    assert [model.names[i] for i in range(1, 4)] == ["left_joint1", "left_joint2", "left_joint3"]
+    assert model.existFrame("left_tip") and model.existFrame("left_report_s")
+    srdf = ET.fromstring(generate_srdf(prefix="left_"))
+    srdf_names = [j.get("name") for j in srdf.iter("joint")]
+    assert srdf_names and all(n.startswith("left_") for n in srdf_names)
+
+
+def test_joints_are_the_report_thetas_and_the_parallelogram_mimics(urdf_root):
+    joints = {j.get("name"): j for j in urdf_root.iter("joint")}
+    for name, axis in zip(ACTUATED, ["0 0 1", "0 -1 0", "0 -1 0"]):
+        assert joints[name].get("type") == "revolute" and joints[name].find("mimic") is None
+        assert joints[name].find("axis").get("xyz") == axis
+    for name, primary, multiplier in PASSIVE:
+        mimic = joints[name].find("mimic")
+        assert (mimic.get("joint"), float(mimic.get("multiplier")), float(mimic.get("offset"))) == (primary, multiplier, 0.0)
+    urdf = yourdfpy.URDF.load(str(URDF_PATH))
+    assert urdf.actuated_joint_names == ACTUATED
+
+
+def test_mimic_model_has_three_dofs_and_the_rotor_armature(mimic_model):
+    p = closed_form.shipped_parameters()
+    assert (mimic_model.nq, mimic_model.nv) == (3, 3)
+    np.testing.assert_allclose(mimic_model.armature, [p.rotor_inertia * r**2 for r in p.ratios], rtol=1e-12)
+    np.testing.assert_array_equal(mimic_model.lowerPositionLimit, p.lower)
+    np.testing.assert_array_equal(mimic_model.upperPositionLimit, p.upper)
+
+
+def _inertials(root):
+    for link in root.iter("link"):
+        inertial = link.find("inertial")
+        if inertial is not None:
+            i = inertial.find("inertia").attrib
+            tensor = np.array([[float(i["ixx"]), float(i["ixy"]), float(i["ixz"])],
+                               [float(i["ixy"]), float(i["iyy"]), float(i["iyz"])],
+                               [float(i["ixz"]), float(i["iyz"]), float(i["izz"])]])
+            com = np.array([float(x) for x in inertial.find("origin").get("xyz").split()])
+            yield link.get("name"), float(inertial.find("mass").get("value")), com, tensor
+
+
+def test_every_link_inertia_is_physical(urdf_root):
+    links = {name: (mass, tensor) for name, mass, _, tensor in _inertials(urdf_root)}
+    assert sorted(links) == sorted(SEGMENT_LINKS)
+    for name, (mass, tensor) in links.items():
+        moments = np.linalg.eigvalsh(tensor)
+        assert mass > 0 and moments.min() > 0, name
+        a, b, c = np.sort(moments)
+        assert c <= a + b, f"{name}: triangle inequality fails at the COM"
+
+
+def test_link_inertias_give_back_the_report_values(urdf_root):
+    """Undo the xacro's conversion: URDF (COM, base axes) to the report's (origin, report axes)."""
+    p = closed_form.shipped_parameters()
+    to_report = np.array([[0, 1, 0], [0, 0, 1], [1, 0, 0]])  # base (x, y, z) = report (z, x, y)
+    armature2, armature3 = p.armature[1], p.armature[2]
+    expected = {  # link: (mass, report inertia about the point below, point in report axes)
+        "forearm_link": (p.ma, np.diag([p.Iaxx, p.Iayy, p.Iazz]), None),
+        "lower_bar_link": (p.mc, np.diag([p.Icxx, p.Icyy, p.Iczz]), None),
+        "upper_arm_link": (p.mbe, np.diag([p.Ibexx - armature2, p.Ibeyy, p.Ibezz]), np.zeros(3)),
+        "crank_link": (p.mdf, np.diag([p.Idfxx - armature3, p.Idfyy, p.Idfzz]), np.zeros(3)),
+    }
+    coms = {"upper_arm_link": [0, 0, p.l5], "crank_link": [0, p.l6, 0],
+            "lower_bar_link": [0, 0, p.l1 / 2], "forearm_link": [0, p.l3 - p.l2 / 2, 0]}
+    for name, mass, com, tensor in _inertials(urdf_root):
+        if name == "turret_link":
+            assert tensor[2, 2] + p.armature[0] == pytest.approx(p.Ibaseyy, rel=1e-12)
+            continue
+        report_mass, report_inertia, about = expected[name]
+        com_report = to_report @ com
+        np.testing.assert_allclose(com_report, coms[name], atol=1e-15)
+        inertia = to_report @ tensor @ to_report.T
+        if about is not None:  # parallel-axis theorem from the COM to the shoulder
+            inertia = inertia + mass * (com_report @ com_report * np.eye(3) - np.outer(com_report, com_report))
+        assert mass == report_mass
+        np.testing.assert_allclose(inertia, report_inertia, rtol=1e-12, atol=1e-18, err_msg=name)
+
+
+def test_crba_equals_the_report_mass_matrix(mimic_model, states):
+    data = mimic_model.createData()
+    theta = states[0]
+    crba = np.array([pin.crba(mimic_model, data, q) for q in theta])
+    crba = np.triu(crba) + np.swapaxes(np.triu(crba, 1), -1, -2)
+    assert relative_error(crba, closed_form.mass_matrix(theta)) < 1e-9
+
+
+def test_rnea_equals_the_appendix_torques_to_their_printed_precision(mimic_model, states):
+    data = mimic_model.createData()
+    theta, dtheta, ddtheta = states
+    rnea = np.array([pin.rnea(mimic_model, data, *s) for s in zip(theta, dtheta, ddtheta)])
+    printed, bound = appendix.torques(theta, dtheta, ddtheta)
+    # the URDF holds eq. 41's Iayy, the appendix used 0.0018e-4: allow for that difference
+    shipped = closed_form.shipped_parameters()
+    as_appendix = dataclasses.replace(shipped, Iayy=appendix.APPENDIX_IAYY)
+    bound += np.abs(closed_form.inverse_dynamics(theta, dtheta, ddtheta, shipped)
+                    - closed_form.inverse_dynamics(theta, dtheta, ddtheta, as_appendix))
+    assert np.all(np.abs(rnea - printed) <= bound + 1e-15)
+
+
+def test_yourdfpy_forward_kinematics_is_eq10_and_pinocchio(mimic_model, states):
+    urdf = yourdfpy.URDF.load(str(URDF_PATH))
+    data = mimic_model.createData()
+    s, tip = mimic_model.getFrameId("report_s"), mimic_model.getFrameId("tip")
+    worst_report = worst_pinocchio = 0.0
+    for theta in states[0]:
+        urdf.update_cfg(theta)
+        g = np.linalg.inv(urdf.get_transform("report_s")) @ urdf.get_transform("tip")
+        pin.framesForwardKinematics(mimic_model, data, theta)
+        g_pin = data.oMf[s].actInv(data.oMf[tip]).homogeneous
+        worst_report = max(worst_report, np.abs(g - closed_form.forward_kinematics(theta)).max())
+        worst_pinocchio = max(worst_pinocchio, np.abs(g - g_pin).max())
+    assert worst_report < 1e-9 and worst_pinocchio < 1e-9
+
+
+def test_parallelogram_closes_in_the_mimic_free_model(urdf_root, states):
+    """Set the passive joints from theta by the URDF's mimic tags, then meet at the elbow."""
+    tree = pin.buildModelFromUrdf(str(URDF_PATH), mimic=False)
+    data = tree.createData()
+    mimic = {j.get("name"): (j.find("mimic").get("joint"), float(j.find("mimic").get("multiplier")))
+             for j in urdf_root.iter("joint") if j.find("mimic") is not None}
+    l3 = closed_form.shipped_parameters().l3
+    worst = 0.0
+    for theta in states[0]:
+        angles = dict(zip(ACTUATED, theta))
+        q = np.array([angles[n] if n in angles else mimic[n][1] * angles[mimic[n][0]]
+                      for n in tree.names[1:]])
+        pin.framesForwardKinematics(tree, data, q)
+        through_upper_arm = data.oMf[tree.getFrameId("elbow")].translation
+        through_lower_bar = data.oMf[tree.getFrameId("forearm_link")].act(np.array([0, 0, l3]))
+        worst = max(worst, np.abs(through_upper_arm - through_lower_bar).max())
+        # the lower bar stays parallel to the upper arm, the forearm to the crank
+        for a, b in (("lower_bar_link", "upper_arm_link"), ("forearm_link", "crank_link")):
+            rotation = data.oMf[tree.getFrameId(a)].rotation.T @ data.oMf[tree.getFrameId(b)].rotation
+            worst = max(worst, np.abs(rotation - np.eye(3)).max())
+    assert worst < 1e-9
+
+
+def test_report_frames_sit_where_the_report_puts_them(mimic_model):
+    data = mimic_model.createData()
+    pin.framesForwardKinematics(mimic_model, data, np.zeros(3))
+    p = closed_form.shipped_parameters()
+    dynamics = data.oMf[mimic_model.getFrameId("report_dynamics")]
+    s = data.oMf[mimic_model.getFrameId("report_s")]
+    # report y is up (gravity along -y, eqs 34, 45), report z forward, x left (REP-103 base)
+    np.testing.assert_allclose(dynamics.rotation, [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-15)
+    np.testing.assert_allclose(dynamics.translation, 0, atol=1e-15)
+    # the dynamics frame's origin (the shoulder) is at (0, l2, -l1) in s (eqs 4-5, 27)
+    np.testing.assert_allclose(s.actInv(dynamics).translation, [0, p.l2, -p.l1], atol=1e-15)
+    np.testing.assert_allclose(mimic_model.gravity.linear, [0, 0, -p.g])
+
+
+def test_srdf_postures_are_inside_the_limits(limits):
+    srdf = ET.parse(SRDF_PATH).getroot()
+    postures = {g.get("name"): [float(j.get("value")) for j in g.iter("joint")] for g in srdf.iter("group_state")}
+    assert set(postures) == {"zero", "resting"}
+    assert postures["zero"] == [0.0, 0.0, 0.0]
+    for values in postures.values():
+        assert np.all(limits[0] <= values) and np.all(np.array(values) <= limits[1])
