@@ -1,14 +1,9 @@
 """Shared fixtures: one Phantom, and seeded random states inside the joint limits."""
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))  # for tests/appendix.py
-
-from phantom_pin import Phantom, closed_form  # noqa: E402
+from phantom_pin import Phantom, closed_form
 
 N_STATES = 1000
 

@@ -5,7 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-import appendix
+from phantom_pin import appendix
 from phantom_pin import InvalidInputError, UnreachableTargetError, closed_form as cf
 
 

@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 import yourdfpy
 
-import appendix
+from phantom_pin import appendix
 from conftest import relative_error
 from phantom_pin import closed_form
 from phantom_pin.description import generate_srdf, generate_urdf

@@ -1,4 +1,4 @@
-"""The report appendix's numeric Tau1-Tau3, typed as printed, with their rounding bounds.
+"""The report appendix's numeric Tau1-Tau3 ("Numerical Values"), typed as printed, with rounding bounds.
 
 Each coefficient is kept as its printed string, so that its rounding error (half a unit
 in its last printed digit) is known. ``torques`` returns the printed torques and a
