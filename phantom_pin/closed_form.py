@@ -13,7 +13,7 @@ import functools
 
 import numpy as np
 
-from phantom_pin.exceptions import UnreachableTargetError
+from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
 from phantom_pin.parameters import Parameters, load_parameters
 from phantom_pin.validation import as_states, same_batch
 
@@ -59,7 +59,7 @@ def inverse_kinematics(position: object, branch: str = "report",
     """
     p = params or shipped_parameters()
     if branch not in ("report", "other"):
-        raise ValueError(f"branch: expected 'report' or 'other', got {branch!r}")
+        raise InvalidInputError(f"branch: expected 'report' or 'other', got {branch!r}")
     target, _ = as_states(position, "position")
     px, py, pz = target[..., 0], target[..., 1], target[..., 2]
     theta1 = np.arctan2(px, pz + p.l1)                              # eq 11

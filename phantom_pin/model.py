@@ -76,10 +76,7 @@ class Phantom:
         """Apply a one-state function over the leading axes of same-shaped arrays."""
         if arrays[0].ndim == 1:
             return function(*arrays)
-        flat = [a.reshape(-1, 3) for a in arrays]
-        out = np.stack([function(*row) for row in zip(*flat)]) if len(flat[0]) else None
-        if out is None:
-            out = np.empty((0,) + function(*(np.zeros(3) for _ in arrays)).shape)
+        out = np.stack([function(*row) for row in zip(*(a.reshape(-1, 3) for a in arrays))])
         return out.reshape(arrays[0].shape[:-1] + out.shape[1:])
 
     def _states(self, names: tuple[str, ...], *values: object) -> list[np.ndarray]:

@@ -21,6 +21,8 @@ def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, boo
     if array.ndim == 0 or array.shape[-1] != width:
         raise InvalidInputError(
             f"{name}: expected shape ({width},) or (N, {width}), got {array.shape}")
+    if array.size == 0:
+        raise InvalidInputError(f"{name}: expected at least one state, got shape {array.shape}")
     if not np.isfinite(array).all():
         raise InvalidInputError(f"{name}: contains NaN or inf")
     return array, array.ndim > 1

@@ -92,7 +92,8 @@ def test_unreachable_targets_raise(target):
 
 
 @pytest.mark.parametrize("bad, message", [([0, 0], "shape"), ([0, np.nan, 0], "NaN"),
-                                          ([[0, 0, np.inf]], "NaN or inf"), ("abc", "numbers")])
+                                          ([[0, 0, np.inf]], "NaN or inf"), ("abc", "numbers"),
+                                          (np.zeros((0, 3)), "at least one state")])
 def test_bad_input_names_the_argument(bad, message):
     with pytest.raises(InvalidInputError, match=f"theta: .*{message}"):
         cf.mass_matrix(bad)
