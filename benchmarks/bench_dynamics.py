@@ -14,6 +14,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin import Phantom, closed_form as cf
+from phantom_pin.parameters import random_states
 
 
 def per_call(function, repeat: int = 7, number: int = 2000) -> float:
@@ -29,7 +30,7 @@ def main() -> None:
     model, data = phantom.model, phantom.model.createData()
     tree, tree_data, coupling = phantom.coupling.tree, phantom.coupling.tree.createData(), phantom.coupling
     q, v, a = np.array([0.2, 0.4, 0.5]), np.array([0.5, -1.0, 1.5]), np.array([2.0, 1.0, -3.0])
-    s, tip = model.getFrameId("report_s"), model.getFrameId("tip")
+    tip = model.getFrameId("tip")
     qt, vt, at = coupling.configuration(q), coupling.tangent(v), coupling.tangent(a)
     rows = [  # method, Phantom call, raw Pinocchio call it wraps, closed_form call
         ("inverse_dynamics", lambda: phantom.inverse_dynamics(q, v, a),
@@ -53,7 +54,6 @@ def main() -> None:
         ("inverse_kinematics", lambda: phantom.inverse_kinematics([0.05, 0.02, 0.03]),
          None, lambda: cf.inverse_kinematics([0.05, 0.02, 0.03])),
     ]
-    del s
     print(f"pin {pin.__version__}, numpy {np.__version__}, {phantom.threads} OpenMP threads\n")
     print("| method | Phantom [µs] | raw Pinocchio call [µs] | ratio | closed_form [µs] |")
     print("|---|---:|---:|---:|---:|")
@@ -66,10 +66,7 @@ def main() -> None:
         ratios[name] = t_ours / t_raw
         print(f"| {name} | {t_ours:.2f} | {t_raw:.2f} | {t_ours / t_raw:.2f} | {t_closed:.2f} |")
 
-    rng = np.random.default_rng(0)
-    p = phantom.parameters
-    theta = rng.uniform(p.lower, p.upper, (args.batch, 3))
-    dtheta, ddtheta = rng.normal(size=(args.batch, 3)), rng.normal(size=(args.batch, 3))
+    theta, dtheta, ddtheta = random_states(phantom.parameters, args.batch, seed=0)
     timings = {}
     for label, call in (("Phantom.inverse_dynamics", phantom.inverse_dynamics),
                         ("closed_form.inverse_dynamics", cf.inverse_dynamics)):

@@ -1,4 +1,4 @@
-"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf."""
+"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from phantom_pin import appendix, closed_form
 from phantom_pin.description import generate_srdf, generate_urdf
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.model import Phantom
-from phantom_pin.parameters import CONFIG_DIR, PARAMETER_FILES
+from phantom_pin.parameters import CONFIG_DIR, PARAMETER_FILES, random_states
 
 
 class _Parser(argparse.ArgumentParser):
@@ -59,10 +59,8 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
 
 
 def _check(args: argparse.Namespace, phantom: Phantom) -> int:
-    rng = np.random.default_rng(args.seed)
     p = phantom.parameters
-    theta = rng.uniform(p.lower, p.upper, (args.n, 3))
-    dtheta, ddtheta = rng.normal(0, 2, (args.n, 3)), rng.normal(0, 20, (args.n, 3))
+    theta, dtheta, ddtheta = random_states(p, args.n, args.seed)
     rows = []
     for name, arguments in (("forward_kinematics", (theta,)), ("spatial_jacobian", (theta,)),
                             ("body_jacobian", (theta,)), ("mass_matrix", (theta,)),

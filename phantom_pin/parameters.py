@@ -6,6 +6,7 @@ import dataclasses
 import math
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from phantom_pin.exceptions import ParameterFileError
@@ -145,3 +146,12 @@ def load_parameters(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str
         lower=lower,
         upper=upper,
     )
+
+
+def random_states(params: Parameters, n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``n`` seeded states (theta, dtheta, ddtheta), each (n, 3): theta uniform inside the
+    joint limits (rad), rates and accelerations normal with standard deviations 2 rad/s
+    and 20 rad/s^2."""
+    rng = np.random.default_rng(seed)
+    theta = rng.uniform(params.lower, params.upper, (n, 3))
+    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))

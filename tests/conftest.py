@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from phantom_pin import Phantom, closed_form
+from phantom_pin.parameters import random_states
 
 N_STATES = 1000
 
@@ -20,12 +21,9 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.fixture()
-def states(limits):
-    """N_STATES seeded (theta, dtheta, ddtheta): theta uniform inside the joint limits,
-    rates and accelerations normal with 2 rad/s and 20 rad/s^2 standard deviations."""
-    rng = np.random.default_rng(20261121)
-    theta = rng.uniform(limits[0], limits[1], (N_STATES, 3))
-    return theta, rng.normal(0, 2, (N_STATES, 3)), rng.normal(0, 20, (N_STATES, 3))
+def states():
+    """N_STATES seeded (theta, dtheta, ddtheta) inside the joint limits (parameters.random_states)."""
+    return random_states(closed_form.shipped_parameters(), N_STATES, seed=20261121)
 
 
 def relative_error(actual: np.ndarray, expected: np.ndarray) -> float:
