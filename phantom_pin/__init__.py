@@ -3,8 +3,9 @@
 from phantom_pin import closed_form
 from phantom_pin.exceptions import (InvalidInputError, ParameterFileError, PhantomPinError,
                                     UnreachableTargetError)
+from phantom_pin.loader import PhantomLoader, load
 from phantom_pin.model import Phantom
 from phantom_pin.parameters import Parameters, load_parameters
 
-__all__ = ["Phantom", "Parameters", "load_parameters", "closed_form", "PhantomPinError",
+__all__ = ["Phantom", "load", "PhantomLoader", "Parameters", "load_parameters", "closed_form", "PhantomPinError",
            "InvalidInputError", "ParameterFileError", "UnreachableTargetError"]

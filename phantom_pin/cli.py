@@ -1,4 +1,4 @@
-"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf."""
+"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, show."""
 
 from __future__ import annotations
 
@@ -6,6 +6,9 @@ import argparse
 import dataclasses
 import json
 import sys
+import tempfile
+import time
+import webbrowser
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +17,10 @@ import pinocchio as pin
 from phantom_pin import appendix, closed_form
 from phantom_pin.description import generate_srdf, generate_urdf
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.loader import PhantomLoader, load
 from phantom_pin.model import Phantom
-from phantom_pin.parameters import CONFIG_DIR, PARAMETER_FILES, random_states
+from phantom_pin.parameters import (CONFIG_DIR, PARAMETER_FILES, random_states, read_overrides,
+                                    write_overridden)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -119,14 +124,56 @@ def _parse_set(items: list[str]) -> dict[str, float]:
     return out
 
 
+def _refuse_overwrite(path: Path, force: bool, option: str) -> None:
+    if path.exists() and not force:
+        raise PhantomPinError(f"{option}: {path} exists; add --force to overwrite it")
+
+
 def _urdf(args: argparse.Namespace, phantom: Phantom | None) -> int:
     output = Path(args.output)
-    if output.exists() and not args.force:
-        raise PhantomPinError(f"--output: {output} exists; add --force to overwrite it")
-    text = generate_urdf(args.prefix, args.config) if args.kind == "urdf" else generate_srdf(args.prefix, args.config)
+    _refuse_overwrite(output, args.force, "--output")
+    try:
+        overrides = read_overrides(args.params) if args.params else {}
+    except PhantomPinError as error:
+        raise PhantomPinError(f"--params: {error}") from None
+    overrides.update(_parse_set(args.set))
+    generate = generate_urdf if args.kind == "urdf" else generate_srdf
+    with tempfile.TemporaryDirectory() as folder:
+        config = write_overridden(overrides, folder, args.config) if overrides else args.config
+        text = generate(args.prefix, config)
     output.write_text(text)
     print(f"wrote {output}")
     return 0
+
+
+def _show(args: argparse.Namespace, phantom: Phantom | None) -> int:
+    from phantom_pin.viewer import Viewer  # meshcat is only needed here
+
+    if args.html:
+        _refuse_overwrite(Path(args.html), args.force, "--html")
+    with tempfile.TemporaryDirectory() as folder:
+        loader = PhantomLoader
+        if Path(args.config).resolve() != CONFIG_DIR.resolve():
+            urdf, srdf = Path(folder) / "phantom_1_5.urdf", Path(folder) / "phantom_1_5.srdf"
+            urdf.write_text(generate_urdf("", args.config))
+            srdf.write_text(generate_srdf("", args.config))
+            loader = type("ConfigLoader", (PhantomLoader,), {"urdf_path": urdf, "srdf_path": srdf})
+        robot = load(loader)
+    with Viewer(robot) as viewer:
+        if args.tip_force is not None:
+            viewer.set_force(args.tip_force)
+        viewer.show(robot.q0 if args.theta is None else args.theta)
+        if args.html:
+            print(f"wrote {viewer.export_html(args.html, force=args.force)}")
+            return 0
+        print(f"meshcat viewer at {viewer.url} (Ctrl-C to stop)", flush=True)
+        if args.open:
+            webbrowser.open(viewer.url)
+        try:
+            while True:
+                time.sleep(3600)
+        except KeyboardInterrupt:
+            return 0
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -153,7 +200,18 @@ def _parser() -> argparse.ArgumentParser:
         gen.add_argument("--output", "-o", required=True)
         gen.add_argument("--prefix", default="")
         gen.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+        gen.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                         help="override one number of the parameter files, e.g. l1=0.2096 or "
+                              "segment_a.mass=0.03 (SI units, rad); repeatable")
+        gen.add_argument("--params", type=Path, help="a YAML file of such overrides (applied before --set)")
         gen.set_defaults(kind=kind)
+    show = sub.add_parser("show", help="the arm in meshcat: a live viewer on 127.0.0.1, or --html FILE")
+    show.add_argument("--theta", metavar="T", help="posture (rad; default: the SRDF's resting)", **three)
+    show.add_argument("--tip-force", metavar="F", help="force on the tip (N, frame s), drawn as an arrow",
+                      **three)
+    show.add_argument("--html", help="write a self-contained HTML file instead of serving")
+    show.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
+    show.add_argument("--open", action="store_true", help="open the live viewer in a browser")
     for command in (info, check, fk, ik, dyn):
         command.add_argument("--json", action="store_true", help="print JSON")
     return parser
@@ -162,12 +220,12 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code (0 ok, 1 check failed, 2 bad input)."""
     handlers = {"info": _info, "check": _check, "fk": _fk, "ik": _ik, "dynamics": _dynamics,
-                "urdf": _urdf, "srdf": _urdf}
+                "urdf": _urdf, "srdf": _urdf, "show": _show}
     try:
         args = _parser().parse_args(argv)
         if args.command == "check" and args.n < 1:
             raise PhantomPinError("-n: expected a positive number of states")
-        phantom = None if args.command in ("urdf", "srdf") else Phantom(args.config)
+        phantom = None if args.command in ("urdf", "srdf", "show") else Phantom(args.config)
         return handlers[args.command](args, phantom)
     except (PhantomPinError, ValueError) as error:
         print(f"phantom-pin: error: {error}", file=sys.stderr)

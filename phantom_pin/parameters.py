@@ -155,3 +155,71 @@ def random_states(params: Parameters, n: int, seed: int) -> tuple[np.ndarray, np
     rng = np.random.default_rng(seed)
     theta = rng.uniform(params.lower, params.upper, (n, 3))
     return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+
+
+def read_overrides(path: Path | str) -> dict[str, float]:
+    """Read a YAML file of parameter overrides into dotted keys.
+
+    Nested mappings and dotted keys are equivalent: ``segment_a: {mass: 0.03}`` and
+    ``segment_a.mass: 0.03`` both give ``{"segment_a.mass": 0.03}``.
+    """
+    path = Path(path)
+    flat: dict[str, float] = {}
+
+    def walk(node: dict, prefix: str) -> None:
+        for key, value in node.items():
+            dotted = f"{prefix}{key}"
+            if isinstance(value, dict):
+                walk(value, f"{dotted}.")
+            else:
+                flat[dotted] = value
+
+    walk(_read(path), "")
+    return flat
+
+
+def write_overridden(overrides: dict[str, object], destination: Path | str,
+                     config_dir: Path | str = CONFIG_DIR) -> Path:
+    """Copy the five parameter files of ``config_dir`` into the folder ``destination``
+    with ``overrides`` applied, check them with load_parameters, and return the folder.
+
+    Keys are dotted paths into the files ("l1", "segment_a.mass", "joint2.upper"),
+    optionally qualified by the file's stem ("actuation.motor.rotor_inertia"); an
+    unqualified key must exist in exactly one file. Each must name a number, and each
+    value must be a finite number in the units of that file (SI, radians). Comments
+    are not copied.
+    Raises ParameterFileError naming the key.
+    """
+    destination = Path(destination)
+    files = {name: _read(Path(config_dir) / name) for name in PARAMETER_FILES.values()}
+    stems = {Path(name).stem: name for name in files}
+    for key, value in overrides.items():
+        parts = str(key).split(".")
+        if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
+            holders, parts = [stems[parts[0]]], parts[1:]
+        else:
+            holders = [name for name, data in files.items() if parts[0] in data]
+        if not holders:
+            raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
+        if len(holders) > 1:
+            raise ParameterFileError(f"{key}: {' and '.join(holders)} both have {parts[0]!r}; "
+                                     f"qualify it, e.g. {Path(holders[0]).stem}.{key}")
+        if parts[0] not in files[holders[0]]:
+            raise ParameterFileError(f"{key}: {holders[0]} has no key {parts[0]!r}")
+        node: object = files[holders[0]]
+        for part in parts[:-1]:
+            node = node.get(part) if isinstance(node, dict) else None
+        current = node.get(parts[-1]) if isinstance(node, dict) else None
+        if isinstance(current, bool) or not isinstance(current, (int, float)):
+            raise ParameterFileError(f"{key}: not a number in {holders[0]}, cannot override it")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
+        node[parts[-1]] = float(value)
+    for name, data in files.items():
+        with open(destination / name, "w", encoding="utf-8") as stream:
+            yaml.safe_dump(data, stream, sort_keys=False)
+    try:
+        load_parameters(destination)
+    except ParameterFileError as error:  # name the file, not the temporary folder
+        raise ParameterFileError(f"after the overrides, {str(error).replace(f'{destination}/', '')}") from None
+    return destination

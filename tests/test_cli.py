@@ -1,13 +1,24 @@
-"""The phantom-pin command line: outputs against closed_form, exit codes, --force."""
+"""The phantom-pin command line: outputs against closed_form, exit codes, --force,
+overridden URDFs against the closed form with the same overrides, the viewer in chromium."""
 
+import dataclasses
 import json
+import shutil
+import signal
+import subprocess
+import sys
+import urllib.error
+import urllib.request
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
+from conftest import RAISED, dark, patch, render
 from phantom_pin import closed_form as cf
 from phantom_pin.cli import main
-from phantom_pin.paths import URDF_PATH
+from phantom_pin.description import generate_urdf
+from phantom_pin.paths import CONFIG_DIR, URDF_PATH
 
 
 def run(capsys, *argv):
@@ -68,3 +79,87 @@ def test_urdf_refuses_to_overwrite_without_force(tmp_path, capsys):
     assert code == 2 and "--force" in err and target.read_text() == "keep me"
     assert run(capsys, "urdf", "--output", str(target), "--force", "--prefix", "r_")[0] == 0
     assert 'name="r_joint1"' in target.read_text()
+
+
+def test_urdf_overrides_reach_kinematics_dynamics_and_mimic_tags(tmp_path, capsys):
+    params = tmp_path / "params.yaml"
+    params.write_text("segment_a: {mass: 0.03}\nsegment_be.inertia.xx: 12.0e-4\n")
+    target = tmp_path / "phantom.urdf"
+    code, _, _ = run(capsys, "urdf", "-o", str(target), "--params", str(params), "--set", "l1=0.2096")
+    assert code == 0
+    model = pin.buildModelFromUrdf(str(target), mimic=True)
+    expected = dataclasses.replace(cf.shipped_parameters(), l1=0.2096, ma=0.03, Ibexx=12.0e-4)
+    rotors = np.diag(expected.armature)  # the report's inertias include them; the URDF leaves
+                                         # them to the SRDF, which is not loaded here
+    data = model.createData()
+    for theta in np.random.default_rng(7).uniform(expected.lower, expected.upper, (50, 3)):
+        pin.framesForwardKinematics(model, data, theta)
+        g = data.oMf[model.getFrameId("report_s")].actInv(data.oMf[model.getFrameId("tip")])
+        np.testing.assert_allclose(g.homogeneous, cf.forward_kinematics(theta, expected), atol=1e-12)
+        mass = pin.crba(model, data, theta)
+        mass = np.triu(mass) + np.triu(mass, 1).T
+        np.testing.assert_allclose(mass + rotors, cf.mass_matrix(theta, expected), rtol=1e-9, atol=1e-15)
+    assert target.read_text().count("<mimic ") == 4
+
+
+def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, capsys):
+    target = tmp_path / "phantom.srdf"
+    assert run(capsys, "srdf", "-o", str(target), "--set", "actuation.motor.rotor_inertia=2e-6")[0] == 0
+    model = pin.buildModelFromUrdf(str(URDF_PATH), mimic=True)
+    pin.loadRotorParameters(model, str(target), False)
+    np.testing.assert_allclose(model.armature, [2e-6 * r**2 for r in cf.shipped_parameters().ratios],
+                               rtol=1e-12)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--set", "foo=1"], "foo: no parameter file has the key 'foo'"),
+    (["--set", "motor.max_speed=1"], "qualify it, e.g. actuation.motor.max_speed"),
+    (["--set", "kinematics.l4=1"], "kinematics.yaml has no key 'l4'"),
+    (["--set", "l1=abc"], "--set: expected KEY=NUMBER"),
+    (["--set", "segment_a=1"], "segment_a: not a number"),
+    (["--set", "l1=-0.1"], "l1 must be positive"),
+    (["--params", "/nonexistent/params.yaml"], "--params"),
+])
+def test_bad_overrides_give_one_line_and_exit_code_2(tmp_path, capsys, argv, message):
+    target = tmp_path / "phantom.urdf"
+    code, _, err = run(capsys, "urdf", "-o", str(target), *argv)
+    assert code == 2 and message in err and err.count("\n") == 1 and not target.exists()
+
+
+def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, capsys):
+    """--config with l1 = 0.25: the tip ball is drawn where that model (not the
+    shipped one) puts it; an existing file is kept without --force."""
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    kinematics = config / "kinematics.yaml"
+    kinematics.write_text(kinematics.read_text().replace("l1: 0.215 ", "l1: 0.25 "))
+    html = tmp_path / "scene.html"
+    argv = ["--config", str(config), "show", "--html", str(html), "--theta", *map(str, RAISED)]
+    assert run(capsys, *argv)[0] == 0
+    image = render(html, tmp_path / "scene.png")
+    tips = []
+    for urdf in (generate_urdf("", config), URDF_PATH.read_text()):
+        model = pin.buildModelFromXML(urdf, mimic=True)
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, RAISED)
+        tips.append(data.oMf[model.getFrameId("tip")].translation.copy())
+    assert np.linalg.norm(tips[0] - tips[1]) > 0.03
+    assert dark(patch(image, tips[0])) and not dark(patch(image, tips[1]))
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and "--force" in err
+
+
+def test_show_serves_on_loopback_until_interrupted(tmp_path):
+    process = subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "show"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = process.stdout.readline()
+        url = line.split(" at ")[1].split()[0]
+        assert url.startswith("http://127.0.0.1:")
+        with urllib.request.urlopen(url, timeout=10) as response:
+            assert response.status == 200
+    finally:
+        process.send_signal(signal.SIGINT)
+        assert process.wait(30) == 0
+    with pytest.raises(urllib.error.URLError):  # the server went with the command
+        urllib.request.urlopen(url, timeout=5)

@@ -1,0 +1,220 @@
+"""Viewer: the arm in meshcat (postures, animations, tip frame, tip force, HTML export)."""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import io
+import json
+import re
+from pathlib import Path
+
+import meshcat
+import meshcat.geometry as mg
+import numpy as np
+import pinocchio as pin
+import umsgpack
+from meshcat.animation import Animation
+from pinocchio.visualize import MeshcatVisualizer
+
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
+from phantom_pin.loader import load
+from phantom_pin.meshcat_server import MeshcatServer
+from phantom_pin.validation import as_states
+
+#: Camera position (m, base_link) from which the whole workspace is in view. meshcat
+#: 0.3's orbit controls always look at the world origin, here the shoulder.
+CAMERA_POSITION = np.array([0.42, 0.36, 0.22])
+#: Default arrow length per newton of tip force (m/N), and the arrow's radius (m).
+FORCE_SCALE, _ARROW_RADIUS = 0.03, 0.0025
+_FORCE_NODE, _ROOT = "force", "phantom"
+#: Key frames per second of animate(): theta(t) is resampled at this rate.
+_FPS = 30
+
+#: One scene command of meshcat's static HTML: an asynchronous fetch of a data URI.
+_COMMAND = re.compile(r'fetch\("data:application/octet-binary;base64,([A-Za-z0-9+/=]*)"\)'
+                      r'\s*\.then\(res => res\.arrayBuffer\(\)\)\s*\.then\(buffer => '
+                      r'viewer\.handle_command_bytearray\(new Uint8Array\(buffer\)\)\);')
+
+
+def _in_order(html: str) -> str:
+    """meshcat's static HTML with its scene commands run one after the other, in order,
+    animations last.
+
+    meshcat 0.3 replays each command through its own asynchronous fetch, so a large
+    animation may be bound to a node before (and then lose it to) the node's set_object.
+    """
+    payloads = _COMMAND.findall(html)
+    if not payloads:
+        raise PhantomPinError("meshcat's static HTML has no scene commands in the expected form")
+    is_animation = [umsgpack.unpackb(base64.b64decode(p))["type"] == "set_animation" for p in payloads]
+    ordered = [p for p, a in zip(payloads, is_animation) if not a] + \
+              [p for p, a in zip(payloads, is_animation) if a]
+    script = (f"for (const command of {json.dumps(ordered)}) {{\n"
+              "  viewer.handle_command_bytearray(Uint8Array.from(atob(command), c => c.charCodeAt(0)));\n}")
+    start = _COMMAND.search(html).start()
+    return html[:start] + script + _COMMAND.sub("", html[start:])
+
+
+def _arrow_rotation(direction: np.ndarray) -> np.ndarray:
+    """A rotation taking meshcat's cylinder axis (local y) onto the unit ``direction``."""
+    return pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), direction).matrix()
+
+
+class Viewer:
+    """The PHANToM 1.5 in a meshcat viewer served on 127.0.0.1.
+
+    ``Viewer()`` starts a meshcat server in a child process (stopped by ``close()``,
+    by leaving a ``with`` block, or at interpreter exit), loads ``phantom_pin.load()``
+    (or the RobotWrapper you pass), frames the arm with the camera and shows the
+    robot's q0. Joint vectors are the report's theta1..theta3 (rad); the scene's
+    world frame is ``base_link`` (x forward, z up). ``url`` is the page to open.
+    """
+
+    def __init__(self, robot: pin.RobotWrapper | None = None) -> None:
+        self.robot = load() if robot is None else robot
+        self.server = MeshcatServer()
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL
+                scene = meshcat.Visualizer(zmq_url=self.server.zmq_url)
+            self.visualizer = MeshcatVisualizer(self.robot.model, self.robot.collision_model,
+                                                self.robot.visual_model)
+            self.visualizer.initViewer(viewer=scene)
+            self.visualizer.loadViewerModel(rootNodeName=_ROOT)
+            self._tip = self.robot.model.getFrameId("tip")
+            self._s = self.robot.model.getFrameId("report_s")
+            self.visualizer.displayFrames(True, frame_ids=[self._tip], axis_length=0.04,
+                                          axis_width=4)
+            self._force = np.zeros(3)
+            self._force_scale = FORCE_SCALE
+            self.set_camera(CAMERA_POSITION)
+            self.show(self.robot.q0)
+        except BaseException:
+            self.server.stop()
+            raise
+
+    @property
+    def url(self) -> str:
+        """The viewer's web page, http://127.0.0.1:PORT/static/."""
+        return self.server.web_url
+
+    @property
+    def scene(self) -> meshcat.Visualizer:
+        """The meshcat scene, for drawing objects of your own."""
+        return self.visualizer.viewer
+
+    def set_camera(self, position: object) -> None:
+        """Put the camera at ``position`` (3,) (m, base_link), looking at the shoulder.
+
+        meshcat 0.3's orbit controls look at the world origin (base_link's origin,
+        the shoulder); the user can orbit and zoom from there in the browser.
+        """
+        p, batch = as_states(position, "position")
+        if batch:
+            raise InvalidInputError(f"position: expected one point, shape (3,), got {p.shape}")
+        if np.linalg.norm(p) < 1e-3:
+            raise InvalidInputError("position: must be at least 1 mm away from the shoulder")
+        # meshcat's camera node is rotated so that three.js's y-up camera sees a z-up
+        # world: its position is given as (x, z, -y).
+        self.scene["/Cameras/default/rotated/<object>"].set_property("position", [p[0], p[2], -p[1]])
+
+    def show(self, theta: object) -> None:
+        """Place the arm, its tip frame and the force arrow at ``theta`` (3,) (rad)."""
+        q, batch = as_states(theta, "theta")
+        if batch:
+            raise InvalidInputError(f"theta: expected one posture, shape (3,), got {q.shape}")
+        self.visualizer.display(q)
+        self._draw_force()
+
+    def set_force(self, force: object, scale: float = FORCE_SCALE) -> None:
+        """Draw the force on the tip (3,) (N, in the report's frame s) as an arrow of
+        ``scale`` metres per newton starting at the tip; a zero force hides the arrow.
+        The arrow follows the tip in later show() and animate() calls."""
+        f, batch = as_states(force, "force")
+        if batch:
+            raise InvalidInputError(f"force: expected one vector, shape (3,), got {f.shape}")
+        if not (np.isfinite(scale) and scale > 0):
+            raise InvalidInputError(f"scale: expected a positive number of m/N, got {scale!r}")
+        self._force, self._force_scale = f, float(scale)
+        node = self.scene[f"{_ROOT}/{_FORCE_NODE}"]
+        node.delete()
+        length = float(np.linalg.norm(f)) * scale
+        if length == 0.0:
+            return
+        head = min(0.3 * length, 4 * _ARROW_RADIUS)
+        material = mg.MeshLambertMaterial(color=0xD02020)
+        node["shaft"].set_object(mg.Cylinder(length - head, _ARROW_RADIUS), material)
+        node["shaft"].set_transform(pin.SE3(np.eye(3), np.array([0, (length - head) / 2, 0])).homogeneous)
+        node["head"].set_object(mg.Cylinder(head, radiusTop=0.0, radiusBottom=2 * _ARROW_RADIUS), material)
+        node["head"].set_transform(pin.SE3(np.eye(3), np.array([0, length - head / 2, 0])).homogeneous)
+        self._draw_force()
+
+    def _force_pose(self) -> np.ndarray:
+        """World pose of the arrow: at the tip, local y along the force (after kinematics)."""
+        pin.updateFramePlacements(self.robot.model, self.visualizer.data)
+        placements = self.visualizer.data.oMf
+        direction = placements[self._s].rotation @ self._force
+        return pin.SE3(_arrow_rotation(direction / np.linalg.norm(direction)),
+                       placements[self._tip].translation).homogeneous
+
+    def _draw_force(self) -> None:
+        if self._force.any():
+            self.scene[f"{_ROOT}/{_FORCE_NODE}"].set_transform(self._force_pose())
+
+    def animate(self, times: object, theta: object, repetitions: int = 1) -> None:
+        """Play theta(t) in the browser: ``times`` (N,) strictly increasing (s) and
+        ``theta`` (N, 3) (rad), interpolated linearly in time and resampled at 30 key
+        frames per second. The clip lives in the scene, so export_html() keeps it; it
+        plays ``repetitions`` times on page load, then the scene shows the last posture."""
+        t = np.asarray(times, dtype=float)
+        q, _ = as_states(theta, "theta")
+        if t.ndim != 1 or q.shape != (t.size, 3) or t.size < 2:
+            raise InvalidInputError(f"times, theta: expected shapes (N,) and (N, 3) with N >= 2, "
+                                    f"got {t.shape} and {q.shape}")
+        if not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
+            raise InvalidInputError("times: expected finite, strictly increasing seconds")
+        if not (isinstance(repetitions, int) and repetitions >= 1):
+            raise InvalidInputError(f"repetitions: expected a positive integer, got {repetitions!r}")
+        # Resample theta(t) at the frame rate so that every key frame is a true posture
+        # (the browser interpolates each link's pose between key frames).
+        samples = np.append(np.arange(0.0, t[-1] - t[0], 1.0 / _FPS), t[-1] - t[0])
+        postures = np.stack([np.interp(samples, t - t[0], q[:, j]) for j in range(3)], axis=1)
+        animation = Animation(default_framerate=_FPS)
+        model, data, geometry = self.robot.model, self.visualizer.data, self.robot.visual_model
+        geometry_data = self.visualizer.visual_data
+        frame_node = f"{self.visualizer.viewerFramesGroupName}/{model.frames[self._tip].name}"
+        for time, posture in zip(samples, postures):
+            with animation.at_frame(self.scene, time * _FPS) as frame:
+                pin.forwardKinematics(model, data, posture)
+                pin.updateGeometryPlacements(model, data, geometry, geometry_data)
+                for k, obj in enumerate(geometry.geometryObjects):
+                    name = self.visualizer.getViewerNodeName(obj, pin.GeometryType.VISUAL)
+                    frame[name].set_transform(geometry_data.oMg[k].homogeneous)
+                pin.updateFramePlacements(model, data)
+                frame[frame_node].set_transform(data.oMf[self._tip].homogeneous)
+                if self._force.any():
+                    frame[f"{_ROOT}/{_FORCE_NODE}"].set_transform(self._force_pose())
+        self.scene.set_animation(animation, play=True, repetitions=repetitions)
+        self.show(q[-1])  # the scene's own state: the last posture, shown when the clip ends
+
+    def export_html(self, path: Path | str, force: bool = False) -> Path:
+        """Write the scene (with its camera and animation) as one self-contained HTML
+        file that opens in any browser without a server; an existing file is kept
+        unless ``force``. Returns the path."""
+        output = Path(path)
+        if output.exists() and not force:
+            raise InvalidInputError(f"path: {output} exists; pass force=True to overwrite it")
+        if not output.parent.is_dir():
+            raise InvalidInputError(f"path: folder {output.parent} does not exist")
+        output.write_text(_in_order(self.scene.static_html()), encoding="utf-8")
+        return output
+
+    def close(self) -> None:
+        """Stop the meshcat server; idempotent."""
+        self.server.stop()
+
+    def __enter__(self) -> Viewer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

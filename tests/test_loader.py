@@ -1,0 +1,105 @@
+"""load() against the SRDF and YAML read independently, the closed form and yourdfpy."""
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+import yourdfpy
+
+from conftest import relative_error
+from phantom_pin import closed_form
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError
+from phantom_pin.loader import PhantomLoader, load
+from phantom_pin.paths import CONFIG_DIR, SRDF_PATH, URDF_PATH
+
+
+@pytest.fixture(scope="module")
+def robot() -> pin.RobotWrapper:
+    return load()
+
+
+def _srdf_postures() -> dict[str, np.ndarray]:
+    root = ET.parse(SRDF_PATH).getroot()
+    return {state.get("name"): np.array([float(j.get("value")) for j in state.iter("joint")])
+            for state in root.iter("group_state")}
+
+
+def test_model_is_the_mimic_model_with_report_joint_names(robot):
+    assert (robot.model.nq, robot.model.nv) == (3, 3)
+    assert list(robot.model.names)[1:4] == ["joint1", "joint2", "joint3"]
+
+
+def test_postures_and_q0_are_the_srdf_group_states(robot):
+    postures = _srdf_postures()
+    assert {"zero", "resting"} <= postures.keys()
+    assert sorted(e.key() for e in robot.model.referenceConfigurations) == sorted(postures)
+    for name, q in postures.items():
+        np.testing.assert_array_equal(robot.model.referenceConfigurations[name], q)
+    np.testing.assert_array_equal(robot.q0, postures[PhantomLoader.ref_posture])
+    assert PhantomLoader.ref_posture == "resting"
+
+
+def test_armature_is_rotor_inertia_times_ratio_squared_from_the_yaml(robot):
+    actuation = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())
+    ratios = [actuation["transmission_ratio"][j] for j in ("joint1", "joint2", "joint3")]
+    expected = [actuation["motor"]["rotor_inertia"] * r**2 for r in ratios]
+    np.testing.assert_allclose(robot.model.armature, expected, rtol=1e-12)
+
+
+def test_dynamics_of_the_loaded_model_are_the_closed_form(robot, states):
+    theta, dtheta, ddtheta = (s[:200] for s in states)
+    mass = np.array([robot.mass(q) for q in theta])
+    mass = np.triu(mass) + np.transpose(np.triu(mass, 1), (0, 2, 1))
+    tau = np.array([pin.rnea(robot.model, robot.data, *x) for x in zip(theta, dtheta, ddtheta)])
+    assert relative_error(mass, closed_form.mass_matrix(theta)) < 1e-9
+    assert relative_error(tau, closed_form.inverse_dynamics(theta, dtheta, ddtheta)) < 1e-9
+
+
+def test_visual_placements_match_yourdfpy(robot, states):
+    """Every <visual> of the URDF, placed by Pinocchio and by yourdfpy, within 1e-9 m."""
+    urdf_root = ET.parse(URDF_PATH).getroot()
+    visuals = {link.get("name"): link.findall("visual") for link in urdf_root.iter("link")}
+    assert robot.visual_model.ngeoms == sum(len(v) for v in visuals.values())
+    urdf = yourdfpy.URDF.load(str(URDF_PATH))
+    worst = 0.0
+    for q in states[0][:50]:
+        robot.framesForwardKinematics(q)
+        pin.updateGeometryPlacements(robot.model, robot.data, robot.visual_model, robot.visual_data)
+        urdf.update_cfg(q)
+        for k, geometry in enumerate(robot.visual_model.geometryObjects):
+            link, index = geometry.name.rsplit("_", 1)
+            origin = visuals[link][int(index)].find("origin")
+            xyz = [float(v) for v in origin.get("xyz", "0 0 0").split()] if origin is not None else [0, 0, 0]
+            rpy = [float(v) for v in origin.get("rpy", "0 0 0").split()] if origin is not None else [0, 0, 0]
+            local = pin.SE3(pin.rpy.rpyToMatrix(*rpy), np.array(xyz)).homogeneous
+            expected = urdf.get_transform(link) @ local
+            worst = max(worst, np.abs(robot.visual_data.oMg[k].homogeneous - expected).max())
+    assert worst < 1e-9
+
+
+def test_collision_pairs_skip_the_srdf_disabled_links_and_postures_are_free(robot):
+    disabled = {frozenset((d.get("link1"), d.get("link2")))
+                for d in ET.parse(SRDF_PATH).getroot().iter("disable_collisions")}
+    geometries = robot.collision_model.geometryObjects
+    links = [robot.model.frames[g.parentFrame].name for g in geometries]
+    pairs = {frozenset((links[p.first], links[p.second])) for p in robot.collision_model.collisionPairs}
+    assert pairs and not pairs & disabled
+    for name, q in _srdf_postures().items():
+        assert not pin.computeCollisions(robot.model, robot.data, robot.collision_model,
+                                         robot.collision_data, q, True), name
+
+
+def test_bad_loader_attributes_raise_named_errors():
+    class NoFile(PhantomLoader):
+        srdf_path = Path("/nonexistent/phantom.srdf")
+
+    class NoPosture(PhantomLoader):
+        ref_posture = "standing"
+
+    with pytest.raises(ParameterFileError, match="srdf_path"):
+        load(NoFile)
+    with pytest.raises(InvalidInputError, match="ref_posture: 'standing'"):
+        load(NoPosture)

@@ -1,0 +1,99 @@
+"""The exported HTML rendered by headless chromium (conftest.render), checked against a
+pinhole projection of Pinocchio's kinematics (conftest.project)."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from conftest import RAISED, RESTING, dark, patch, red, render
+from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.viewer import FORCE_SCALE, Viewer
+
+@pytest.fixture(scope="module")
+def viewer():
+    with Viewer() as v:
+        yield v
+
+
+def tip_frame(viewer: Viewer, theta: np.ndarray) -> tuple[pin.SE3, pin.SE3]:
+    """World poses of the frames tip and report_s at theta."""
+    model = viewer.robot.model
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, theta)
+    return data.oMf[model.getFrameId("tip")], data.oMf[model.getFrameId("report_s")]
+
+
+def test_two_postures_are_visible_where_kinematics_put_them(viewer, tmp_path):
+    images = {}
+    for name, theta in (("resting", RESTING), ("raised", RAISED)):
+        viewer.show(theta)
+        images[name] = render(viewer.export_html(tmp_path / f"{name}.html"), tmp_path / f"{name}.png")
+    tip_resting, tip_raised = (tip_frame(viewer, q)[0].translation for q in (RESTING, RAISED))
+    assert dark(patch(images["resting"], tip_resting)) and not dark(patch(images["resting"], tip_raised))
+    assert dark(patch(images["raised"], tip_raised)) and not dark(patch(images["raised"], tip_resting))
+    for image in images.values():  # the arm's grey links: thousands of unsaturated pixels
+        assert np.count_nonzero(np.ptp(image[40:], axis=2) < 30) > 3000
+    changed = np.any(np.abs(images["resting"] - images["raised"]) > 30, axis=2)
+    assert changed.mean() > 0.01
+
+
+def test_tip_frame_and_force_arrow_are_drawn(viewer, tmp_path):
+    force = np.array([0.0, -2.0, 1.0])  # N, in frame s
+    viewer.set_force(force)
+    viewer.show(RAISED)
+    image = render(viewer.export_html(tmp_path / "force.html"), tmp_path / "force.png")
+    viewer.set_force(np.zeros(3))
+    tip, s = tip_frame(viewer, RAISED)
+    direction = s.rotation @ force
+    arrow_middle = tip.translation + 0.5 * FORCE_SCALE * direction
+    assert red(patch(image, arrow_middle))
+    assert red(patch(image, tip.translation + tip.rotation @ [0.03, 0.0, 0.0]))  # the x axis
+
+
+def test_animation_plays_in_the_exported_page(viewer, tmp_path):
+    """Hold RESTING for 30 s, then move to RAISED: two seconds after loading, the page
+    shows RESTING although the scene's own (static) state is the last posture."""
+    viewer.animate([0.0, 30.0, 31.0], [RESTING, RESTING, RAISED])
+    image = render(viewer.export_html(tmp_path / "animation.html"), tmp_path / "animation.png")
+    viewer.show(RESTING)
+    tip_resting, tip_raised = (tip_frame(viewer, q)[0].translation for q in (RESTING, RAISED))
+    assert dark(patch(image, tip_resting)) and not dark(patch(image, tip_raised))
+
+
+def test_exported_html_is_self_contained(viewer, tmp_path):
+    html = viewer.export_html(tmp_path / "scene.html").read_text()
+    assert "<script src" not in html and "http://" not in html.split("<script>")[0]
+    assert len(html) > 100_000  # meshcat's viewer code is inlined
+
+
+def test_bad_input_raises_named_errors(viewer, tmp_path):
+    with pytest.raises(InvalidInputError, match="theta"):
+        viewer.show([0.0, 0.1])
+    with pytest.raises(InvalidInputError, match="theta"):
+        viewer.show([0.0, np.nan, 0.0])
+    with pytest.raises(InvalidInputError, match="times"):
+        viewer.animate([0.0, 0.0], [RESTING, RAISED])
+    with pytest.raises(InvalidInputError, match="times, theta"):
+        viewer.animate([0.0, 1.0, 2.0], [RESTING, RAISED])
+    with pytest.raises(InvalidInputError, match="force"):
+        viewer.set_force([1.0, 2.0])
+    with pytest.raises(InvalidInputError, match="scale"):
+        viewer.set_force([1.0, 0.0, 0.0], scale=-1.0)
+    with pytest.raises(InvalidInputError, match="position"):
+        viewer.set_camera([0.0, 0.0, 0.0])
+    existing = tmp_path / "existing.html"
+    existing.write_text("keep")
+    with pytest.raises(InvalidInputError, match="exists"):
+        viewer.export_html(existing)
+    assert existing.read_text() == "keep"
+    viewer.export_html(existing, force=True)
+    assert existing.read_text() != "keep"
+
+
+def test_close_stops_the_server():
+    viewer = Viewer()
+    process = viewer.server.process
+    with viewer:
+        assert process.poll() is None
+    assert process.poll() is not None
+    viewer.close()  # idempotent
