@@ -7,7 +7,6 @@ import dataclasses
 import json
 import sys
 import tempfile
-import time
 import webbrowser
 from pathlib import Path
 
@@ -169,11 +168,8 @@ def _show(args: argparse.Namespace, phantom: Phantom | None) -> int:
         print(f"meshcat viewer at {viewer.url} (Ctrl-C to stop)", flush=True)
         if args.open:
             webbrowser.open(viewer.url)
-        try:
-            while True:
-                time.sleep(3600)
-        except KeyboardInterrupt:
-            return 0
+        viewer.wait()
+    return 0
 
 
 def _parser() -> argparse.ArgumentParser:

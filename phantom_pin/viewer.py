@@ -7,6 +7,7 @@ import contextlib
 import io
 import json
 import re
+import time
 from pathlib import Path
 
 import meshcat
@@ -183,8 +184,8 @@ class Viewer:
         model, data, geometry = self.robot.model, self.visualizer.data, self.robot.visual_model
         geometry_data = self.visualizer.visual_data
         frame_node = f"{self.visualizer.viewerFramesGroupName}/{model.frames[self._tip].name}"
-        for time, posture in zip(samples, postures):
-            with animation.at_frame(self.scene, time * _FPS) as frame:
+        for instant, posture in zip(samples, postures):
+            with animation.at_frame(self.scene, instant * _FPS) as frame:
                 pin.forwardKinematics(model, data, posture)
                 pin.updateGeometryPlacements(model, data, geometry, geometry_data)
                 for k, obj in enumerate(geometry.geometryObjects):
@@ -208,6 +209,16 @@ class Viewer:
             raise InvalidInputError(f"path: folder {output.parent} does not exist")
         output.write_text(_in_order(self.scene.static_html()), encoding="utf-8")
         return output
+
+    def wait(self) -> None:
+        """Block until Ctrl-C (KeyboardInterrupt), keeping the live viewer served; raise
+        PhantomPinError if the server process ends first."""
+        try:
+            while self.server.running:
+                time.sleep(0.5)
+        except KeyboardInterrupt:
+            return
+        raise PhantomPinError(f"the meshcat server stopped (exit code {self.server.process.returncode})")
 
     def close(self) -> None:
         """Stop the meshcat server; idempotent."""

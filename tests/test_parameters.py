@@ -1,11 +1,13 @@
 """Malformed parameter files raise ParameterFileError naming the file and the key."""
 
+import dataclasses
 import shutil
 
 import pytest
 
 from phantom_pin import ParameterFileError, Phantom, load_parameters
 from phantom_pin.description import generate_urdf
+from phantom_pin.parameters import read_overrides, write_overridden
 from phantom_pin.paths import CONFIG_DIR
 
 
@@ -44,3 +46,24 @@ def test_malformed_files_are_named(config, file, old, new, message):
 def test_missing_file(tmp_path):
     with pytest.raises(ParameterFileError, match="cannot read"):
         load_parameters(tmp_path)
+
+
+def test_overrides_nested_dotted_and_qualified_keys_are_the_same(tmp_path):
+    nested, dotted = tmp_path / "nested.yaml", tmp_path / "dotted.yaml"
+    nested.write_text("segment_a: {inertia: {xx: 5.0e-5}}\nactuation: {motor: {rotor_inertia: 2.0e-6}}\n")
+    dotted.write_text("segment_a.inertia.xx: 5.0e-5\nactuation.motor.rotor_inertia: 2.0e-6\n")
+    assert read_overrides(nested) == read_overrides(dotted) == {
+        "segment_a.inertia.xx": 5.0e-5, "actuation.motor.rotor_inertia": 2.0e-6}
+    folder = tmp_path / "config"
+    folder.mkdir()
+    p = load_parameters(write_overridden(read_overrides(nested), folder))
+    assert (p.Iaxx, p.rotor_inertia) == (5.0e-5, 2.0e-6)
+    assert dataclasses.replace(p, Iaxx=load_parameters().Iaxx, rotor_inertia=load_parameters().rotor_inertia) \
+        == load_parameters()  # nothing else changed
+
+
+def test_malformed_override_file_raises_naming_the_file(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("- l1\n- 0.2\n")
+    with pytest.raises(ParameterFileError, match="bad.yaml: expected a mapping"):
+        read_overrides(bad)
