@@ -6,7 +6,7 @@ import pinocchio as pin
 import pytest
 
 from conftest import RAISED, RESTING, dark, patch, red, render
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.viewer import FORCE_SCALE, Viewer
 
 @pytest.fixture(scope="module")
@@ -97,3 +97,10 @@ def test_close_stops_the_server():
         assert process.poll() is None
     assert process.poll() is not None
     viewer.close()  # idempotent
+
+
+def test_wait_reports_a_server_that_died():
+    with Viewer() as viewer:
+        viewer.server.process.kill()
+        with pytest.raises(PhantomPinError, match="meshcat server stopped"):
+            viewer.wait()
