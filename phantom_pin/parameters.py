@@ -81,13 +81,18 @@ def _read(path: Path) -> dict:
     return data
 
 
+def _is_number(value: object) -> bool:
+    """True for an int or float that is not a bool (YAML's true/false)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _number(data: dict, path: Path, *keys: str, positive: bool = False) -> float:
     node: object = data
     for depth, key in enumerate(keys):
         if not isinstance(node, dict) or key not in node:
             raise ParameterFileError(f"{path}: missing key {'.'.join(keys[:depth + 1])}")
         node = node[key]
-    if isinstance(node, bool) or not isinstance(node, (int, float)) or not math.isfinite(node):
+    if not _is_number(node) or not math.isfinite(node):
         raise ParameterFileError(f"{path}: {'.'.join(keys)} must be a finite number, got {node!r}")
     if positive and node <= 0:
         raise ParameterFileError(f"{path}: {'.'.join(keys)} must be positive, got {node!r}")
@@ -210,9 +215,9 @@ def write_overridden(overrides: dict[str, object], destination: Path | str,
         for part in parts[:-1]:
             node = node.get(part) if isinstance(node, dict) else None
         current = node.get(parts[-1]) if isinstance(node, dict) else None
-        if isinstance(current, bool) or not isinstance(current, (int, float)):
+        if not _is_number(current):
             raise ParameterFileError(f"{key}: not a number in {holders[0]}, cannot override it")
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        if not _is_number(value) or not math.isfinite(value):
             raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
         node[parts[-1]] = float(value)
     for name, data in files.items():

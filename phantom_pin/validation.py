@@ -28,6 +28,14 @@ def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, boo
     return array, array.ndim > 1
 
 
+def as_state(value: object, name: str) -> np.ndarray:
+    """Return ``value`` as one float vector of shape (3,); as_states' checks, and no batch."""
+    array, batch = as_states(value, name)
+    if batch:
+        raise InvalidInputError(f"{name}: expected one vector, shape (3,), got {array.shape}")
+    return array
+
+
 def same_batch(names: tuple[str, ...], *arrays: np.ndarray) -> None:
     """Raise InvalidInputError unless all ``arrays`` have the same shape."""
     shapes = {a.shape for a in arrays}

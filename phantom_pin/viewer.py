@@ -21,14 +21,16 @@ from pinocchio.visualize import MeshcatVisualizer
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.loader import load
 from phantom_pin.meshcat_server import MeshcatServer
-from phantom_pin.validation import as_states
+from phantom_pin.validation import as_state, as_states
 
 #: Camera position (m, base_link) from which the whole workspace is in view. meshcat
 #: 0.3's orbit controls always look at the world origin, here the shoulder.
 CAMERA_POSITION = np.array([0.42, 0.36, 0.22])
 #: Default arrow length per newton of tip force (m/N), and the arrow's radius (m).
 FORCE_SCALE, _ARROW_RADIUS = 0.03, 0.0025
-_FORCE_NODE, _ROOT = "force", "phantom"
+#: meshcat paths: the robot's root node, and the force arrow under it.
+_ROOT = "phantom"
+_FORCE_PATH = f"{_ROOT}/force"
 #: Key frames per second of animate(): theta(t) is resampled at this rate.
 _FPS = 30
 
@@ -87,7 +89,6 @@ class Viewer:
             self.visualizer.displayFrames(True, frame_ids=[self._tip], axis_length=0.04,
                                           axis_width=4)
             self._force = np.zeros(3)
-            self._force_scale = FORCE_SCALE
             self.set_camera(CAMERA_POSITION)
             self.show(self.robot.q0)
         except BaseException:
@@ -110,9 +111,7 @@ class Viewer:
         meshcat 0.3's orbit controls look at the world origin (base_link's origin,
         the shoulder); the user can orbit and zoom from there in the browser.
         """
-        p, batch = as_states(position, "position")
-        if batch:
-            raise InvalidInputError(f"position: expected one point, shape (3,), got {p.shape}")
+        p = as_state(position, "position")
         if np.linalg.norm(p) < 1e-3:
             raise InvalidInputError("position: must be at least 1 mm away from the shoulder")
         # meshcat's camera node is rotated so that three.js's y-up camera sees a z-up
@@ -121,23 +120,18 @@ class Viewer:
 
     def show(self, theta: object) -> None:
         """Place the arm, its tip frame and the force arrow at ``theta`` (3,) (rad)."""
-        q, batch = as_states(theta, "theta")
-        if batch:
-            raise InvalidInputError(f"theta: expected one posture, shape (3,), got {q.shape}")
-        self.visualizer.display(q)
+        self.visualizer.display(as_state(theta, "theta"))
         self._draw_force()
 
     def set_force(self, force: object, scale: float = FORCE_SCALE) -> None:
         """Draw the force on the tip (3,) (N, in the report's frame s) as an arrow of
         ``scale`` metres per newton starting at the tip; a zero force hides the arrow.
         The arrow follows the tip in later show() and animate() calls."""
-        f, batch = as_states(force, "force")
-        if batch:
-            raise InvalidInputError(f"force: expected one vector, shape (3,), got {f.shape}")
+        f = as_state(force, "force")
         if not (np.isfinite(scale) and scale > 0):
             raise InvalidInputError(f"scale: expected a positive number of m/N, got {scale!r}")
-        self._force, self._force_scale = f, float(scale)
-        node = self.scene[f"{_ROOT}/{_FORCE_NODE}"]
+        self._force = f
+        node = self.scene[_FORCE_PATH]
         node.delete()
         length = float(np.linalg.norm(f)) * scale
         if length == 0.0:
@@ -151,8 +145,9 @@ class Viewer:
         self._draw_force()
 
     def _force_pose(self) -> np.ndarray:
-        """World pose of the arrow: at the tip, local y along the force (after kinematics)."""
-        pin.updateFramePlacements(self.robot.model, self.visualizer.data)
+        """World pose of the arrow: at the tip, local y along the force. Reads the frame
+        placements of the visualizer's data, which display() (frames shown) and animate()
+        update."""
         placements = self.visualizer.data.oMf
         direction = placements[self._s].rotation @ self._force
         return pin.SE3(_arrow_rotation(direction / np.linalg.norm(direction)),
@@ -160,7 +155,7 @@ class Viewer:
 
     def _draw_force(self) -> None:
         if self._force.any():
-            self.scene[f"{_ROOT}/{_FORCE_NODE}"].set_transform(self._force_pose())
+            self.scene[_FORCE_PATH].set_transform(self._force_pose())
 
     def animate(self, times: object, theta: object, repetitions: int = 1) -> None:
         """Play theta(t) in the browser: ``times`` (N,) strictly increasing (s) and
@@ -194,7 +189,7 @@ class Viewer:
                 pin.updateFramePlacements(model, data)
                 frame[frame_node].set_transform(data.oMf[self._tip].homogeneous)
                 if self._force.any():
-                    frame[f"{_ROOT}/{_FORCE_NODE}"].set_transform(self._force_pose())
+                    frame[_FORCE_PATH].set_transform(self._force_pose())
         self.scene.set_animation(animation, play=True, repetitions=repetitions)
         self.show(q[-1])  # the scene's own state: the last posture, shown when the clip ends
 

@@ -8,6 +8,7 @@ import subprocess
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from PIL import Image
 
@@ -33,6 +34,13 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
 def states():
     """N_STATES seeded (theta, dtheta, ddtheta) inside the joint limits (parameters.random_states)."""
     return random_states(closed_form.shipped_parameters(), N_STATES, seed=20261121)
+
+
+def frame_pose(model: pin.Model, theta: np.ndarray, name: str) -> pin.SE3:
+    """World pose of the frame ``name`` at theta (rad), by Pinocchio's forward kinematics."""
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, np.asarray(theta, dtype=float))
+    return pin.SE3(data.oMf[model.getFrameId(name)])  # a copy, independent of data
 
 
 def relative_error(actual: np.ndarray, expected: np.ndarray) -> float:

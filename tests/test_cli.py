@@ -14,7 +14,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import RAISED, dark, patch, render
+from conftest import RAISED, dark, frame_pose, patch, render
 from phantom_pin import closed_form as cf
 from phantom_pin.cli import main
 from phantom_pin.description import generate_urdf
@@ -137,12 +137,8 @@ def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, ca
     argv = ["--config", str(config), "show", "--html", str(html), "--theta", *map(str, RAISED)]
     assert run(capsys, *argv)[0] == 0
     image = render(html, tmp_path / "scene.png")
-    tips = []
-    for urdf in (generate_urdf("", config), URDF_PATH.read_text()):
-        model = pin.buildModelFromXML(urdf, mimic=True)
-        data = model.createData()
-        pin.framesForwardKinematics(model, data, RAISED)
-        tips.append(data.oMf[model.getFrameId("tip")].translation.copy())
+    tips = [frame_pose(pin.buildModelFromXML(urdf, mimic=True), RAISED, "tip").translation
+            for urdf in (generate_urdf("", config), URDF_PATH.read_text())]
     assert np.linalg.norm(tips[0] - tips[1]) > 0.03
     assert dark(patch(image, tips[0])) and not dark(patch(image, tips[1]))
     code, _, err = run(capsys, *argv)

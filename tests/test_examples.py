@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import dark, patch, render
+from conftest import dark, frame_pose, patch, render
 from phantom_pin import load
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -81,12 +81,7 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
         sys.path.remove(str(EXAMPLES))
     robot = load()
     _, postures = example.sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-    tip = robot.model.getFrameId("tip")
-    tips = []
-    for theta in postures:
-        robot.framesForwardKinematics(theta)
-        tips.append(robot.data.oMf[tip].translation.copy())
-    assert any(dark(patch(image, p)) for p in tips)
+    assert any(dark(patch(image, frame_pose(robot.model, theta, "tip").translation)) for theta in postures)
 
 
 @pytest.mark.parametrize("script", ["gravity_compensation.py", "simulate.py", "workspace.py",

@@ -5,7 +5,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import RAISED, RESTING, dark, patch, red, render
+from conftest import RAISED, RESTING, dark, frame_pose, patch, red, render
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.viewer import FORCE_SCALE, Viewer
 
@@ -18,9 +18,7 @@ def viewer():
 def tip_frame(viewer: Viewer, theta: np.ndarray) -> tuple[pin.SE3, pin.SE3]:
     """World poses of the frames tip and report_s at theta."""
     model = viewer.robot.model
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, theta)
-    return data.oMf[model.getFrameId("tip")], data.oMf[model.getFrameId("report_s")]
+    return frame_pose(model, theta, "tip"), frame_pose(model, theta, "report_s")
 
 
 def test_two_postures_are_visible_where_kinematics_put_them(viewer, tmp_path):
