@@ -36,7 +36,7 @@ def read_mimic_tags(urdf_xml: str) -> dict[str, Mimic]:
     except ET.ParseError as error:
         raise ParameterFileError(f"URDF is not well-formed XML: {error}") from error
     mimics = {}
-    for joint in root.iter("joint"):
+    for joint in root.findall("joint"):
         tag = joint.find("mimic")
         if tag is not None:
             name = joint.get("name")

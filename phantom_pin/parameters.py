@@ -19,6 +19,7 @@ PARAMETER_FILES = {
     "actuation_file": "actuation.yaml",
     "joint_limits_file": "joint_limits.yaml",
     "visual_parameters_file": "visual_parameters.yaml",
+    "mjcf_file": "mjcf.yaml",
 }
 
 

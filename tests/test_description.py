@@ -12,13 +12,15 @@ from phantom_pin import appendix
 from conftest import relative_error
 from phantom_pin import closed_form
 from phantom_pin.description import generate_srdf, generate_urdf
-from phantom_pin.paths import SRDF_PATH, URDF_PATH
+from phantom_pin.mjcf import generate_mjcf
+from phantom_pin.paths import DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
 
 ACTUATED = ["joint1", "joint2", "joint3"]
 # (joint, primary, multiplier) of the parallelogram, as designed in urdf/phantom_1_5_macro.xacro
 PASSIVE = [("crank_pin_a", "joint3", -1.0), ("crank_pin_b", "joint2", 1.0),
            ("forearm_pin_a", "joint2", -1.0), ("forearm_pin_b", "joint3", 1.0)]
 SEGMENT_LINKS = ["turret_link", "upper_arm_link", "crank_link", "lower_bar_link", "forearm_link"]
+PIN_LINKS = {"crank_pin_link": "crank_link", "forearm_pin_link": "lower_bar_link"}  # pin: mass donor
 
 
 @pytest.fixture(scope="module")
@@ -36,6 +38,9 @@ def mimic_model():
 def test_committed_files_match_a_fresh_xacro_run():
     assert URDF_PATH.read_text() == generate_urdf(), "run the regeneration in robots/phantom_description/README.md"
     assert SRDF_PATH.read_text() == generate_srdf()
+    robot, scene = generate_mjcf()
+    assert (DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml").read_text() == robot
+    assert (DESCRIPTION_DIR / "mjcf" / "scene.xml").read_text() == scene
 
 
 def test_prefix_reaches_every_name():
@@ -54,7 +59,7 @@ def test_prefix_reaches_every_name():
 
 
 def test_joints_are_the_report_thetas_and_the_parallelogram_mimics(urdf_root):
-    joints = {j.get("name"): j for j in urdf_root.iter("joint")}
+    joints = {j.get("name"): j for j in urdf_root.findall("joint")}
     for name, axis in zip(ACTUATED, ["0 0 1", "0 -1 0", "0 -1 0"]):
         assert joints[name].get("type") == "revolute" and joints[name].find("mimic") is None
         assert joints[name].find("axis").get("xyz") == axis
@@ -87,7 +92,7 @@ def _inertials(root):
 
 def test_every_link_inertia_is_physical(urdf_root):
     links = {name: (mass, tensor) for name, mass, _, tensor in _inertials(urdf_root)}
-    assert sorted(links) == sorted(SEGMENT_LINKS)
+    assert sorted(links) == sorted(SEGMENT_LINKS + list(PIN_LINKS))  # no massless moving body
     for name, (mass, tensor) in links.items():
         moments = np.linalg.eigvalsh(tensor)
         assert mass > 0 and moments.min() > 0, name
@@ -96,7 +101,12 @@ def test_every_link_inertia_is_physical(urdf_root):
 
 
 def test_link_inertias_give_back_the_report_values(urdf_root):
-    """Undo the xacro's conversion: URDF (COM, base axes) to the report's (origin, report axes)."""
+    """Undo the xacro's conversion: URDF (COM, base axes) to the report's (origin, report axes).
+
+    Each hinge pin's mass sits at its pivot, a point of its donor link: added back to the
+    donor (as a point mass, by Pinocchio's spatial-inertia sum), the donor is the report's
+    segment again. The pins' vertical moments add back to the turret's.
+    """
     p = closed_form.shipped_parameters()
     to_report = np.array([[0, 1, 0], [0, 0, 1], [1, 0, 0]])  # base (x, y, z) = report (z, x, y)
     armature2, armature3 = p.armature[1], p.armature[2]
@@ -108,18 +118,25 @@ def test_link_inertias_give_back_the_report_values(urdf_root):
     }
     coms = {"upper_arm_link": [0, 0, p.l5], "crank_link": [0, p.l6, 0],
             "lower_bar_link": [0, 0, p.l1 / 2], "forearm_link": [0, p.l3 - p.l2 / 2, 0]}
-    for name, mass, com, tensor in _inertials(urdf_root):
-        if name == "turret_link":
-            assert tensor[2, 2] + p.armature[0] == pytest.approx(p.Ibaseyy, rel=1e-12)
-            continue
+    links = {name: pin.Inertia(mass, com, tensor) for name, mass, com, tensor in _inertials(urdf_root)}
+    pivots = {"crank_pin_link": np.array([0, 0, -p.l3]),     # in crank_link (base axes)
+              "forearm_pin_link": np.array([p.l1, 0, 0])}   # in lower_bar_link
+    vertical = 0.0
+    for pin_link, donor in PIN_LINKS.items():
+        pin_inertia = links.pop(pin_link)
+        vertical += pin_inertia.inertia[2, 2]
+        links[donor] = links[donor] + pin.Inertia(pin_inertia.mass, pivots[pin_link], np.zeros((3, 3)))
+    turret = links.pop("turret_link")
+    assert turret.inertia[2, 2] + vertical + p.armature[0] == pytest.approx(p.Ibaseyy, rel=1e-12)
+    for name, inertia in links.items():
         report_mass, report_inertia, about = expected[name]
-        com_report = to_report @ com
-        np.testing.assert_allclose(com_report, coms[name], atol=1e-15)
-        inertia = to_report @ tensor @ to_report.T
+        com_report = to_report @ inertia.lever
+        np.testing.assert_allclose(com_report, coms[name], atol=1e-15, err_msg=name)
+        tensor = to_report @ inertia.inertia @ to_report.T
         if about is not None:  # parallel-axis theorem from the COM to the shoulder
-            inertia = inertia + mass * (com_report @ com_report * np.eye(3) - np.outer(com_report, com_report))
-        assert mass == report_mass
-        np.testing.assert_allclose(inertia, report_inertia, rtol=1e-12, atol=1e-18, err_msg=name)
+            tensor = tensor + inertia.mass * (com_report @ com_report * np.eye(3) - np.outer(com_report, com_report))
+        assert inertia.mass == pytest.approx(report_mass, rel=1e-15)
+        np.testing.assert_allclose(tensor, report_inertia, rtol=1e-12, atol=1e-18, err_msg=name)
 
 
 def test_crba_equals_the_report_mass_matrix(mimic_model, states):

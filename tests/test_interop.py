@@ -1,0 +1,229 @@
+"""The committed URDF and MJCF in other tools: MuJoCo, Drake and urdfdom's check_urdf.
+
+Each tool's dynamics are compared with the report's closed form (phantom_pin.closed_form),
+projected to theta1..theta3 through the coupling matrix G read from the URDF's mimic tags
+(v_tree = G dtheta): M = G^T M_tree G, N = G^T N_tree. Free swings are compared with an
+RK4 integration of the closed form written here. States are seeded and inside the device's
+limits: the URDF's joint box and the coupled stops of config/joint_limits.yaml.
+"""
+
+import shutil
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pydrake.all as drake
+import pytest
+import yaml
+
+from conftest import relative_error
+from phantom_pin import closed_form
+from phantom_pin.coupling import Coupling
+from phantom_pin.paths import CONFIG_DIR, DESCRIPTION_DIR, URDF_PATH
+
+
+MJCF_PATH = DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml"
+SCENE_PATH = DESCRIPTION_DIR / "mjcf" / "scene.xml"
+ACTUATED = ("joint1", "joint2", "joint3")
+THETA0 = np.array([0.3, 0.8, 0.4])  # rad, the free swing's rest state
+
+
+@pytest.fixture(scope="module")
+def coupling() -> Coupling:
+    return Coupling(URDF_PATH.read_text())
+
+
+def inside_stops(n: int, seed: int, pool: np.ndarray | None = None) -> np.ndarray:
+    """At most ``n`` seeded theta (rad), uniform in the URDF box and inside the coupled
+    stops: the first of ``pool`` (default: 4 n seeded states in the box) that are inside."""
+    limits = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())
+    stops = limits["stops"]
+    if pool is None:
+        lower = [limits[j]["lower"] for j in ACTUATED]
+        upper = [limits[j]["upper"] for j in ACTUATED]
+        pool = np.random.default_rng(seed).uniform(lower, upper, (4 * n, 3))
+    keep = ((pool[:, 1] - pool[:, 2] <= stops["theta2_minus_theta3_max"])
+            & (pool[:, 2] - pool[:, 1] <= stops["theta3_minus_theta2_max"]))
+    return pool[keep][:n]
+
+
+def rk4_closed_form(theta0: np.ndarray, duration: float, step: float) -> np.ndarray:
+    """theta (rad) after ``duration`` s of free motion from rest (tau = 0), RK4 on eq. 80."""
+    def rate(x):
+        theta, dtheta = x[:3], x[3:]
+        force = -closed_form.coriolis_matrix(theta, dtheta) @ dtheta - closed_form.gravity(theta)
+        return np.concatenate([dtheta, np.linalg.solve(closed_form.mass_matrix(theta), force)])
+    x = np.concatenate([theta0, np.zeros(3)])
+    for _ in range(round(duration / step)):
+        k1 = rate(x)
+        k2 = rate(x + step / 2 * k1)
+        k3 = rate(x + step / 2 * k2)
+        k4 = rate(x + step * k3)
+        x = x + step / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x[:3]
+
+
+# -- MuJoCo ------------------------------------------------------------------------------
+
+class MujocoArm:
+    """A MuJoCo model with its joints addressed in the coupling's tree order."""
+
+    def __init__(self, model, coupling: Coupling) -> None:
+        self.model, self.data, self.coupling = model, mujoco.MjData(model), coupling
+        names = [model.joint(i).name for i in range(model.njnt)]
+        assert sorted(names) == sorted(coupling.tree.names[1:])
+        self.qpos = [model.jnt_qposadr[names.index(n)] for n in coupling.tree.names[1:]]
+        self.dof = [model.jnt_dofadr[names.index(n)] for n in coupling.tree.names[1:]]
+
+    def set(self, theta: np.ndarray) -> None:
+        self.data.qpos[self.qpos] = self.coupling.configuration(theta)
+        self.data.qvel[:] = 0
+        mujoco.mj_forward(self.model, self.data)
+
+    def reduced_mass_and_gravity(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        self.set(theta)
+        full = np.zeros((self.model.nv, self.model.nv))
+        mujoco.mj_fullM(self.model, self.data, full)
+        tree = full[np.ix_(self.dof, self.dof)]
+        G = self.coupling.matrix
+        return G.T @ tree @ G, G.T @ self.data.qfrc_bias[self.dof]  # bias at rest = gravity
+
+
+def test_mujoco_loads_the_committed_urdf_with_the_report_dynamics(coupling):
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(URDF_PATH)), coupling)
+    assert arm.model.neq == 4  # the mimic tags, as joint equalities
+    armature = np.diag(closed_form.shipped_parameters().armature)  # the URDF has no armature
+    for theta in inside_stops(200, seed=1):
+        mass, gravity = arm.reduced_mass_and_gravity(theta)
+        assert relative_error(mass, closed_form.mass_matrix(theta) - armature) < 1e-9
+        assert relative_error(gravity, closed_form.gravity(theta)) < 1e-9
+
+
+def test_no_self_contact_in_mujoco_inside_the_limits(coupling):
+    """MuJoCo excludes only parent-child pairs: the geometry itself must stay apart."""
+    for path in (URDF_PATH, SCENE_PATH):
+        arm = MujocoArm(mujoco.MjModel.from_xml_path(str(path)), coupling)
+        for theta in inside_stops(300, seed=2):
+            arm.set(theta)
+            pairs = {(arm.model.body(arm.model.geom_bodyid[c.geom1]).name,
+                      arm.model.body(arm.model.geom_bodyid[c.geom2]).name)
+                     for c in arm.data.contact[:arm.data.ncon]}
+            assert not pairs, f"{path.name}: contact {pairs} at theta = {theta}"
+
+
+def test_mjcf_has_the_report_dynamics_with_the_rotors(coupling):
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(MJCF_PATH)), coupling)
+    for theta in inside_stops(200, seed=3):
+        mass, gravity = arm.reduced_mass_and_gravity(theta)
+        assert relative_error(mass, closed_form.mass_matrix(theta)) < 1e-9
+        assert relative_error(gravity, closed_form.gravity(theta)) < 1e-9
+
+
+def test_mjcf_tip_site_is_eq10(coupling):
+    """The tip site, seen from the report_s site, is eq. 10's position (1e-12 m)."""
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(MJCF_PATH)), coupling)
+    tip, s = arm.model.site("tip").id, arm.model.site("report_s").id
+    for theta in inside_stops(100, seed=4):
+        arm.set(theta)
+        position = arm.data.site_xmat[s].reshape(3, 3).T @ (arm.data.site_xpos[tip] - arm.data.site_xpos[s])
+        np.testing.assert_allclose(position, closed_form.forward_kinematics(theta)[:3, 3], atol=1e-12)
+
+
+def test_mjcf_actuators_sensors_and_options_follow_the_yaml():
+    model = mujoco.MjModel.from_xml_path(str(MJCF_PATH))
+    actuation = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())
+    settings = yaml.safe_load((CONFIG_DIR / "mjcf.yaml").read_text())
+    torque = actuation["motor"]["max_continuous_torque"]
+    for i, joint in enumerate(ACTUATED):
+        assert model.joint(model.actuator_trnid[i, 0]).name == joint
+        assert model.actuator_gear[i, 0] == actuation["transmission_ratio"][joint]
+        np.testing.assert_array_equal(model.actuator_ctrlrange[i], [-torque, torque])
+        dof = model.jnt_dofadr[model.joint(joint).id]
+        assert model.dof_armature[dof] == pytest.approx(
+            actuation["motor"]["rotor_inertia"] * actuation["transmission_ratio"][joint] ** 2, rel=1e-15)
+    assert model.opt.timestep == settings["timestep"]
+    assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
+    assert [model.sensor(i).name for i in range(model.nsensor)] == [
+        *(f"{j}_pos" for j in ACTUATED), *(f"{j}_vel" for j in ACTUATED), "tip_pos"]
+
+
+def test_mjcf_free_swing_follows_the_closed_form(coupling):
+    """1 s from rest at THETA0 with RK4 at 1 ms (limits, contacts, friction, damping off)."""
+    model = mujoco.MjModel.from_xml_path(str(MJCF_PATH))
+    for flag in ("mjDSBL_LIMIT", "mjDSBL_CONTACT", "mjDSBL_FRICTIONLOSS", "mjDSBL_DAMPER"):
+        model.opt.disableflags |= getattr(mujoco.mjtDisableBit, flag)
+    arm = MujocoArm(model, coupling)
+    arm.set(THETA0)
+    for _ in range(1000):
+        mujoco.mj_step(model, arm.data)
+    theta = arm.data.qpos[arm.qpos[:3]]
+    reference = rk4_closed_form(THETA0, 1.0, 1e-4)  # converged: 1e-3 s differs by 5e-10 rad
+    assert np.abs(theta - reference).max() < 1e-5
+    assert np.abs(theta - THETA0).max() > 1.0  # it did swing
+
+
+# -- Drake -------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def drake_plant():
+    builder = drake.DiagramBuilder()
+    plant, _ = drake.AddMultibodyPlantSceneGraph(builder, time_step=1e-4)
+    plant.set_discrete_contact_approximation(drake.DiscreteContactApproximation.kSap)
+    with warnings.catch_warnings():  # Drake warns that it ignores mechanicalReduction
+        warnings.simplefilter("ignore")
+        drake.Parser(plant).AddModels(str(URDF_PATH))
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base_link"))
+    plant.Finalize()
+    diagram = builder.Build()
+    return plant, diagram
+
+
+def _drake_positions(plant, coupling: Coupling) -> list[int]:
+    return [plant.GetJointByName(n).position_start() for n in coupling.tree.names[1:]]
+
+
+def test_drake_reads_the_mimic_tags_and_the_rotor_inertia(drake_plant, coupling):
+    plant, _ = drake_plant
+    assert plant.num_constraints() == 4  # coupler constraints from the mimic tags
+    context = plant.CreateDefaultContext()
+    index = _drake_positions(plant, coupling)
+    G = coupling.matrix
+    for theta in inside_stops(200, seed=5):
+        q = np.zeros(plant.num_positions())
+        q[index] = coupling.configuration(theta)
+        plant.SetPositions(context, q)
+        mass = plant.CalcMassMatrix(context)[np.ix_(index, index)]
+        gravity = -plant.CalcGravityGeneralizedForces(context)[index]
+        assert relative_error(G.T @ mass @ G, closed_form.mass_matrix(theta)) < 1e-9
+        assert relative_error(G.T @ gravity, closed_form.gravity(theta)) < 1e-9
+
+
+def test_drake_sap_free_swing_follows_the_closed_form(drake_plant, coupling):
+    """A discrete SAP plant at 1e-4 s, 0.15 s from rest at THETA0, within 1e-3 rad."""
+    plant, diagram = drake_plant
+    context = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    index = _drake_positions(plant, coupling)
+    q = np.zeros(plant.num_positions())
+    q[index] = coupling.configuration(THETA0)
+    plant.SetPositions(plant_context, q)
+    plant.get_actuation_input_port().FixValue(plant_context, np.zeros(plant.num_actuators()))
+    drake.Simulator(diagram, context).AdvanceTo(0.15)
+    theta = plant.GetPositions(plant_context)[index][:3]
+    assert np.abs(theta - rk4_closed_form(THETA0, 0.15, 1e-4)).max() < 1e-3
+    assert np.abs(theta - THETA0).max() > 0.3  # it did swing
+
+
+# -- urdfdom -----------------------------------------------------------------------------
+
+def test_check_urdf_accepts_the_urdf():
+    check_urdf = Path(sys.executable).parent / "check_urdf"
+    if not check_urdf.exists():
+        check_urdf = shutil.which("check_urdf")
+    assert check_urdf, "check_urdf ships with pin's urdfdom"
+    result = subprocess.run([str(check_urdf), str(URDF_PATH)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "Successfully Parsed XML" in result.stdout
