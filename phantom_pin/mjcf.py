@@ -9,6 +9,8 @@ joints and frames; the MJCF adds what the URDF cannot say in MuJoCo's terms:
 - one ``<motor>`` per actuated joint: gear = transmission ratio, so that the control is
   the motor-shaft torque (N m) and its range is the motor's max. continuous torque;
 - ``<contact><exclude>`` for the SRDF's disabled pairs (MuJoCo excludes only parent-child);
+- the coupled stops (theta2 - theta3 between -55 and 65 deg) as a limited fixed tendon;
+- joint damping and frictionloss from the URDF's <dynamics> (actuation.yaml's friction);
 - joint ranges, a ``tip`` site (the report's tool frame t), the report frames as sites,
   joint position and velocity sensors, the timestep and the integrator.
 
@@ -185,6 +187,15 @@ def generate_mjcf(prefix: str = "", config_dir: Path | str = CONFIG_DIR,
     for pair in srdf.iter("disable_collisions"):
         ET.SubElement(contact, "exclude", {"body1": pair.get("link1"), "body2": pair.get("link2")})
 
+    # the parallelogram's coupled stops, which a URDF cannot express, as a fixed tendon
+    # theta2 - theta3 limited to [-(theta3 - theta2)_max, (theta2 - theta3)_max]
+    stops = _read_yaml(paths["joint_limits_file"])["stops"]
+    tendon = ET.SubElement(ET.SubElement(mujoco, "tendon"), "fixed", {
+        "name": f"{prefix}parallelogram",
+        "range": _vec([-stops["theta3_minus_theta2_max"], stops["theta2_minus_theta3_max"]])})
+    ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint2", "coef": "1"})
+    ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint3", "coef": "-1"})
+
     equality = ET.SubElement(mujoco, "equality")
     solref = _vec([settings["equality_solref_timesteps"] * timestep,
                    settings["equality_solref_damping_ratio"]])
@@ -231,29 +242,20 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
     if transmission is not None:
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
         attributes["armature"] = _num(actuation["motor"]["rotor_inertia"] * ratio**2)
+    dynamics = joint.find("dynamics")
+    if dynamics is not None:  # MuJoCo's frictionloss is dry friction without smoothing
+        attributes["damping"] = _num(float(dynamics.get("damping", 0)))
+        attributes["frictionloss"] = _num(float(dynamics.get("friction", 0)))
     return attributes
 
 
-def _base_plate_bottom(turret: ET.Element) -> float:
-    """Lowest point of the turret's collision geometry (m, base_link z): the table top."""
-    bottom = math.inf
-    for collision in turret.findall("collision"):
-        z = float(collision.find("origin").get("xyz").split()[2])
-        shape = collision.find("geometry")[0]
-        half = (float(shape.get("length")) / 2 if shape.tag == "cylinder"
-                else float(shape.get("size").split()[2]) / 2)
-        bottom = min(bottom, z - half)
-    return bottom
-
-
 def _scene(scene: dict, turret: ET.Element, robot_file: str, name: str) -> str:
-    plate = _base_plate_bottom(turret)
-    stand = float(scene["stand_height"])
-    top = plate - stand  # the table top
+    top = -float(scene["shoulder_height"])  # the table top, m in base_link (origin: shoulder)
+    plate = min(float(v.find("origin").get("xyz").split()[2]) for v in turret.findall("visual"))
     size = [float(v) for v in scene["table_size"]]
     mujoco = ET.Element("mujoco", {"model": f"{name} scene"})
     ET.SubElement(mujoco, "include", {"file": robot_file})
-    # the base plate (on joint1) rests on the table top: no contact friction on joint1
+    # the turret (joint1) sits on the stand, which is world geometry: no contact between them
     ET.SubElement(ET.SubElement(mujoco, "contact"), "exclude", {"body1": "world", "body2": turret.get("name")})
     ET.SubElement(mujoco, "statistic", {"center": "0.1 0 0", "extent": "0.6"})
     visual = ET.SubElement(mujoco, "visual")
@@ -269,9 +271,9 @@ def _scene(scene: dict, turret: ET.Element, robot_file: str, name: str) -> str:
     ET.SubElement(asset, "material", {"name": "table", "rgba": "0.55 0.45 0.35 1"})
     world = ET.SubElement(mujoco, "worldbody")
     ET.SubElement(world, "light", {"pos": "0 0 1.5", "dir": "0 0 -1", "directional": "true"})
-    radius = max(float(c.find("geometry")[0].get("radius", 0)) for c in turret.findall("collision"))
     ET.SubElement(world, "geom", {"name": "stand", "type": "cylinder", "material": "table",
-                                  "size": _vec([radius, stand / 2]), "pos": _vec([0, 0, plate - stand / 2])})
+                                  "size": _vec([float(scene["stand_radius"]), (plate - top) / 2]),
+                                  "pos": _vec([0, 0, (plate + top) / 2])})
     floor = top - float(scene["floor_below_table"])
     ET.SubElement(world, "geom", {"name": "floor", "type": "plane", "size": "0 0 0.05",
                                   "pos": _vec([0, 0, floor]), "material": "groundplane"})

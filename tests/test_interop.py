@@ -50,11 +50,13 @@ def inside_stops(n: int, seed: int, pool: np.ndarray | None = None) -> np.ndarra
     return pool[keep][:n]
 
 
-def rk4_closed_form(theta0: np.ndarray, duration: float, step: float) -> np.ndarray:
-    """theta (rad) after ``duration`` s of free motion from rest (tau = 0), RK4 on eq. 80."""
+def rk4_closed_form(theta0: np.ndarray, duration: float, step: float, damping: float = 0.0) -> np.ndarray:
+    """theta (rad) after ``duration`` s of motion from rest under tau = -damping * dtheta
+    (N m s/rad), RK4 on eq. 80."""
     def rate(x):
         theta, dtheta = x[:3], x[3:]
-        force = -closed_form.coriolis_matrix(theta, dtheta) @ dtheta - closed_form.gravity(theta)
+        force = (-closed_form.coriolis_matrix(theta, dtheta) @ dtheta - closed_form.gravity(theta)
+                 - damping * dtheta)
         return np.concatenate([dtheta, np.linalg.solve(closed_form.mass_matrix(theta), force)])
     x = np.concatenate([theta0, np.zeros(3)])
     for _ in range(round(duration / step)):
@@ -144,10 +146,30 @@ def test_mjcf_actuators_sensors_and_options_follow_the_yaml():
         dof = model.jnt_dofadr[model.joint(joint).id]
         assert model.dof_armature[dof] == pytest.approx(
             actuation["motor"]["rotor_inertia"] * actuation["transmission_ratio"][joint] ** 2, rel=1e-15)
+    for joint in ACTUATED:
+        assert model.dof_damping[model.jnt_dofadr[model.joint(joint).id]] == actuation["friction"]["viscous"]
+        assert model.dof_frictionloss[model.jnt_dofadr[model.joint(joint).id]] == actuation["friction"]["coulomb"]
     assert model.opt.timestep == settings["timestep"]
     assert model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4
     assert [model.sensor(i).name for i in range(model.nsensor)] == [
         *(f"{j}_pos" for j in ACTUATED), *(f"{j}_vel" for j in ACTUATED), "tip_pos"]
+
+
+def test_mjcf_tendon_is_the_coupled_stops(coupling):
+    """MuJoCo's tendon theta2 - theta3 limits exactly the postures outside the stops."""
+    stops = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())["stops"]
+    model = mujoco.MjModel.from_xml_path(str(MJCF_PATH))
+    arm = MujocoArm(model, coupling)
+    limit = mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON
+    rng = np.random.default_rng(6)
+    lower, upper = model.jnt_range[:3].T
+    for theta in rng.uniform(lower, upper, (300, 3)):
+        arm.set(theta)
+        difference = theta[1] - theta[2]
+        assert arm.data.ten_length[0] == pytest.approx(difference, abs=1e-12)
+        outside = (difference > stops["theta2_minus_theta3_max"]
+                   or -difference > stops["theta3_minus_theta2_max"])
+        assert (limit in arm.data.efc_type[:arm.data.nefc]) == outside, theta
 
 
 def test_mjcf_free_swing_follows_the_closed_form(coupling):
@@ -202,7 +224,10 @@ def test_drake_reads_the_mimic_tags_and_the_rotor_inertia(drake_plant, coupling)
 
 
 def test_drake_sap_free_swing_follows_the_closed_form(drake_plant, coupling):
-    """A discrete SAP plant at 1e-4 s, 0.15 s from rest at THETA0, within 1e-3 rad."""
+    """A discrete SAP plant at 1e-4 s, 0.15 s from rest at THETA0, within 1e-3 rad.
+
+    Drake applies the URDF's joint damping (actuation.yaml's viscous friction); it has no
+    dry friction for URDF joints."""
     plant, diagram = drake_plant
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyMutableContextFromRoot(context)
@@ -213,7 +238,8 @@ def test_drake_sap_free_swing_follows_the_closed_form(drake_plant, coupling):
     plant.get_actuation_input_port().FixValue(plant_context, np.zeros(plant.num_actuators()))
     drake.Simulator(diagram, context).AdvanceTo(0.15)
     theta = plant.GetPositions(plant_context)[index][:3]
-    assert np.abs(theta - rk4_closed_form(THETA0, 0.15, 1e-4)).max() < 1e-3
+    viscous = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())["friction"]["viscous"]
+    assert np.abs(theta - rk4_closed_form(THETA0, 0.15, 1e-4, damping=viscous)).max() < 1e-3
     assert np.abs(theta - THETA0).max() > 0.3  # it did swing
 
 
