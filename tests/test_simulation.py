@@ -48,6 +48,8 @@ def test_without_friction_stops_and_saturation_it_is_the_closed_form():
     assert np.abs(result.dtheta - reference[:, 3:]).max() < 1e-5         # rad/s
     assert np.abs(result.theta[-1] - START).max() > 0.05                 # it did move
     np.testing.assert_allclose(result.tip, closed_form.forward_kinematics(result.theta)[:, :3, 3], atol=1e-12)
+    slow = simulate(START, 0.15, rate=20.0, friction=False, hard_stops=False, saturation=False)
+    assert slow.substeps == 50 and np.abs(slow.theta - reference[::50, :3]).max() < 1e-6  # steps <= 1 ms
 
 
 def test_the_controller_torque_is_held_between_samples():

@@ -35,6 +35,9 @@ class Device:
     Sign convention of the motors: a positive current drives its joint in the joint's
     positive direction, tau_i = ratio_i * torque_constant * i_i. A real amplifier may flip
     directions (mahilab/Phantom uses +1, -1, -1); that belongs to the driver, not here.
+
+    Attributes: ``phantom`` (the rigid body), ``parameters`` (DeviceParameters, with the
+    sources), ``ratios`` (3,).
     """
 
     def __init__(self, phantom: Phantom | None = None, config_dir: Path | str | None = None) -> None:
