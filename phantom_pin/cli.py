@@ -1,4 +1,4 @@
-"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, show."""
+"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, show, simulate."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ import pinocchio as pin
 
 from phantom_pin import appendix, closed_form
 from phantom_pin.description import generate_srdf, generate_urdf
+from phantom_pin.device import cli as device_cli
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.loader import PhantomLoader, load
 from phantom_pin.mjcf import generate_mjcf
@@ -59,6 +60,8 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
     lines += [f"{lk['name']:15} {lk['mass']:8.4f}  {_vector(lk['com'], '{:7.4f}'):26}"
               f"{_vector(lk['inertia'], '{:.3e}')}" for lk in links]
     lines += ["", f"rotor inertia {p.rotor_inertia:.3e} kg m2 (each motor)"]
+    data["device"], device_lines = device_cli.info(phantom, args.config)  # stops, friction, motor, encoder
+    lines += ["", *device_lines]
     _print(args, data, "\n".join(lines))
     return 0
 
@@ -187,7 +190,8 @@ def _parser() -> argparse.ArgumentParser:
                         help=f"folder with the parameter files {sorted(PARAMETER_FILES.values())}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     three = {"nargs": 3, "type": float}
-    info = sub.add_parser("info", help="joints, limits, links with mass, COM and inertia, rotor data")
+    info = sub.add_parser("info", help="joints, limits, links with mass, COM and inertia, rotor data, "
+                                       "the device's stops, friction, motor and encoder with sources")
     check = sub.add_parser("check", help="Phantom vs closed form vs the appendix at N random states")
     check.add_argument("-n", type=int, default=1000, help="number of random states (default 1000)")
     check.add_argument("--seed", type=int, default=0)
@@ -220,6 +224,7 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--html", help="write a self-contained HTML file instead of serving")
     show.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     show.add_argument("--open", action="store_true", help="open the live viewer in a browser")
+    device_cli.add_parser(sub)
     for command in (info, check, fk, ik, dyn):
         command.add_argument("--json", action="store_true", help="print JSON")
     return parser
@@ -228,7 +233,8 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code (0 ok, 1 check failed, 2 bad input)."""
     handlers = {"info": _info, "check": _check, "fk": _fk, "ik": _ik, "dynamics": _dynamics,
-                "urdf": _urdf, "srdf": _urdf, "mjcf": _urdf, "show": _show}
+                "urdf": _urdf, "srdf": _urdf, "mjcf": _urdf, "show": _show,
+                "simulate": device_cli.simulate_command}
     try:
         args = _parser().parse_args(argv)
         if args.command == "check" and args.n < 1:

@@ -1,0 +1,123 @@
+"""A virtual wall rendered at 1 kHz: force and penetration over time, and the highest
+stable wall stiffness against the sampling rate, compared with the passivity bound.
+
+The wall is the floor y <= y_wall (frame s: y up) through the tip of the posture --posture.
+The controller (sampled at the rate, zero-order hold) renders F = K * depth along +y while
+the tip is below the floor (a pure spring, virtual damping B = 0), compensates gravity,
+and adds a steady 1 N push down that stands for the user's hand (the motors emulate it, so
+it is sampled and saturated too). The plant is phantom_pin.simulate's: rigid body, rotors,
+friction, hard stops, saturation. Each run starts at rest, 1 mm deeper than the static
+penetration F_push / K.
+
+Stability: a run (0.4 s) is stable when the peak-to-peak penetration over its last 0.1 s is
+less than half that over its first 0.1 s (the bounce decays); the highest stable stiffness of
+a rate is the last of a geometric grid (250 N/m x sqrt 2 ** k) before the first unstable one.
+Colgate and Schenkel's passivity condition b > K T / 2 + |B| gives K < 2 b / T, with b the
+device's physical damping at the tip along the wall normal, b_n = b_joint n^T (J J^T)^-1 n:
+with the viscous friction alone (b_joint = viscous) and with the smoothed Coulomb
+friction's slope at rest added (b_joint = viscous + coulomb / smoothing_speed).
+Passivity is sufficient, not necessary: the device's measured limit may exceed the bound.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+import common
+from phantom_pin import Device, PhantomPinError, simulate
+
+NORMAL = np.array([0.0, 1.0, 0.0])   # the wall's outward normal in frame s (up)
+PUSH = 1.0                           # N, the hand's push into the wall
+OFFSET = 1e-3                        # m, initial depth beyond the static penetration
+DURATION, SWEEP_DURATION, WINDOW = 0.5, 0.4, 0.1   # s: the plotted runs, the sweep's, the windows
+GRID = 250.0 * np.sqrt(2.0) ** np.arange(13)         # N/m, 250 .. 16000
+
+
+def wall_run(device: Device, posture: np.ndarray, stiffness: float, rate: float, duration: float):
+    """One run: (result, penetration (K,) m, wall force (K,) N, stable?)."""
+    phantom = device.phantom
+    surface = phantom.forward_kinematics(posture)[:3, 3]             # on the floor (m, frame s)
+    start = phantom.inverse_kinematics(surface - (PUSH / stiffness + OFFSET) * NORMAL)
+
+    def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
+        pose = phantom.forward_kinematics(theta)
+        depth = (surface - pose[:3, 3]) @ NORMAL
+        force = (stiffness * depth if depth > 0 else 0.0) - PUSH
+        jacobian = pose[:3, :3] @ phantom.body_jacobian(theta)[:3]  # Device.tip_jacobian, one fk fewer
+        return phantom.gravity(theta) + jacobian.T @ (force * NORMAL)
+
+    result = simulate(start, duration, controller, rate=rate, device=device)
+    depth = (surface - result.tip) @ NORMAL
+    first, last = depth[result.t < WINDOW], depth[result.t > duration - WINDOW]
+    return result, depth, stiffness * np.maximum(depth, 0.0), bool(np.ptp(last) <= 0.5 * np.ptp(first))
+
+
+def highest_stable(device: Device, posture: np.ndarray, rate: float) -> float:
+    """The last stiffness of GRID (N/m) before the first unstable one; 0 if GRID[0] is unstable."""
+    best = 0.0
+    for stiffness in GRID:
+        if not wall_run(device, posture, stiffness, rate, SWEEP_DURATION)[3]:
+            break
+        best = stiffness
+    return best
+
+
+def main(argv: list[str] | None = None) -> None:
+    cli = common.parser(__doc__.splitlines()[0])
+    cli.add_argument("--posture", type=float, nargs=3, default=[0.0, 0.3, 0.4], metavar="T",
+                     help="posture whose tip is on the wall (rad)")
+    cli.add_argument("--stiffness", type=float, nargs=2, default=[1000.0, 2000.0], metavar="K",
+                     help="the two walls plotted over time at 1 kHz (N/m)")
+    cli.add_argument("--rates", type=float, nargs="+", default=[250.0, 500.0, 1000.0, 2000.0],
+                     help="sampling rates of the stability sweep (Hz)")
+    args = cli.parse_args(argv)
+    if min(args.stiffness) <= 0 or min(args.rates) <= 0:
+        raise PhantomPinError("--stiffness, --rates: expected positive numbers")
+    figure_path = common.output(args, "virtual_wall.png")
+    device = Device()
+    posture = np.array(args.posture)
+    if not device.within_limits(posture):
+        raise PhantomPinError(f"--posture: {args.posture} rad is outside the device's stops")
+    p = device.parameters
+    jacobian = device.tip_jacobian(posture)
+    mobility = NORMAL @ np.linalg.inv(jacobian @ jacobian.T) @ NORMAL     # 1/m^2
+    damping = {"viscous": p.viscous * mobility,                          # N s/m at the tip
+               "viscous + Coulomb slope": (p.viscous + p.coulomb / p.smoothing_speed) * mobility}
+    tip_mass = 1.0 / (NORMAL @ jacobian @ np.linalg.inv(device.phantom.mass_matrix(posture)) @ jacobian.T @ NORMAL)
+
+    figure, (penetration_axis, force_axis, sweep_axis) = plt.subplots(3, 1, figsize=(8, 10), constrained_layout=True)
+    for stiffness in args.stiffness:
+        result, depth, force, stable = wall_run(device, posture, stiffness, 1000.0, DURATION)
+        label = f"K = {stiffness:g} N/m ({'stable' if stable else 'unstable'})"
+        penetration_axis.plot(result.t, 1e3 * depth, label=label)
+        force_axis.plot(result.t, force, label=label)
+        settled = depth[result.t > DURATION - WINDOW]
+        print(f"1000 Hz, K = {stiffness:g} N/m: {'stable' if stable else 'unstable'}; last {WINDOW} s: "
+              f"penetration {1e3 * settled.mean():.4f} mm (F/K = {1e3 * PUSH / stiffness:.4f} mm), "
+              f"peak-to-peak {1e3 * np.ptp(settled):.2e} mm")
+    penetration_axis.axhline(0.0, color="k", lw=0.8)
+    penetration_axis.set(ylabel="penetration [mm]", title=f"virtual wall at 1 kHz, {PUSH:g} N push, "
+                                                           f"tip mass {1e3 * tip_mass:.0f} g along the normal")
+    force_axis.set(xlabel="time [s]", ylabel="wall force [N]")
+    for axis in (penetration_axis, force_axis):
+        axis.legend()
+
+    rates = np.array(sorted(args.rates))
+    measured = np.array([highest_stable(device, posture, rate) for rate in rates])
+    sweep_axis.loglog(rates, measured, "o-", label="highest stable K (simulated)")
+    for name, b in damping.items():
+        sweep_axis.loglog(rates, 2 * b * rates, "--", label=f"passivity bound 2 b / T, b = {name}")
+    sweep_axis.set(xlabel="sampling rate [Hz]", ylabel="wall stiffness K [N/m]")
+    sweep_axis.legend()
+    figure.savefig(figure_path, dpi=120)
+    print(f"wrote {figure_path}")
+    print(f"tip damping along the normal: viscous b_n = {damping['viscous']:.4g} N s/m, with the Coulomb "
+          f"slope {damping['viscous + Coulomb slope']:.4g} N s/m; tip mass {tip_mass:.4f} kg")
+    for rate, k in zip(rates, measured):
+        print(f"rate {rate:g} Hz: highest stable K = {k:g} N/m; passivity bound {2 * damping['viscous'] * rate:.4g} "
+              f"N/m (viscous), {2 * damping['viscous + Coulomb slope'] * rate:.4g} N/m (with the Coulomb slope)")
+
+
+if __name__ == "__main__":
+    common.run(main)

@@ -1,0 +1,135 @@
+"""The device's part of the phantom-pin command line: `simulate`, and the device data of `info`.
+
+phantom_pin.cli registers these; the handlers live here."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from phantom_pin.device.device import Device
+from phantom_pin.device.simulation import SimulationResult, simulate
+from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.model import Phantom
+
+#: Columns of the result, with their units, as written to JSON and CSV.
+UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
+         "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """Register ``phantom-pin simulate``."""
+    three = {"nargs": 3, "type": float}
+    command = sub.add_parser("simulate", help="a controller sampled at --rate driving the device "
+                                              "(friction, stops, saturation), as JSON or CSV")
+    command.add_argument("--theta0", required=True, metavar="T", help="initial posture (rad)", **three)
+    command.add_argument("--dtheta0", default=[0.0, 0.0, 0.0], metavar="W", help="initial rates (rad/s)",
+                         **three)
+    command.add_argument("--duration", required=True, type=float, help="simulated time (s)")
+    command.add_argument("--rate", type=float, default=1000.0, help="controller rate (Hz, default 1000)")
+    command.add_argument("--controller", choices=["none", "gravity"], default="none",
+                         help="zero torque (default), or gravity compensation N(theta) from the Phantom")
+    command.add_argument("--no-friction", action="store_true")
+    command.add_argument("--no-hard-stops", action="store_true")
+    command.add_argument("--no-saturation", action="store_true")
+    command.add_argument("--quantization", action="store_true",
+                         help="the controller sees encoder counts (and their backward difference)")
+    command.add_argument("--format", choices=["json", "csv"], default="json")
+    command.add_argument("--output", "-o", help="file to write (default: standard output)")
+    command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
+
+
+def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
+    """Run ``phantom-pin simulate``: nothing is written unless the simulation succeeds."""
+    output = Path(args.output) if args.output else None
+    if output is not None and output.exists() and not args.force:
+        raise PhantomPinError(f"--output: {output} exists; add --force to overwrite it")
+    device = Device(phantom, args.config)
+    controller = None
+    if args.controller == "gravity":
+        def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
+            return phantom.gravity(theta)
+    result = simulate(args.theta0, args.duration, controller, dtheta0=args.dtheta0, rate=args.rate,
+                      friction=not args.no_friction, hard_stops=not args.no_hard_stops,
+                      saturation=not args.no_saturation, quantization=args.quantization, device=device)
+    settings = {key: getattr(args, key) for key in ("theta0", "dtheta0", "duration", "rate", "controller",
+                                                    "no_friction", "no_hard_stops", "no_saturation",
+                                                    "quantization")}
+    settings["substeps"] = result.substeps
+    text = _json(result, settings) if args.format == "json" else _csv(result)
+    if output is None:
+        sys.stdout.write(text)
+        return 0
+    try:
+        output.write_text(text)
+    except OSError as error:
+        raise PhantomPinError(f"--output: cannot write {output} ({error.strerror})") from None
+    print(f"wrote {output} ({len(result.t)} samples)")
+    return 0
+
+
+def _json(result: SimulationResult, settings: dict) -> str:
+    data = {"settings": settings, "units": UNITS}
+    data.update({name: getattr(result, name).tolist() for name in UNITS})
+    return json.dumps(data) + "\n"
+
+
+def _csv(result: SimulationResult) -> str:
+    header, columns = [], []
+    for name, unit in UNITS.items():
+        values = getattr(result, name).reshape(len(result.t), -1)
+        suffixes = [""] if values.shape[1] == 1 else (["_x", "_y", "_z"] if name == "tip" else ["1", "2", "3"])
+        header += [f"{name}{s} [{unit.split(' (')[0]}]" for s in suffixes]
+        columns.append(values)
+    rows = (",".join(map(repr, row)) for row in np.hstack(columns).tolist())  # shortest exact decimals
+    return "\n".join([",".join(header), *rows]) + "\n"
+
+
+def info(phantom: Phantom, config_dir: Path) -> tuple[dict, list[str]]:
+    """The device data of ``phantom-pin info``, as (JSON data, text lines), with sources."""
+    device = Device(phantom, config_dir)
+    p = device.parameters
+    numbers = dataclasses.asdict(p)
+    sections = {
+        "stops": {key: numbers[key] for key in ("stop_lower", "stop_upper", "theta2_minus_theta3_max",
+                                                "theta3_minus_theta2_max", "stop_stiffness", "stop_damping")},
+        "friction": {key: numbers[key] for key in ("viscous", "coulomb", "smoothing_speed")},
+        "motor": {key: numbers[key] for key in ("max_continuous_torque", "max_continuous_current", "stall_torque",
+                                                "stall_current", "torque_constant", "terminal_resistance",
+                                                "max_speed")}
+        | {"continuous_joint_torque": device.continuous_torque.tolist(),
+           "peak_joint_torque": device.peak_torque.tolist()},
+        "encoder": {"cycles_per_revolution": p.cycles_per_revolution, "counts_per_cycle": p.counts_per_cycle,
+                    "resolution": device.encoder_resolution.tolist()},
+        "transmission_ratio": {"ratios": device.ratios.tolist()},
+    }
+    for name, section in sections.items():
+        section["source"] = p.sources[name]
+    deg = 180 / math.pi
+    vector = " ".join
+    text = {
+        "stops": "stops [deg]: " + ", ".join(f"joint{i + 1} {lo * deg:.1f}..{hi * deg:.1f}"
+                                             for i, (lo, hi) in enumerate(zip(p.stop_lower, p.stop_upper)))
+        + f"; theta2 - theta3 <= {p.theta2_minus_theta3_max * deg:.1f}, theta3 - theta2 <= "
+          f"{p.theta3_minus_theta2_max * deg:.1f}; K {p.stop_stiffness:g} N m/rad, B {p.stop_damping:g} N m s/rad",
+        "friction": f"friction: viscous {p.viscous:g} N m s/rad + coulomb {p.coulomb:g} N m * tanh(dtheta / "
+                    f"{p.smoothing_speed:g} rad/s)",
+        "motor": f"motor: continuous {p.max_continuous_torque * 1e3:g} mN m / {p.max_continuous_current:g} A, "
+                 f"stall {p.stall_torque * 1e3:g} mN m / {p.stall_current:g} A, Kt {p.torque_constant * 1e3:g} "
+                 f"mN m/A, R {p.terminal_resistance:g} Ohm, no-load {p.max_speed:.1f} rad/s; at the joints: "
+                 f"continuous [{vector(f'{x:.4f}' for x in device.continuous_torque)}] N m, peak "
+                 f"[{vector(f'{x:.4f}' for x in device.peak_torque)}] N m",
+        "encoder": f"encoder: {p.cycles_per_revolution:g} cycles/rev x {p.counts_per_cycle:g} counts/cycle on "
+                   f"the motor; resolution [{vector(f'{x:.3e}' for x in device.encoder_resolution)}] rad at the joints",
+        "transmission_ratio": f"transmission ratios: [{vector(f'{x:g}' for x in device.ratios)}]",
+    }
+    lines = ["device (phantom_pin.Device), SI units at the joints unless said:"]
+    for name, section in sections.items():
+        lines += [text[name], f"  source: {section['source']}"]
+    return sections, lines

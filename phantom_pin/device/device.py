@@ -1,0 +1,204 @@
+"""Device: the physical PHANToM Premium 1.5 around the report's rigid body (stops, friction,
+motors, encoders). Phantom stays the report's rigid body; this class holds the rest."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from phantom_pin.device.parameters import DeviceParameters, load_device_parameters
+from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.model import Phantom
+from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.validation import as_states, same_batch
+
+#: Rows: the stop coordinates as linear maps of theta: theta1, theta2, theta3, theta2 - theta3.
+STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, -1.0]])
+
+
+class Device:
+    """The PHANToM Premium 1.5 as a device: a Phantom plus its stops, friction, motors, encoders.
+
+    ``Device()`` wraps ``Phantom()`` and reads the device numbers (actuation.yaml and
+    joint_limits.yaml ``stops``) from the shipped config folder. ``Device(config_dir=DIR)``
+    reads both the rigid body and the device numbers from DIR. ``Device(phantom, DIR)``
+    wraps an existing Phantom and reads the device numbers from DIR (default: the shipped
+    folder): pass the folder the Phantom was built from. The transmission ratios are
+    the Phantom's (``phantom.parameters.ratios``), so the currents agree with its armature.
+
+    Joint vectors are the report's theta1..theta3 (rad), rates rad/s, torques N m at the
+    joint, currents A in the motor windings; tip positions and forces are in the report's
+    frame s (m, N). Methods take one state (3,) or a batch (N, 3).
+
+    Sign convention of the motors: a positive current drives its joint in the joint's
+    positive direction, tau_i = ratio_i * torque_constant * i_i. A real amplifier may flip
+    directions (mahilab/Phantom uses +1, -1, -1); that belongs to the driver, not here.
+
+    Attributes: ``phantom`` (the rigid body), ``parameters`` (DeviceParameters, with the
+    sources), ``ratios`` (3,).
+    """
+
+    def __init__(self, phantom: Phantom | None = None, config_dir: Path | str | None = None) -> None:
+        if phantom is None:
+            phantom = Phantom() if config_dir is None else Phantom(config_dir)
+        if not isinstance(phantom, Phantom):
+            raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom or None, got {phantom!r}")
+        self.phantom = phantom
+        self.parameters: DeviceParameters = load_device_parameters(
+            CONFIG_DIR if config_dir is None else config_dir)
+        p = self.parameters
+        #: joint angle = motor angle / ratio (the Phantom's actuation.yaml)
+        self.ratios = np.array(phantom.parameters.ratios, dtype=float)
+        self._stop_lower = np.array([*p.stop_lower, -p.theta3_minus_theta2_max])
+        self._stop_upper = np.array([*p.stop_upper, p.theta2_minus_theta3_max])
+        self._counts_per_radian = self.ratios * p.cycles_per_revolution * p.counts_per_cycle / (2 * math.pi)
+
+    # -- stops -----------------------------------------------------------------------
+    def within_limits(self, theta: object) -> bool | np.ndarray:
+        """True where theta (rad) is inside the real stops, boundaries included: each joint's
+        stop interval, and the parallelogram's theta2 - theta3 <= theta2_minus_theta3_max and
+        theta3 - theta2 <= theta3_minus_theta2_max. A bool for one state (3,), an (N,) bool
+        array for a batch (N, 3)."""
+        q, batch = as_states(theta, "theta")
+        c = q @ STOP_COORDINATES.T
+        inside = np.all((c >= self._stop_lower) & (c <= self._stop_upper), axis=-1)
+        return inside if batch else bool(inside)
+
+    def _penetration(self, theta: np.ndarray) -> np.ndarray:
+        """Signed depth (rad) of each stop coordinate beyond its stop: (..., 4)."""
+        c = theta @ STOP_COORDINATES.T
+        return c - np.clip(c, self._stop_lower, self._stop_upper)
+
+    def stop_energy(self, theta: object) -> np.ndarray:
+        """Potential energy of the stop springs (J): K/2 * sum of squared penetrations of
+        theta1, theta2, theta3 and theta2 - theta3 beyond their stops; zero inside."""
+        q, _ = as_states(theta, "theta")
+        return 0.5 * self.parameters.stop_stiffness * np.sum(self._penetration(q) ** 2, axis=-1)
+
+    def stop_torque(self, theta: object, dtheta: object) -> np.ndarray:
+        """Torque of the hard stops on the joints (N m): (..., 3).
+
+        Each stop coordinate c (theta1, theta2, theta3, theta2 - theta3) beyond its stop by
+        the penetration p pushes back with K p + B dc/dt along dc/dtheta: the spring is
+        -grad(stop_energy), and the damper acts only while penetrating. A coupled stop
+        therefore acts on theta2 and theta3 equally and oppositely. Its power is
+        -B (dc/dt)^2 <= 0 plus the spring's exchange with stop_energy, so stops never add
+        energy. Where one stop is active this is mahilab/Phantom's tau = K (limit - theta)
+        - B dtheta (there the damping of a coupled stop acts on theta2 - theta3's rate).
+        """
+        q, _ = as_states(theta, "theta")
+        v, _ = as_states(dtheta, "dtheta")
+        same_batch(("theta", "dtheta"), q, v)
+        return self._stop_torque(q, v)
+
+    def _stop_torque(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
+        p = self.parameters
+        depth = self._penetration(theta)
+        force = p.stop_stiffness * depth + p.stop_damping * (dtheta @ STOP_COORDINATES.T) * (depth != 0)
+        return -force @ STOP_COORDINATES
+
+    # -- friction --------------------------------------------------------------------
+    def friction(self, dtheta: object) -> np.ndarray:
+        """Friction torque (N m) of each joint at rates dtheta (rad/s): (..., 3).
+
+        tau_f = viscous * dtheta + coulomb * tanh(dtheta / smoothing_speed), with the sign of
+        dtheta: it opposes motion, M ddtheta + C dtheta + N + tau_f = tau. Smooth at rest, so
+        it holds nothing still (no stiction); below smoothing_speed it acts as a damper of
+        coulomb / smoothing_speed N m s/rad.
+        """
+        v, _ = as_states(dtheta, "dtheta")
+        return self._friction(v)
+
+    def _friction(self, dtheta: np.ndarray) -> np.ndarray:
+        p = self.parameters
+        return p.viscous * dtheta + p.coulomb * np.tanh(dtheta / p.smoothing_speed)
+
+    # -- motors ----------------------------------------------------------------------
+    @property
+    def continuous_torque(self) -> np.ndarray:
+        """Joint torque (N m) of each motor's max. continuous torque: max_continuous_torque * ratio."""
+        return self.parameters.max_continuous_torque * self.ratios
+
+    @property
+    def peak_torque(self) -> np.ndarray:
+        """Joint torque (N m) of each motor's stall torque, the most it gives: stall_torque * ratio.
+        simulate() clips commanded torques here."""
+        return self.parameters.stall_torque * self.ratios
+
+    def _limit(self, continuous: bool) -> np.ndarray:
+        return self.continuous_torque if continuous else self.peak_torque
+
+    def motor_currents(self, tau: object) -> np.ndarray:
+        """Winding currents (A) that give joint torques tau (N m): tau / (ratio * torque_constant)."""
+        t, _ = as_states(tau, "tau")
+        return t / (self.ratios * self.parameters.torque_constant)
+
+    def joint_torques(self, currents: object) -> np.ndarray:
+        """Joint torques (N m) of winding currents (A): ratio * torque_constant * currents."""
+        i, _ = as_states(currents, "currents")
+        return i * self.ratios * self.parameters.torque_constant
+
+    def available_torque(self, theta: object, continuous: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Joint torques (N m) left for rendering forces at theta after holding gravity.
+
+        Returns (lower, upper), each (..., 3): the motors can add any tau_render with
+        lower <= tau_render <= upper while also compensating gravity N(theta), i.e.
+        -limit - N <= tau_render <= limit - N, where limit is the continuous torque
+        (``continuous=True``) or the peak torque. Where gravity alone exceeds the limit,
+        upper < 0 or lower > 0.
+        """
+        gravity = self.phantom.gravity(theta)
+        limit = self._limit(continuous)
+        return -limit - gravity, limit - gravity
+
+    def tip_jacobian(self, theta: object) -> np.ndarray:
+        """J_p = d(tip position in frame s)/d(theta): (..., 3, 3), m/rad. A tip force F (N,
+        frame s) needs the joint torques J_p^T F (N m)."""
+        rotation = self.phantom.forward_kinematics(theta)[..., :3, :3]
+        return rotation @ self.phantom.body_jacobian(theta)[..., :3, :]
+
+    def tip_force_capacity(self, theta: object, direction: object, continuous: bool = True) -> np.ndarray:
+        """The largest tip force (N) the device can render along ``direction`` (frame s,
+        normalised here) at theta while holding gravity: (...,).
+
+        The force F = f u needs the joint torques J_p^T F (J_p the tip's position Jacobian
+        in s); f is the largest f >= 0 within available_torque(theta, continuous); 0 where
+        gravity alone exceeds a limit.
+        """
+        q, _ = as_states(theta, "theta")
+        u, _ = as_states(direction, "direction")
+        norm = np.linalg.norm(u, axis=-1, keepdims=True)
+        if np.any(norm == 0):
+            raise InvalidInputError("direction: must not be the zero vector")
+        lower, upper = self.available_torque(q, continuous)
+        per_force = np.einsum("...ji,...j->...i", self.tip_jacobian(q), u / norm)  # N m per N
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = np.where(per_force > 0, upper / per_force,
+                             np.where(per_force < 0, lower / per_force, np.inf))
+        return np.clip(bound.min(axis=-1), 0.0, None)
+
+    # -- encoders --------------------------------------------------------------------
+    @property
+    def encoder_resolution(self) -> np.ndarray:
+        """Joint angle of one encoder count (rad): 2 pi / (ratio * cycles_per_revolution *
+        counts_per_cycle), (3,)."""
+        return 1.0 / self._counts_per_radian
+
+    def encoder_counts(self, theta: object) -> np.ndarray:
+        """Encoder counts (int64) at theta (rad): round(theta * ratio * cycles * counts_per_cycle
+        / (2 pi)). Count 0 is the report's zero configuration; a real device reads counts
+        from wherever it was switched on and needs a calibration offset."""
+        q, _ = as_states(theta, "theta")
+        return np.rint(q * self._counts_per_radian).astype(np.int64)
+
+    def encoder_theta(self, counts: object) -> np.ndarray:
+        """Joint angles (rad) of encoder counts: counts * encoder_resolution."""
+        c, _ = as_states(counts, "counts")
+        return c * self.encoder_resolution
+
+    def tip_resolution(self, theta: object) -> np.ndarray:
+        """Tip displacement (m) of one encoder count of each joint at theta: (..., 3),
+        |column i of the tip's position Jacobian| * encoder_resolution[i]."""
+        return np.linalg.norm(self.tip_jacobian(theta), axis=-2) * self.encoder_resolution

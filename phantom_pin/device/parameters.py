@@ -1,0 +1,113 @@
+"""The physical device's numbers: motor, encoder, friction (actuation.yaml) and the
+mechanical stops (joint_limits.yaml ``stops``), each section with its source."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from phantom_pin.exceptions import ParameterFileError
+from phantom_pin.parameters import _number, _read, parameter_paths
+from phantom_pin.paths import CONFIG_DIR
+
+_JOINTS = ("joint1", "joint2", "joint3")
+#: The ``sources`` entries each file must have (a non-empty text per section).
+_SOURCES = {"actuation_file": ("transmission_ratio", "motor", "encoder", "friction"),
+            "joint_limits_file": ("stops",)}
+
+
+@dataclasses.dataclass(frozen=True)
+class DeviceParameters:
+    """Numbers of the physical PHANToM Premium 1.5 beyond the rigid body, SI units, radians.
+
+    Motor (maxon RE 25 118743, at the motor shaft): ``max_continuous_torque``,
+    ``stall_torque`` (N m), ``max_continuous_current``, ``stall_current`` (A),
+    ``torque_constant`` (N m/A), ``terminal_resistance`` (Ohm), ``max_speed`` (rad/s).
+    Encoder: ``cycles_per_revolution`` of the motor shaft, ``counts_per_cycle``
+    (quadrature decoding). Friction at each joint: ``viscous`` (N m s/rad), ``coulomb``
+    (N m), ``smoothing_speed`` (rad/s). Stops (rad, the report's theta):
+    ``stop_lower``, ``stop_upper`` per joint, ``theta2_minus_theta3_max`` and
+    ``theta3_minus_theta2_max`` (the parallelogram), ``stop_stiffness`` (N m/rad) and
+    ``stop_damping`` (N m s/rad). ``sources``: section name -> where its numbers come from.
+    """
+
+    max_continuous_torque: float
+    max_continuous_current: float
+    stall_torque: float
+    stall_current: float
+    torque_constant: float
+    terminal_resistance: float
+    max_speed: float
+    cycles_per_revolution: float
+    counts_per_cycle: float
+    viscous: float
+    coulomb: float
+    smoothing_speed: float
+    stop_lower: tuple[float, float, float]
+    stop_upper: tuple[float, float, float]
+    theta2_minus_theta3_max: float
+    theta3_minus_theta2_max: float
+    stop_stiffness: float
+    stop_damping: float
+    sources: dict[str, str]
+
+
+def _non_negative(data: dict, path: Path, *keys: str) -> float:
+    value = _number(data, path, *keys)
+    if value < 0:
+        raise ParameterFileError(f"{path}: {'.'.join(keys)} must not be negative, got {value!r}")
+    return value
+
+
+def _sources(data: dict, path: Path, sections: tuple[str, ...]) -> dict[str, str]:
+    node = data.get("sources")
+    if not isinstance(node, dict):
+        raise ParameterFileError(f"{path}: missing key sources (a mapping: section -> source)")
+    for section in sections:
+        if not isinstance(node.get(section), str) or not node[section].strip():
+            raise ParameterFileError(f"{path}: sources.{section} must be a non-empty text")
+    return {section: node[section] for section in sections}
+
+
+def load_device_parameters(config_dir: Path | str = CONFIG_DIR) -> DeviceParameters:
+    """Read actuation.yaml and joint_limits.yaml of ``config_dir``; raise ParameterFileError
+    naming the file and the key of a missing or non-physical number."""
+    paths = parameter_paths(config_dir)
+    act_path, lim_path = paths["actuation_file"], paths["joint_limits_file"]
+    act, lim = _read(act_path), _read(lim_path)
+
+    def motor(key: str) -> float:
+        return _number(act, act_path, "motor", key, positive=True)
+
+    lower = tuple(_number(lim, lim_path, "stops", j, "lower") for j in _JOINTS)
+    upper = tuple(_number(lim, lim_path, "stops", j, "upper") for j in _JOINTS)
+    for joint, lo, hi in zip(_JOINTS, lower, upper):
+        if lo >= hi:
+            raise ParameterFileError(f"{lim_path}: stops.{joint}.lower must be below stops.{joint}.upper")
+    forward = _number(lim, lim_path, "stops", "theta2_minus_theta3_max")
+    backward = _number(lim, lim_path, "stops", "theta3_minus_theta2_max")
+    if forward + backward <= 0:
+        raise ParameterFileError(f"{lim_path}: stops.theta2_minus_theta3_max + "
+                                 f"stops.theta3_minus_theta2_max must be positive (an open interval)")
+    return DeviceParameters(
+        max_continuous_torque=motor("max_continuous_torque"),
+        max_continuous_current=motor("max_continuous_current"),
+        stall_torque=motor("stall_torque"),
+        stall_current=motor("stall_current"),
+        torque_constant=motor("torque_constant"),
+        terminal_resistance=motor("terminal_resistance"),
+        max_speed=motor("max_speed"),
+        cycles_per_revolution=_number(act, act_path, "encoder", "cycles_per_revolution", positive=True),
+        counts_per_cycle=_number(act, act_path, "encoder", "counts_per_cycle", positive=True),
+        viscous=_non_negative(act, act_path, "friction", "viscous"),
+        coulomb=_non_negative(act, act_path, "friction", "coulomb"),
+        smoothing_speed=_number(act, act_path, "friction", "smoothing_speed", positive=True),
+        stop_lower=lower,
+        stop_upper=upper,
+        theta2_minus_theta3_max=forward,
+        theta3_minus_theta2_max=backward,
+        stop_stiffness=_number(lim, lim_path, "stops", "stiffness", positive=True),
+        stop_damping=_non_negative(lim, lim_path, "stops", "damping"),
+        sources={**_sources(act, act_path, _SOURCES["actuation_file"]),
+                 **_sources(lim, lim_path, _SOURCES["joint_limits_file"])},
+    )

@@ -1,0 +1,222 @@
+"""Device: stops, friction, motors and encoders against the published numbers, typed here
+from their sources (../shared/data/phantom_premium_1_5.md: mahilab/Phantom and maxon's data
+sheet of the RE 25 118743), and against the closed form (gravity, kinematics)."""
+
+import math
+import shutil
+
+import numpy as np
+import pytest
+
+from phantom_pin import Device, InvalidInputError, ParameterFileError, closed_form
+from phantom_pin.device import load_device_parameters
+from phantom_pin.paths import CONFIG_DIR
+
+DEG = math.pi / 180
+#: mahilab/Phantom's stops (deg): per joint, and the parallelogram's coupled ones.
+STOPS_DEG = {"q1": (-90, 90), "q2": (-124, 119), "q3": (-29, 214), "q2-q3": 65, "q3-q2": 55}
+K_STOP, B_STOP = 10.0, 0.1                       # N m/rad, N m s/rad (mahilab's hard stop)
+VISCOUS, COULOMB = 5e-4, 0.01                    # N m s/rad, N m; smoothed as tanh(10 q')
+KT, I_NOMINAL, TAU_NOMINAL = 23.4e-3, 1.24, 28.6e-3   # N m/A, A, N m (data sheet)
+I_STALL, TAU_STALL = 5.5, 129e-3                 # A, N m (data sheet)
+RATIOS = np.array([13.3, 11.6, 11.6])            # the report (docs/errata.md E15)
+ENCODER_CPR, QUADRATURE = 1024, 4                # HEDM-5500, decoded X4
+
+
+@pytest.fixture(scope="module")
+def device(phantom):
+    return Device(phantom)
+
+
+def test_device_wraps_the_phantom_and_builds_one_by_default(phantom):
+    assert Device(phantom).phantom is phantom
+    assert Device().phantom.parameters == phantom.parameters
+    with pytest.raises(InvalidInputError, match="phantom"):
+        Device("not a phantom")
+
+
+# -- stops -----------------------------------------------------------------------------
+def _state(q1=0.0, q2=30.0, q3=40.0):
+    return np.radians([q1, q2, q3])
+
+
+@pytest.mark.parametrize("name, inside, outside", [
+    # per joint, with the other angles chosen so that the coupled stops hold
+    ("q1 lower", _state(q1=-89.9), _state(q1=-90.1)),
+    ("q1 upper", _state(q1=89.9), _state(q1=90.1)),
+    ("q2 upper", _state(q2=118.9, q3=120), _state(q2=119.1, q3=120)),
+    ("q3 lower", _state(q2=0, q3=-28.9), _state(q2=0, q3=-29.1)),
+    # the parallelogram
+    ("q2 - q3 <= 65", _state(q2=64.9, q3=0), _state(q2=65.1, q3=0)),
+    ("q3 - q2 <= 55", _state(q2=0, q3=54.9), _state(q2=0, q3=55.1)),
+    ("q3 - q2 <= 55, raised", _state(q2=60, q3=114.9), _state(q2=60, q3=115.1)),
+])
+def test_within_limits_on_both_sides_of_each_stop(device, name, inside, outside):
+    assert device.within_limits(inside) is True
+    assert device.within_limits(outside) is False
+
+
+def test_loose_joint_stops_are_unreachable_through_the_parallelogram(device):
+    """q2 >= -124 deg and q3 <= 214 deg never bind: q3 >= -29 and q3 - q2 <= 55 give
+    q2 >= -84 deg; q3 - q2 <= 55 and q2 <= 119 give q3 <= 174 deg."""
+    assert not device.within_limits(_state(q2=-123.9, q3=-29)) and not device.within_limits(_state(q2=-84.1, q3=-29))
+    assert device.within_limits(_state(q2=-83.9, q3=-29)) and device.within_limits(_state(q2=119, q3=174))
+    assert not device.within_limits(_state(q2=119, q3=174.1))
+
+
+def test_within_limits_of_a_batch_is_an_array(device):
+    batch = np.stack([_state(), _state(q1=95), _state(q2=0, q3=60)])
+    result = device.within_limits(batch)
+    assert isinstance(result, np.ndarray) and result.dtype == bool and result.tolist() == [True, False, False]
+    with pytest.raises(InvalidInputError, match="theta"):
+        device.within_limits([0.0, np.nan, 0.0])
+
+
+def test_stop_torque_is_mahilabs_where_one_stop_engages(device):
+    theta, rate = _state(q1=95), np.array([0.3, 0.0, 0.0])
+    expected = K_STOP * (90 * DEG - theta[0]) - B_STOP * rate[0]   # tau = K (limit - q) - B q'
+    np.testing.assert_allclose(device.stop_torque(theta, rate), [expected, 0, 0], rtol=1e-12)
+    # coupled: q2's interval is [.., q3 + 65 deg]; the reaction on q3 is equal and opposite
+    theta, rate = _state(q2=70, q3=0), np.array([0.0, 0.4, 0.0])
+    expected = K_STOP * (theta[2] + 65 * DEG - theta[1]) - B_STOP * rate[1]
+    np.testing.assert_allclose(device.stop_torque(theta, rate), [0, expected, -expected], rtol=1e-12)
+    assert not device.stop_torque(_state(), [1.0, 2.0, 3.0]).any()
+
+
+def test_stop_torque_is_minus_the_gradient_of_the_stop_energy_and_damps(device):
+    rng = np.random.default_rng(12)
+    theta = rng.uniform(np.radians([-100, -60, -40]), np.radians([100, 130, 200]), (300, 3))
+    rate = rng.normal(0, 2, (300, 3))
+    spring = device.stop_torque(theta, np.zeros(3) * theta)
+    step = 1e-7
+    for j in range(3):
+        shift = np.zeros(3)
+        shift[j] = step
+        gradient = (device.stop_energy(theta + shift) - device.stop_energy(theta - shift)) / (2 * step)
+        np.testing.assert_allclose(spring[:, j], -gradient, atol=1e-6)  # N m
+    damping = device.stop_torque(theta, rate) - spring
+    assert np.all(np.einsum("ni,ni->n", damping, rate) <= 1e-15)  # power of the dampers <= 0
+    assert (device.stop_energy(theta) > 0).sum() > 100               # the sample hits stops
+
+
+# -- friction --------------------------------------------------------------------------
+def test_friction_is_mahilabs_and_opposes_motion(device):
+    rate = np.random.default_rng(3).normal(0, 1, (200, 3))
+    expected = VISCOUS * rate + COULOMB * np.tanh(10 * rate)
+    np.testing.assert_allclose(device.friction(rate), expected, rtol=1e-14)
+    assert np.all(device.friction(rate) * rate >= 0)   # removes power: -tau_f . dtheta <= 0
+    np.testing.assert_array_equal(device.friction([0.0, 0.0, 0.0]), 0.0)
+
+
+# -- motors ----------------------------------------------------------------------------
+def test_motor_limits_are_the_data_sheet_torques_through_the_ratios(device, phantom):
+    np.testing.assert_allclose(device.continuous_torque, TAU_NOMINAL * RATIOS, rtol=1e-15)
+    np.testing.assert_allclose(device.peak_torque, TAU_STALL * RATIOS, rtol=1e-15)
+    np.testing.assert_allclose(phantom.model.effortLimit, device.continuous_torque, rtol=1e-12)  # URDF effort
+
+
+def test_currents_and_torques_round_trip_against_the_data_sheet(device):
+    # stall: 5.5 A x 23.4 mN m/A = 128.7 mN m, the data sheet's 129 within its rounding (+-0.5)
+    stall = device.joint_torques([I_STALL] * 3) / RATIOS
+    assert np.all(np.abs(stall - TAU_STALL) <= 0.5e-3)
+    np.testing.assert_allclose(device.motor_currents(TAU_STALL * RATIOS), TAU_STALL / KT, rtol=1e-14)
+    # nominal: 28.6 mN m needs 1.222 A, 1.4 % below the rated 1.24 A (the data sheet's nominal
+    # torque is the shaft torque, net of the motor's own friction, so Kt I_N exceeds it)
+    nominal = device.motor_currents(device.continuous_torque)
+    assert np.all((nominal < I_NOMINAL) & (nominal > 0.98 * I_NOMINAL))
+    tau = np.random.default_rng(4).normal(0, 0.3, (100, 3))
+    np.testing.assert_allclose(device.joint_torques(device.motor_currents(tau)), tau, rtol=1e-14)
+    np.testing.assert_allclose(device.motor_currents(tau), tau / (RATIOS * KT), rtol=1e-14)
+
+
+def test_available_torque_is_the_limit_minus_gravity(device, states):
+    theta = states[0]
+    gravity = closed_form.gravity(theta)
+    for continuous, limit in ((True, TAU_NOMINAL * RATIOS), (False, TAU_STALL * RATIOS)):
+        lower, upper = device.available_torque(theta, continuous=continuous)
+        np.testing.assert_allclose(lower, -limit - gravity, atol=1e-12)
+        np.testing.assert_allclose(upper, limit - gravity, atol=1e-12)
+
+
+def _position_jacobian(theta, step=1e-6):
+    """d(tip position)/d(theta) by central differences of the closed form (eq. 10)."""
+    columns = []
+    for j in range(3):
+        shift = np.zeros(3)
+        shift[j] = step
+        columns.append((closed_form.forward_kinematics(theta + shift)[..., :3, 3]
+                        - closed_form.forward_kinematics(theta - shift)[..., :3, 3]) / (2 * step))
+    return np.stack(columns, axis=-1)
+
+
+def test_tip_jacobian_is_the_derivative_of_eq_10(device, states):
+    theta = states[0][:50]
+    np.testing.assert_allclose(device.tip_jacobian(theta), _position_jacobian(theta), atol=1e-9)  # m/rad
+
+
+def test_tip_force_capacity_reaches_exactly_one_motor_limit(device, states):
+    theta = states[0][:50]
+    direction = np.random.default_rng(5).normal(size=(50, 3))
+    force = device.tip_force_capacity(theta, direction)
+    unit = direction / np.linalg.norm(direction, axis=1, keepdims=True)
+    motor = np.einsum("nji,nj->ni", _position_jacobian(theta), force[:, None] * unit) + closed_form.gravity(theta)
+    margin = np.abs(motor) / (TAU_NOMINAL * RATIOS)
+    assert np.all(margin <= 1 + 1e-8) and np.all(np.abs(margin.max(axis=1) - 1) < 1e-8)
+    assert np.all(force > 0.5)  # N: the box is far from where gravity alone saturates a motor
+    with pytest.raises(InvalidInputError, match="direction"):
+        device.tip_force_capacity(theta[0], [0.0, 0.0, 0.0])
+
+
+# -- encoders --------------------------------------------------------------------------
+def test_encoder_resolution_counts_and_tip_resolution(device, states):
+    resolution = 2 * np.pi / (ENCODER_CPR * QUADRATURE * RATIOS)   # rad per count
+    np.testing.assert_allclose(device.encoder_resolution, resolution, rtol=1e-15)
+    np.testing.assert_array_equal(device.encoder_counts(2 * np.pi / RATIOS), [4096, 4096, 4096])  # one motor turn
+    np.testing.assert_array_equal(device.encoder_counts([0.0, 0.0, 0.0]), [0, 0, 0])
+    theta = states[0]
+    counts = device.encoder_counts(theta)
+    assert counts.dtype == np.int64
+    assert np.all(np.abs(device.encoder_theta(counts) - theta) <= resolution / 2 * (1 + 1e-12))
+    np.testing.assert_allclose(device.tip_resolution(theta[:20]),
+                               np.linalg.norm(_position_jacobian(theta[:20]), axis=1) * resolution, rtol=1e-7)
+
+
+# -- parameters ------------------------------------------------------------------------
+def test_shipped_device_numbers_and_sources(device):
+    p = device.parameters
+    assert (p.viscous, p.coulomb, p.smoothing_speed) == (VISCOUS, COULOMB, 0.1)
+    assert (p.stop_stiffness, p.stop_damping) == (K_STOP, B_STOP)
+    np.testing.assert_allclose(p.stop_lower, np.radians([-90, -124, -29]), rtol=1e-15)
+    np.testing.assert_allclose(p.stop_upper, np.radians([90, 119, 214]), rtol=1e-15)
+    np.testing.assert_allclose([p.theta2_minus_theta3_max, p.theta3_minus_theta2_max], np.radians([65, 55]), rtol=1e-15)
+    assert set(p.sources) == {"transmission_ratio", "motor", "encoder", "friction", "stops"}
+    assert "118743" in p.sources["motor"] and "mahilab" in p.sources["stops"]
+
+
+@pytest.mark.parametrize("file, old, new, message", [
+    ("actuation.yaml", "  coulomb: 0.01", "  coulomb: -0.01", "friction.coulomb must not be negative"),
+    ("actuation.yaml", "  torque_constant: 0.0234", "  torque_constant: 0", "motor.torque_constant must be positive"),
+    ("actuation.yaml", "  counts_per_cycle: 4.0", "  counts: 4.0", "missing key encoder.counts_per_cycle"),
+    ("joint_limits.yaml", "  stiffness: 10.0", "  stiffness: .nan", "stops.stiffness must be a finite"),
+    ("joint_limits.yaml", "  joint3: {lower: -0.5061454830783556", "  joint3: {lower: 4.0",
+     "stops.joint3.lower must be below"),
+    ("joint_limits.yaml", "  stops: \"mahilab", "  stop: \"mahilab", "sources.stops must be a non-empty text"),
+])
+def test_malformed_device_numbers_are_named(tmp_path, file, old, new, message):
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    text = (config / file).read_text()
+    assert old in text
+    (config / file).write_text(text.replace(old, new, 1))
+    with pytest.raises(ParameterFileError, match=message) as error:
+        load_device_parameters(config)
+    assert file in str(error.value)
+
+
+def test_device_reads_its_config_folder(tmp_path, phantom):
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    text = (config / "actuation.yaml").read_text()
+    (config / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
+    device = Device(phantom, config)
+    np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB * np.tanh(10), 0, 0], rtol=1e-14)

@@ -1,0 +1,77 @@
+"""phantom-pin simulate and the device data of phantom-pin info: outputs against
+phantom_pin.simulate and the published numbers, exit codes, --force, nothing written on failure."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from phantom_pin import closed_form, simulate
+from phantom_pin.cli import main
+
+START = ["0.3", "0.8", "0.4"]
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_simulate_json_is_the_python_result(tmp_path, capsys):
+    target = tmp_path / "run.json"
+    code, out, _ = run(capsys, "simulate", "--theta0", *START, "--dtheta0", "0", "1", "0", "--duration", "0.05",
+                       "--rate", "500", "--quantization", "-o", str(target))
+    assert code == 0 and "26 samples" in out
+    data = json.loads(target.read_text())
+    expected = simulate([0.3, 0.8, 0.4], 0.05, dtheta0=[0, 1, 0], rate=500.0, quantization=True)
+    for name in ("t", "theta", "dtheta", "tau", "tau_commanded", "current", "tip"):
+        np.testing.assert_array_equal(data[name], getattr(expected, name))
+    assert data["units"]["theta"] == "rad" and data["settings"]["substeps"] == expected.substeps
+
+
+def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(capsys):
+    code, out, _ = run(capsys, "simulate", "--theta0", *START, "--duration", "0.02", "--controller", "gravity",
+                       "--format", "csv")
+    rows = list(csv.reader(out.splitlines()))
+    assert code == 0 and rows[0][:4] == ["t [s]", "theta1 [rad]", "theta2 [rad]", "theta3 [rad]"] and len(rows) == 22
+    table = np.array(rows[1:], dtype=float)
+    np.testing.assert_allclose(table[:, 1:4], np.tile([0.3, 0.8, 0.4], (21, 1)), atol=1e-12)
+    np.testing.assert_allclose(table[:, 8:10], np.tile(closed_form.gravity([0.3, 0.8, 0.4])[1:], (21, 1)), rtol=1e-9)
+    assert rows[0][-3:] == ["tip_x [m]", "tip_y [m]", "tip_z [m]"]
+
+
+def test_simulate_keeps_files_and_writes_nothing_on_failure(tmp_path, capsys):
+    target = tmp_path / "run.csv"
+    code, _, err = run(capsys, "simulate", "--theta0", *START, "--duration", "-1", "-o", str(target))
+    assert code == 2 and "duration" in err and err.count("\n") == 1 and not target.exists()
+    target.write_text("keep")
+    code, _, err = run(capsys, "simulate", "--theta0", *START, "--duration", "0.01", "-o", str(target))
+    assert code == 2 and "--force" in err and target.read_text() == "keep"
+    code, _, _ = run(capsys, "simulate", "--theta0", *START, "--duration", "0.01", "-o", str(target), "--force",
+                     "--format", "csv", "--no-friction", "--no-hard-stops", "--no-saturation")
+    assert code == 0 and target.read_text().startswith("t [s],")
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--theta0", "0", "nan", "0", "--duration", "1"], "theta0: contains NaN"),
+    (["--theta0", *START, "--duration", "1", "--rate", "0"], "rate: expected a finite number > 0"),
+    (["--theta0", *START, "--duration", "1", "--controller", "pd"], "invalid choice"),
+    (["--theta0", *START], "required: --duration"),
+])
+def test_simulate_bad_arguments_give_one_line_and_exit_code_2(capsys, argv, message):
+    code, _, err = run(capsys, "simulate", *argv)
+    assert code == 2 and message in err and err.count("\n") == 1
+
+
+def test_info_lists_the_device_data_with_sources(capsys):
+    code, out, _ = run(capsys, "info", "--json")
+    device = json.loads(out)["device"]
+    assert code == 0 and set(device) == {"stops", "friction", "motor", "encoder", "transmission_ratio"}
+    assert all(section["source"] for section in device.values())
+    assert device["motor"]["stall_torque"] == 0.129 and device["motor"]["torque_constant"] == 0.0234
+    np.testing.assert_allclose(device["encoder"]["resolution"], 2 * np.pi / (4096 * np.array([13.3, 11.6, 11.6])))
+    np.testing.assert_allclose(device["stops"]["stop_upper"], np.radians([90, 119, 214]))
+    code, out, _ = run(capsys, "info")
+    assert "theta3 - theta2 <= 55.0" in out and "118743" in out and "HEDM-5500" in out

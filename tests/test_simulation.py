@@ -1,0 +1,209 @@
+"""simulate(): against an RK4 integration of the closed form written here (another step),
+energy (kinetic + potential + stop springs, from the closed form and the published stop
+stiffness), the static equilibrium at the stops, and the zero-order hold, saturation and
+quantization of the controller's samples."""
+
+import math
+
+import numpy as np
+import pytest
+
+from phantom_pin import InvalidInputError, closed_form, simulate
+from phantom_pin.device.simulation import default_device
+
+START = np.array([0.3, 0.8, 0.4])                  # rad, released at rest
+K_STOP = 10.0                                      # N m/rad, mahilab's hard stop
+#: mahilab's stops as rows of (coordinate gradient, lower, upper) in rad: q1, q2, q3, q2 - q3
+GRADIENTS = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 1.0, -1.0]])
+LOWER, UPPER = np.radians([-90, -124, -29, -55]), np.radians([90, 119, 214, 65])
+PEAK = 0.129 * np.array([13.3, 11.6, 11.6])         # N m: stall torque x ratio
+FALL = 15.0                                        # s
+
+
+def closed_form_rk4(theta0, dtheta0, torque, duration, h):
+    """RK4 with step h of M(q) q'' + C(q, q') q' + N(q) = torque(t), the report's closed form."""
+    def rate(x, t):
+        q, v = x[:3], x[3:]
+        a = np.linalg.solve(closed_form.mass_matrix(q),
+                            torque(t) - closed_form.coriolis_matrix(q, v) @ v - closed_form.gravity(q))
+        return np.concatenate([v, a])
+
+    x, out = np.concatenate([theta0, dtheta0]), []
+    for k in range(int(round(duration / h)) + 1):
+        out.append(x)
+        t = k * h
+        k1 = rate(x, t)
+        k2 = rate(x + h / 2 * k1, t)
+        k3 = rate(x + h / 2 * k2, t)
+        k4 = rate(x + h * k3, t)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return np.array(out)
+
+
+def test_without_friction_stops_and_saturation_it_is_the_closed_form():
+    result = simulate(START, 0.15, friction=False, hard_stops=False, saturation=False)
+    reference = closed_form_rk4(START, np.zeros(3), lambda t: np.zeros(3), 0.15, 1e-4)[::10]
+    assert result.t.shape == (151,) and result.t[0] == 0 and result.t[-1] == pytest.approx(0.15, abs=1e-15)
+    assert np.abs(result.theta - reference[:, :3]).max() < 1e-6          # measured 3e-11 rad
+    assert np.abs(result.dtheta - reference[:, 3:]).max() < 1e-5         # rad/s
+    assert np.abs(result.theta[-1] - START).max() > 0.05                 # it did move
+    np.testing.assert_allclose(result.tip, closed_form.forward_kinematics(result.theta)[:, :3, 3], atol=1e-12)
+    slow = simulate(START, 0.15, rate=20.0, friction=False, hard_stops=False, saturation=False)
+    assert slow.substeps == 50 and np.abs(slow.theta - reference[::50, :3]).max() < 1e-6  # steps <= 1 ms
+
+
+def test_the_controller_torque_is_held_between_samples():
+    """A torque sampled at 500 Hz and held: the closed form integrated at 1/10 of the
+    period with the same held torque."""
+    def command(t, theta, dtheta):
+        return 0.05 * np.sin(2 * np.pi * 7 * t + np.array([0.0, 1.0, 2.0]))
+
+    result = simulate(START, 0.1, command, rate=500.0, friction=False, hard_stops=False, saturation=False)
+
+    def held(t):
+        return command(math.floor(t * 500 * (1 + 1e-12)) / 500, None, None)
+
+    reference = closed_form_rk4(START, np.zeros(3), held, 0.1, 2e-4)[::10]
+    assert np.abs(result.theta - reference[:, :3]).max() < 1e-6
+    np.testing.assert_allclose(result.tau, [command(t, None, None) for t in result.t], rtol=1e-15)
+
+
+def test_halving_the_substep_changes_little_through_a_stop():
+    """0.5 s of free fall, through the first contact with the coupled stop (at 0.3 s)."""
+    default = simulate(START, 0.5)
+    finer = simulate(START, 0.5, substeps=2 * default.substeps)
+    assert default.substeps == 4
+    assert np.abs(default.theta - finer.theta).max() < 1e-6             # measured 4.1e-7 rad
+
+
+@pytest.fixture(scope="module")
+def fall():
+    """FALL seconds from rest at START, unpowered, with friction and stops. Two substeps
+    (the default is four; the halving test above covers it) keep the test short."""
+    return simulate(START, FALL, substeps=2)
+
+
+def stop_depth(theta):
+    coordinate = theta @ GRADIENTS.T
+    return coordinate - np.clip(coordinate, LOWER, UPPER)
+
+
+def test_mechanical_energy_never_grows_without_input(fall):
+    theta, dtheta = fall.theta, fall.dtheta
+    energy = (0.5 * np.einsum("ni,nij,nj->n", dtheta, closed_form.mass_matrix(theta), dtheta)
+              + closed_form.potential_energy(theta) + 0.5 * K_STOP * np.sum(stop_depth(theta) ** 2, axis=1))
+    assert np.diff(energy).max() < 1e-10                                # J; measured < 0 at every sample
+    assert energy[-1] < energy[0] - 0.1                                 # J: it fell and lost it
+    assert (np.abs(stop_depth(theta)).max(axis=1) > 0).any()            # and it hit the stops
+
+
+def test_a_free_fall_comes_to_rest_against_the_parallelogram_stop(fall):
+    """The counterweights pull theta3 up until q3 - q2 = 55 deg; along that stop the arm
+    creeps (the smoothed friction damps it, time constant about 2.3 s) towards the
+    equilibrium where the stop spring balances gravity: N2 = K p = -N3, p the penetration."""
+    theta, dtheta = fall.theta[-1], fall.dtheta[-1]
+    assert np.abs(dtheta).max() < 1e-3                                  # rad/s (measured 1.7e-4)
+    depth = stop_depth(theta)
+    assert depth[:3].tolist() == [0, 0, 0] and -2e-3 < depth[3] < 0     # only q3 - q2 <= 55 deg
+    gravity, spring = closed_form.gravity(theta), -K_STOP * depth[3]
+    assert gravity[1] == pytest.approx(spring, rel=0.01) and -gravity[2] == pytest.approx(spring, rel=0.01)
+    # the equilibrium, by Newton's method on N(q) = stop torque for (q2, q3)
+    q = theta[1:].copy()
+
+    def residual(x):
+        n = closed_form.gravity([theta[0], *x])[1:]
+        p = x[1] - x[0] - np.radians(55)
+        return n - K_STOP * p * np.array([1.0, -1.0])
+
+    for _ in range(20):
+        jacobian = np.stack([(residual(q + e) - residual(q - e)) / 2e-7 for e in np.eye(2) * 1e-7], axis=1)
+        q = q - np.linalg.solve(jacobian, residual(q))
+    assert np.abs(residual(q)).max() < 1e-12
+    assert np.abs(theta[1:] - q).max() < 1e-3                           # rad (measured 4.0e-4)
+    assert theta[0] == pytest.approx(START[0], abs=1e-12)               # no gravity on theta1
+
+
+def test_saturation_clips_at_the_stall_torque():
+    result = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.5])
+    np.testing.assert_allclose(result.tau_commanded, np.tile([5.0, -5.0, 0.5], (11, 1)))
+    np.testing.assert_allclose(result.tau, np.tile([PEAK[0], -PEAK[1], 0.5], (11, 1)), rtol=1e-15)
+    np.testing.assert_allclose(result.current[0], [0.129 / 0.0234, -0.129 / 0.0234, 0.5 / (11.6 * 0.0234)])
+    unclipped = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.5], saturation=False)
+    np.testing.assert_allclose(unclipped.tau, unclipped.tau_commanded)
+
+
+def test_gravity_compensation_holds_the_arm_still():
+    """The sign convention: the controller's torque is eq. 80's tau."""
+    result = simulate(START, 0.2, lambda t, q, dq: closed_form.gravity(q))
+    assert np.abs(result.theta - START).max() < 1e-12
+
+
+def test_quantization_shows_encoder_counts_and_their_backward_difference():
+    seen = []
+
+    def record(t, theta, dtheta):
+        seen.append((t, theta, dtheta))
+        return np.zeros(3)
+
+    dtheta0 = np.array([0.2, -0.1, 0.3])
+    result = simulate(START, 0.02, record, dtheta0=dtheta0, quantization=True)
+    resolution = 2 * np.pi / (1024 * 4 * np.array([13.3, 11.6, 11.6]))
+    times, theta, dtheta = (np.array(x) for x in zip(*seen))
+    np.testing.assert_allclose(times, np.arange(21) / 1000, atol=1e-15)
+    counts = theta / resolution
+    np.testing.assert_allclose(counts, np.round(counts), atol=1e-9)
+    assert np.all(np.abs(theta - result.theta) <= resolution / 2 + 1e-15)
+    np.testing.assert_allclose(dtheta[1:], np.diff(theta, axis=0) * 1000, rtol=1e-9)
+    before = np.round((START - dtheta0 / 1000) / resolution) * resolution
+    np.testing.assert_allclose(dtheta[0], (theta[0] - before) * 1000, rtol=1e-9)
+
+
+@pytest.mark.parametrize("arguments, message", [
+    ({"theta0": [0.0, 0.0]}, "theta0: expected shape"),
+    ({"theta0": [0.0, np.nan, 0.0]}, "theta0: contains NaN"),
+    ({"theta0": np.zeros((2, 3))}, "theta0: expected one vector"),
+    ({"dtheta0": [0.0, np.inf, 0.0]}, "dtheta0: contains NaN"),
+    ({"duration": 0.0}, "duration: expected a finite number > 0"),
+    ({"duration": np.inf}, "duration: expected a finite number > 0"),
+    ({"duration": 1e-4}, "duration: .* shorter than one sample period"),
+    ({"duration": 2000.0}, "duration: .* more than"),
+    ({"rate": -1.0}, "rate: expected a finite number > 0"),
+    ({"rate": "fast"}, "rate: expected a finite number > 0"),
+    ({"controller": 3}, "controller: expected a callable"),
+    ({"controller": lambda t, q, dq: [0.0, 0.0]}, r"controller: returned \[0.0, 0.0\] at t = 0 s"),
+    ({"controller": lambda t, q, dq: [0.0, np.nan, 0.0] if t > 0.005 else [0.0] * 3}, "at t = 0.006 s"),
+    ({"controller": lambda t, q, dq: None}, "controller: returned None"),
+    ({"device": "mine"}, "device: expected a phantom_pin.Device"),
+    ({"substeps": 0}, "substeps: expected an integer >= 1"),
+])
+def test_bad_arguments_are_named(arguments, message):
+    call = {"theta0": START, "duration": 0.01, **arguments}
+    with pytest.raises(InvalidInputError, match=message):
+        simulate(**call)
+
+
+def test_the_plant_is_phantom_forward_dynamics_with_friction_and_stops():
+    """One RK4 substep of h from (theta, dtheta) equals RK4 of Phantom.forward_dynamics plus
+    Device.friction and Device.stop_torque, at states inside and beyond the stops."""
+    device = default_device()
+    rng = np.random.default_rng(8)
+    h = 1e-5
+    for theta in rng.uniform(np.radians([-95, -40, -35]), np.radians([95, 125, 150]), (20, 3)):
+        dtheta = rng.normal(0, 1, 3)
+        if device.within_limits(theta) != device.within_limits(theta + dtheta * h):
+            continue  # event bisection would split this step
+
+        def rate(x):
+            q, v = x[:3], x[3:]
+            tau = device.stop_torque(q, v) - device.friction(v)
+            return np.concatenate([v, device.phantom.forward_dynamics(q, v, tau)])
+
+        x = np.concatenate([theta, dtheta])
+        k1 = rate(x)
+        k2 = rate(x + h / 2 * k1)
+        k3 = rate(x + h / 2 * k2)
+        k4 = rate(x + h * k3)
+        expected = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        result = simulate(theta, h, dtheta0=dtheta, rate=1 / h, substeps=1)
+        np.testing.assert_allclose(result.theta[-1], expected[:3], atol=1e-15)
+        np.testing.assert_allclose(result.dtheta[-1], expected[3:], rtol=1e-10, atol=1e-12)
