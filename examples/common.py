@@ -12,6 +12,7 @@ import matplotlib
 matplotlib.use("Agg")  # headless: figures go to files
 
 from phantom_pin import PhantomPinError  # noqa: E402
+from phantom_pin.validation import output_path  # noqa: E402
 
 
 def parser(description: str) -> argparse.ArgumentParser:
@@ -26,10 +27,7 @@ def parser(description: str) -> argparse.ArgumentParser:
 def output(args: argparse.Namespace, name: str) -> Path:
     """``args.out / name``; refuses an existing file unless --force."""
     args.out.mkdir(parents=True, exist_ok=True)
-    path = args.out / name
-    if path.exists() and not args.force:
-        raise PhantomPinError(f"--out: {path} exists; add --force to overwrite it")
-    return path
+    return output_path(args.out / name, args.force, "--out", "--force")
 
 
 def run(main: Callable[[list[str] | None], None]) -> None:

@@ -3,8 +3,10 @@
 Each coefficient is kept as its printed string, so that its rounding error (half a unit
 in its last printed digit) is known. ``torques`` returns the printed torques and a
 rigorous bound on their rounding error: sum over terms of half-ulp * |basis function|.
-The appendix computed them with Iayy = 0.0018e-4 (its "Numerical Values"); eq. 41 prints
-0.001843e-4, which is what the YAML holds: APPENDIX_IAYY lets a test use the appendix's.
+The appendix computed them with its "Numerical Values" (NUMERICAL_VALUES), which are
+section 3's numbers except Iayy = 0.0018e-4, eq. 41's 0.001843e-4 rounded; the YAML holds
+eq. 41's. ``applies`` tells whether a set of parameters is the report's, so that the
+printed torques apply to it.
 """
 
 from __future__ import annotations
@@ -13,7 +15,25 @@ from decimal import Decimal
 
 import numpy as np
 
-APPENDIX_IAYY = 0.0018e-4
+#: The appendix's "Numerical Values", as printed (h = 0 omitted), by Parameters field name.
+NUMERICAL_VALUES = {
+    "l1": "0.215", "l2": "0.170", "l3": "0.0325", "l5": "-0.0368", "l6": "0.0527",
+    "ma": "0.0202", "Iaxx": "0.4864e-4", "Iayy": "0.0018e-4", "Iazz": "0.4864e-4",
+    "mc": "0.0249", "Icxx": "0.959e-4", "Icyy": "0.959e-4", "Iczz": "0.0051e-4",
+    "mbe": "0.2359", "Ibexx": "11.09e-4", "Ibeyy": "10.06e-4", "Ibezz": "0.591e-4",
+    "mdf": "0.1906", "Idfxx": "7.11e-4", "Idfyy": "0.629e-4", "Idfzz": "6.246e-4",
+    "Ibaseyy": "11.87e-4", "g": "9.81",
+}
+APPENDIX_IAYY = float(NUMERICAL_VALUES["Iayy"])
+#: Eq. 41's Iayy (kg m^2), which the appendix rounded to APPENDIX_IAYY.
+EQ41_IAYY = 0.001843e-4
+
+
+def applies(params: object) -> bool:
+    """True if ``params`` (a Parameters) hold the report's numbers: every appendix value,
+    with Iayy either the appendix's or eq. 41's. Only then do the printed torques apply."""
+    return all(getattr(params, name) == float(text) for name, text in NUMERICAL_VALUES.items()
+               if name != "Iayy") and params.Iayy in (APPENDIX_IAYY, EQ41_IAYY)
 
 
 def _c(text: str) -> tuple[float, float]:

@@ -15,7 +15,7 @@ import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
 from phantom_pin.parameters import Parameters, load_parameters
-from phantom_pin.validation import as_states, same_batch
+from phantom_pin.validation import as_states, finite_result, same_batch, wrap_angle
 
 #: Relative slack on the law-of-cosines arguments before a target counts as unreachable.
 _ACOS_SLACK = 1e-12
@@ -55,7 +55,8 @@ def inverse_kinematics(position: object, branch: str = "report",
     parallelogram reaches. ``branch="other"`` is the mirrored elbow
     (theta2 = beta - gamma, theta3 = theta2 - alpha - pi/2). Raises
     UnreachableTargetError when a target is farther from the shoulder than l1 + l2
-    or nearer than |l1 - l2|.
+    or nearer than |l1 - l2|. Angles are wrapped into (-pi, pi] (theta1 = +pi behind
+    the shoulder); they may lie outside the joint limits.
     """
     p = params or shipped_parameters()
     if branch not in ("report", "other"):
@@ -83,7 +84,7 @@ def inverse_kinematics(position: object, branch: str = "report",
     else:
         theta2 = beta - gamma
         theta3 = theta2 - alpha - np.pi / 2
-    return np.stack([theta1, theta2, theta3], axis=-1)
+    return wrap_angle(np.stack([theta1, theta2, theta3], axis=-1))
 
 
 def spatial_jacobian(theta: object, params: Parameters | None = None) -> np.ndarray:
@@ -209,4 +210,6 @@ def inverse_dynamics(theta: object, dtheta: object, ddtheta: object,
     same_batch(("theta", "dtheta", "ddtheta"), pos, vel, acc)
     m = mass_matrix(pos, p)
     c = coriolis_matrix(pos, vel, p)
-    return (m @ acc[..., None])[..., 0] + (c @ vel[..., None])[..., 0] + gravity(pos, p)
+    with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result
+        return finite_result((m @ acc[..., None])[..., 0] + (c @ vel[..., None])[..., 0] + gravity(pos, p),
+                             "theta, dtheta, ddtheta")

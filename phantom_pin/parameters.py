@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import re
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from phantom_pin.exceptions import ParameterFileError
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.paths import CONFIG_DIR
 
 #: The parameter files of robots/phantom_description/config, by xacro argument name.
@@ -21,6 +23,10 @@ PARAMETER_FILES = {
     "visual_parameters_file": "visual_parameters.yaml",
     "mjcf_file": "mjcf.yaml",
 }
+
+#: Largest |joint limit| (rad): a revolute joint's range beyond one turn each way repeats
+#: postures and describes no stop of this arm (mahilab's widest stop is 3.74 rad).
+JOINT_LIMIT_BOUND = 2 * math.pi
 
 
 @dataclasses.dataclass(frozen=True)
@@ -69,14 +75,35 @@ class Parameters:
         return tuple(self.rotor_inertia * r**2 for r in self.ratios)
 
 
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader, which also reads 1e-6 and 1.0e6 as numbers.
+
+    PyYAML follows YAML 1.1, whose floats need a dot and a signed exponent: it reads
+    ``1e-6`` and ``1.0e6`` as strings (``1.0e-6`` and ``1.0e+6`` as numbers). YAML 1.2
+    reads all four as numbers, and so does this loader.
+    """
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"))
+
+
 def _read(path: Path) -> dict:
+    """The mapping in the YAML file ``path``; ParameterFileError naming it (one line) if it
+    cannot be read, is not UTF-8 text, is not valid YAML or is not a mapping."""
     try:
         with open(path, encoding="utf-8") as stream:
-            data = yaml.safe_load(stream)
+            data = yaml.load(stream, Loader=_Loader)
     except OSError as error:
         raise ParameterFileError(f"{path}: cannot read ({error.strerror})") from error
+    except UnicodeDecodeError as error:
+        raise ParameterFileError(f"{path}: not a text file (not UTF-8 at byte {error.start})") from error
     except yaml.YAMLError as error:
-        raise ParameterFileError(f"{path}: not valid YAML ({error})") from error
+        mark = getattr(error, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(error, "problem", None) or " ".join(str(error).split())
+        raise ParameterFileError(f"{path}: not valid YAML{where}: {problem}") from error
     if not isinstance(data, dict):
         raise ParameterFileError(f"{path}: expected a mapping at the top level")
     return data
@@ -102,6 +129,9 @@ def _number(data: dict, path: Path, *keys: str, positive: bool = False) -> float
 
 def parameter_paths(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str) -> dict[str, Path]:
     """Paths of the five parameter files: ``config_dir``'s, or ``overrides`` by xacro arg name."""
+    for name, value in {"config_dir": config_dir, **overrides}.items():
+        if not isinstance(value, (str, os.PathLike)):
+            raise InvalidInputError(f"{name}: expected a path (str or os.PathLike), got {value!r}")
     unknown = set(overrides) - set(PARAMETER_FILES)
     if unknown:
         raise ParameterFileError(f"unknown parameter file argument(s): {sorted(unknown)}")
@@ -124,6 +154,10 @@ def load_parameters(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str
     lower = tuple(_number(lim, lim_path, j, "lower") for j in joints)
     upper = tuple(_number(lim, lim_path, j, "upper") for j in joints)
     for joint, lo, hi in zip(joints, lower, upper):
+        for side, value in (("lower", lo), ("upper", hi)):
+            if abs(value) > JOINT_LIMIT_BOUND:
+                raise ParameterFileError(f"{lim_path}: {joint}.{side} must be within one turn "
+                                         f"(|limit| <= 2 pi rad), got {value!r}")
         if lo >= hi:
             raise ParameterFileError(f"{lim_path}: {joint}.lower must be below {joint}.upper")
     return Parameters(
@@ -154,10 +188,11 @@ def load_parameters(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str
     )
 
 
-def random_states(params: Parameters, n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def random_states(params: Parameters, n: int,
+                  seed: int | np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``n`` seeded states (theta, dtheta, ddtheta), each (n, 3): theta uniform inside the
     joint limits (rad), rates and accelerations normal with standard deviations 2 rad/s
-    and 20 rad/s^2."""
+    and 20 rad/s^2. ``seed`` may be a Generator, to draw a long sequence in chunks."""
     rng = np.random.default_rng(seed)
     theta = rng.uniform(params.lower, params.upper, (n, 3))
     return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
@@ -185,9 +220,11 @@ def read_overrides(path: Path | str) -> dict[str, float]:
 
 
 def write_overridden(overrides: dict[str, object], destination: Path | str,
-                     config_dir: Path | str = CONFIG_DIR) -> Path:
-    """Copy the five parameter files of ``config_dir`` into the folder ``destination``
-    with ``overrides`` applied, check them with load_parameters, and return the folder.
+                     config_dir: Path | str = CONFIG_DIR, **files: Path | str) -> Path:
+    """Copy the five parameter files (``config_dir``'s, or ``files`` by xacro arg name as
+    in parameter_paths) into the folder ``destination`` with ``overrides`` applied, check
+    them with load_parameters, and return the folder. The copies hold plain YAML numbers
+    that any YAML 1.1 reader (xacro's) reads as numbers, whatever form the originals use.
 
     Keys are dotted paths into the files ("l1", "segment_a.mass", "joint2.upper"),
     optionally qualified by the file's stem ("actuation.motor.rotor_inertia"); an
@@ -197,22 +234,23 @@ def write_overridden(overrides: dict[str, object], destination: Path | str,
     Raises ParameterFileError naming the key.
     """
     destination = Path(destination)
-    files = {name: _read(Path(config_dir) / name) for name in PARAMETER_FILES.values()}
-    stems = {Path(name).stem: name for name in files}
+    paths = parameter_paths(config_dir, **files)
+    documents = {name: _read(paths[arg]) for arg, name in PARAMETER_FILES.items()}
+    stems = {Path(name).stem: name for name in documents}
     for key, value in overrides.items():
         parts = str(key).split(".")
         if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
             holders, parts = [stems[parts[0]]], parts[1:]
         else:
-            holders = [name for name, data in files.items() if parts[0] in data]
+            holders = [name for name, data in documents.items() if parts[0] in data]
         if not holders:
             raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
         if len(holders) > 1:
             raise ParameterFileError(f"{key}: {' and '.join(holders)} both have {parts[0]!r}; "
                                      f"qualify it, e.g. {Path(holders[0]).stem}.{key}")
-        if parts[0] not in files[holders[0]]:
+        if parts[0] not in documents[holders[0]]:
             raise ParameterFileError(f"{key}: {holders[0]} has no key {parts[0]!r}")
-        node: object = files[holders[0]]
+        node: object = documents[holders[0]]
         for part in parts[:-1]:
             node = node.get(part) if isinstance(node, dict) else None
         current = node.get(parts[-1]) if isinstance(node, dict) else None
@@ -221,11 +259,11 @@ def write_overridden(overrides: dict[str, object], destination: Path | str,
         if not _is_number(value) or not math.isfinite(value):
             raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
         node[parts[-1]] = float(value)
-    for name, data in files.items():
+    for name, data in documents.items():
         with open(destination / name, "w", encoding="utf-8") as stream:
             yaml.safe_dump(data, stream, sort_keys=False)
     try:
         load_parameters(destination)
     except ParameterFileError as error:  # name the file, not the temporary folder
-        raise ParameterFileError(f"after the overrides, {str(error).replace(f'{destination}/', '')}") from None
+        raise ParameterFileError(f"after the overrides, {str(error).replace(f'{destination}{os.sep}', '')}") from None
     return destination

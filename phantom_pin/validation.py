@@ -1,6 +1,9 @@
-"""Shape and finiteness checks shared by the closed-form and Pinocchio APIs."""
+"""Checks shared by the closed-form and Pinocchio APIs and the command line: shapes and
+finiteness of inputs and results, angle wrapping, output paths."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 
@@ -11,12 +14,19 @@ def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, boo
     """Return ``value`` as a float array of shape (width,) or (..., width).
 
     The second result is True when ``value`` carried leading (batch) axes.
-    Raises InvalidInputError naming ``name`` on a wrong shape, a non-numeric
-    value, NaN or inf.
+    Raises InvalidInputError naming ``name`` on a wrong or ragged shape, a non-numeric
+    or complex value, NaN or inf.
     """
     try:
-        array = np.asarray(value, dtype=float)
+        array = np.asarray(value)
+        if array.dtype.kind == "c":
+            raise InvalidInputError(f"{name}: expected real numbers, got complex values")
+        if array.dtype.kind not in "biufO":  # strings, bytes, dates
+            raise TypeError(array.dtype)
+        array = array.astype(float, copy=False)
     except (TypeError, ValueError) as error:
+        if isinstance(error, InvalidInputError):
+            raise
         raise InvalidInputError(f"{name}: expected numbers, got {value!r}") from error
     if array.ndim == 0 or array.shape[-1] != width:
         raise InvalidInputError(
@@ -42,3 +52,40 @@ def same_batch(names: tuple[str, ...], *arrays: np.ndarray) -> None:
     if len(shapes) > 1:
         listed = ", ".join(f"{n} {a.shape}" for n, a in zip(names, arrays))
         raise InvalidInputError(f"arguments must have the same shape: {listed}")
+
+
+def finite_result(result: np.ndarray, names: str) -> np.ndarray:
+    """Return ``result``; raise InvalidInputError naming the inputs ``names`` if it holds a
+    NaN or inf, which finite inputs produce only by overflowing (for example rates of
+    1e200 rad/s, whose squares exceed the largest float)."""
+    if not np.isfinite(result).all():
+        raise InvalidInputError(f"{names}: too large, the result overflows to inf or NaN")
+    return result
+
+
+def within_box(theta: object, lower: np.ndarray, upper: np.ndarray) -> bool | np.ndarray:
+    """True where ``theta`` (rad), shape (3,) or (..., 3), satisfies lower <= theta <= upper
+    in every joint: a bool for one state, a bool array of shape (...) for a batch."""
+    q, batch = as_states(theta, "theta")
+    inside = np.all((lower <= q) & (q <= upper), axis=-1)
+    return inside if batch else bool(inside)
+
+
+def wrap_angle(angle: np.ndarray) -> np.ndarray:
+    """Angles (rad) mapped into (-pi, pi]; angles already inside are returned unchanged."""
+    outside = (angle > np.pi) | (angle <= -np.pi)
+    return np.where(outside, np.pi - (np.pi - angle) % (2 * np.pi), angle)
+
+
+def output_path(path: object, force: bool, name: str, force_hint: str = "force=True") -> Path:
+    """``path`` as the Path of a file to write: raise InvalidInputError naming ``name``
+    if it is a folder, if its folder does not exist, or if it exists and not ``force``
+    (``force_hint`` says how to ask for overwriting)."""
+    output = Path(path)
+    if output.is_dir():
+        raise InvalidInputError(f"{name}: {output} is a folder; give a file name")
+    if not output.parent.is_dir():
+        raise InvalidInputError(f"{name}: folder {output.parent} does not exist")
+    if output.exists() and not force:
+        raise InvalidInputError(f"{name}: {output} exists; use {force_hint} to overwrite it")
+    return output

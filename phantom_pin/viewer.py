@@ -21,7 +21,7 @@ from pinocchio.visualize import MeshcatVisualizer
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.loader import load
 from phantom_pin.meshcat_server import MeshcatServer
-from phantom_pin.validation import as_state, as_states
+from phantom_pin.validation import as_state, as_states, output_path
 
 #: Camera position (m, base_link) from which the whole workspace is in view. meshcat
 #: 0.3's orbit controls always look at the world origin, here the shoulder.
@@ -130,10 +130,14 @@ class Viewer:
         f = as_state(force, "force")
         if not (np.isfinite(scale) and scale > 0):
             raise InvalidInputError(f"scale: expected a positive number of m/N, got {scale!r}")
-        self._force = f
+        magnitude = float(np.abs(f).max())  # scaled first: |f| of a tiny f underflows to 0
+        direction = f / magnitude if magnitude else f
+        length = magnitude * float(np.linalg.norm(direction)) * scale
+        if not np.isfinite(length):
+            raise InvalidInputError("force, scale: the arrow would be infinitely long")
+        self._force = direction  # only the direction is needed from here on
         node = self.scene[_FORCE_PATH]
         node.delete()
-        length = float(np.linalg.norm(f)) * scale
         if length == 0.0:
             return
         head = min(0.3 * length, 4 * _ARROW_RADIUS)
@@ -197,11 +201,7 @@ class Viewer:
         """Write the scene (with its camera and animation) as one self-contained HTML
         file that opens in any browser without a server; an existing file is kept
         unless ``force``. Returns the path."""
-        output = Path(path)
-        if output.exists() and not force:
-            raise InvalidInputError(f"path: {output} exists; pass force=True to overwrite it")
-        if not output.parent.is_dir():
-            raise InvalidInputError(f"path: folder {output.parent} does not exist")
+        output = output_path(path, force, "path")
         output.write_text(_in_order(self.scene.static_html()), encoding="utf-8")
         return output
 

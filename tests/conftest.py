@@ -93,5 +93,10 @@ def dark(pixels: np.ndarray) -> bool:
     return bool(np.any((pixels.max(axis=1) < 90) & (np.ptp(pixels, axis=1) < 25)))
 
 
+def light_grey(pixels: np.ndarray) -> bool:
+    """The arm's tubes are light grey (0.75); the background is saturated, the base darker."""
+    return bool(np.any((pixels.min(axis=1) > 120) & (np.ptp(pixels, axis=1) < 25)))
+
+
 def red(pixels: np.ndarray) -> bool:
     return bool(np.any((pixels[:, 0] > 140) & (pixels[:, 1] < 90) & (pixels[:, 2] < 90)))

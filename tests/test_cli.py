@@ -3,10 +3,12 @@ overridden URDFs against the closed form with the same overrides, the viewer in 
 
 import dataclasses
 import json
+import os
 import shutil
 import signal
 import subprocess
 import sys
+import time
 import urllib.error
 import urllib.request
 
@@ -18,6 +20,7 @@ from conftest import RAISED, dark, frame_pose, patch, render
 from phantom_pin import closed_form as cf
 from phantom_pin.cli import main
 from phantom_pin.description import generate_urdf
+from phantom_pin.parameters import random_states
 from phantom_pin.paths import CONFIG_DIR, URDF_PATH
 
 
@@ -162,3 +165,140 @@ def test_show_serves_on_loopback_until_interrupted(tmp_path):
         assert process.wait(30) == 0
     with pytest.raises(urllib.error.URLError):  # the server went with the command
         urllib.request.urlopen(url, timeout=5)
+
+
+def _config(tmp_path, file, old, new):
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    path = config / file
+    assert old in path.read_text()
+    path.write_text(path.read_text().replace(old, new, 1))
+    return config
+
+
+def test_check_of_a_custom_configuration_passes_and_skips_the_appendix(tmp_path, capsys):
+    """The README's example l1 = 0.2096: Phantom vs closed form with the same parameters
+    passes; the appendix's torques are not the numbers of this arm, so their row is n/a."""
+    config = _config(tmp_path, "kinematics.yaml", "l1: 0.215 ", "l1: 0.2096 ")
+    code, out, _ = run(capsys, "--config", str(config), "check", "-n", "300", "--json")
+    report = json.loads(out)
+    assert code == 0 and report["passed"] and len(report["checks"]) == 8
+    assert report["checks"][-1]["max_error"] is None
+    assert all(row["max_error"] < 1e-9 for row in report["checks"][:-1])
+    code, out, _ = run(capsys, "--config", str(config), "check", "-n", "30")
+    assert code == 0 and "n/a" in out and "all checks pass" in out
+
+
+def test_check_draws_and_evaluates_in_chunks(monkeypatch, capsys):
+    """250 states in chunks of 7: 35 chunks of 7 and one of 5, every check passes."""
+    sizes = []
+
+    def spy(params, n, seed):
+        sizes.append(n)
+        return random_states(params, n, seed)
+    monkeypatch.setattr("phantom_pin.cli.CHECK_CHUNK", 7)
+    monkeypatch.setattr("phantom_pin.cli.random_states", spy)
+    report = json.loads(run(capsys, "check", "-n", "250", "--json")[1])
+    assert sizes == [7] * 35 + [5] and report["passed"] and report["states"] == 250
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["urdf", "-o", "/nonexistent_dir/x.urdf"], "--output: folder /nonexistent_dir does not exist"),
+    (["urdf", "-o", "{tmp}", "--force"], "is a folder"),
+    (["srdf", "-o", "{tmp}", "--force"], "is a folder"),
+    (["show", "--html", "{tmp}", "--force"], "--html: "),
+    (["dynamics", "--theta", "0", "0", "0", "--dtheta", "1e200", "1e200", "1e200", "--json"], "overflows"),
+    (["check", "-n", "1.5"], "-n: expected a positive whole number"),
+    (["ik", "0", "0.17", "0.17", "--branch", "left"], "invalid choice"),
+])
+def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, capsys, argv, message):
+    code, out, err = run(capsys, *(a.format(tmp=tmp_path) for a in argv))
+    assert code == 2 and message in err and err.count("\n") == 1 and out == ""
+
+
+@pytest.mark.parametrize("file, old, new, message", [
+    ("joint_limits.yaml", "joint2: {lower: -0.3, upper: 1.0}", "joint2: {lower: -1e308, upper: 1e308}",
+     "joint2.lower must be within one turn"),
+    ("actuation.yaml", "motor:", "motor: [", "not valid YAML at line"),
+    ("physical_parameters.yaml", "segment_a:", "segment_a: {", "not valid YAML at line"),
+])
+def test_bad_configuration_gives_one_line_naming_the_file(tmp_path, capsys, file, old, new, message):
+    config = _config(tmp_path, file, old, new)
+    for argv in (["check", "-n", "10"], ["urdf", "-o", str(tmp_path / "x.urdf")]):
+        code, _, err = run(capsys, "--config", str(config), *argv)
+        assert code == 2 and message in err and file in err and err.count("\n") == 1
+    assert not (tmp_path / "x.urdf").exists()
+
+
+def test_binary_params_file_is_named(tmp_path, capsys):
+    params = tmp_path / "params.yaml"
+    params.write_bytes(bytes(range(128, 256)))
+    code, _, err = run(capsys, "urdf", "-o", str(tmp_path / "x.urdf"), "--params", str(params))
+    assert code == 2 and "params.yaml: not a text file" in err and err.count("\n") == 1
+
+
+def test_negative_numbers_in_scientific_notation_are_values(capsys):
+    code, out, _ = run(capsys, "fk", "-1e-3", "0", "0", "--json")
+    assert code == 0
+    np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics([-1e-3, 0, 0]), atol=1e-12)
+    code, out, _ = run(capsys, "dynamics", "--theta", "-1e-3", "0.1", "0.2", "--dtheta", "-2E+0", "0", "-.5",
+                       "--json")
+    assert code == 0
+    np.testing.assert_allclose(json.loads(out)["tau"], cf.inverse_dynamics([-1e-3, 0.1, 0.2], [-2, 0, -0.5],
+                                                                           [0, 0, 0]), rtol=1e-9)
+
+
+@pytest.mark.parametrize("argv, warned", [
+    (["fk", "0", "0", "3"], "theta [0 0 3] rad is outside the joint limits"),
+    (["dynamics", "--theta", "1.5", "0", "0"], "theta [1.5 0 0] rad is outside the joint limits"),
+    (["ik", "0", "0.17", "0.17"], "the solution theta"),   # theta3 = pi/2 > 1.1
+    (["fk", "1", "1", "1.1"], None),                        # on the limits: inside
+    (["ik", "0", "0.12", "0.05"], None),
+])
+def test_out_of_limit_angles_are_computed_with_one_warning_line(capsys, argv, warned):
+    code, out, err = run(capsys, *argv)
+    assert code == 0 and out
+    if warned is None:
+        assert err == ""
+    else:
+        assert err.count("\n") == 1 and err.startswith("phantom-pin: warning: ") and warned in err
+
+
+def _popen(*argv):
+    return subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", *argv],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_closed_output_pipe_ends_quietly():
+    """phantom-pin info | head -1: the reader goes away; no traceback, exit 141 (128 + SIGPIPE)."""
+    process = _popen("info")
+    process.stdout.close()
+    assert process.wait(60) == 141
+    assert process.stderr.read() == ""
+
+
+def _cpu_seconds(pid: int) -> float:
+    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _peak_rss_mb(pid: int) -> float:
+    status = open(f"/proc/{pid}/status").read()
+    return int(status.split("VmHWM:")[1].split()[0]) / 1024
+
+
+def test_huge_check_runs_in_bounded_memory_and_ctrl_c_gives_one_line():
+    """check -n 1e11 (2 TiB of states at once before): after 6 s of CPU its peak memory
+    is below 400 MB; Ctrl-C then ends it with one line and exit 130 (128 + SIGINT)."""
+    process = _popen("check", "-n", "100000000000")
+    try:
+        deadline = time.monotonic() + 120
+        while _cpu_seconds(process.pid) < 6.0 and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.2)
+        assert process.poll() is None, process.stderr.read()
+        assert _peak_rss_mb(process.pid) < 400
+        process.send_signal(signal.SIGINT)
+        assert process.wait(60) == 130
+    finally:
+        process.kill()
+    assert process.stderr.read() == "phantom-pin: interrupted\n"

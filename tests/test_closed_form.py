@@ -19,10 +19,21 @@ def test_torques_equal_the_appendix_to_its_printed_precision(states):
     assert np.all(np.abs(cf.inverse_dynamics(*states, params) - printed) <= bound)
 
 
-def test_mass_matrix_is_symmetric_positive_definite(states):
-    m = cf.mass_matrix(states[0])
-    np.testing.assert_array_equal(m, np.swapaxes(m, -1, -2))
-    assert np.linalg.eigvalsh(m).min() > 0
+def test_mass_matrix_is_the_appendix_coefficient_of_ddtheta(states):
+    """Column j of M is tau(theta, 0, e_j) - tau(theta, 0, 0) of the appendix's printed
+    torques (Iayy as the appendix), within the printed rounding of both."""
+    params = dataclasses.replace(cf.shipped_parameters(), Iayy=appendix.APPENDIX_IAYY)
+    theta = states[0]
+    zero = np.zeros_like(theta)
+    base, base_bound = appendix.torques(theta, zero, zero)
+    m = cf.mass_matrix(theta, params)
+    for j, e in enumerate(np.eye(3)):
+        column, bound = appendix.torques(theta, zero, zero + e)
+        assert np.all(np.abs(m[:, :, j] - (column - base)) <= bound + base_bound), j
+
+
+def test_mass_matrix_is_positive_definite(states):
+    assert np.linalg.eigvalsh(cf.mass_matrix(states[0])).min() > 0
 
 
 def test_mdot_minus_2c_is_skew_symmetric(states):

@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 
 from phantom_pin import closed_form as cf
-
-derivation = pytest.importorskip("phantom_pin.derivation", reason="needs sympy (the test extra)")
+from phantom_pin import derivation  # needs sympy, a test dependency: fail, never skip, without it
 
 
 @pytest.fixture(scope="module")

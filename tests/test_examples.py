@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import dark, frame_pose, patch, render
-from phantom_pin import load
+from conftest import dark, frame_pose, light_grey, patch, render
+from phantom_pin import Phantom, closed_form as cf, load
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -49,39 +49,86 @@ def test_simulate_conserves_energy(tmp_path):
     assert number(r"max \|E\(t\) - E\(0\)\| = (\S+) J", result.stdout) < 1e-8
 
 
-def test_workspace_stays_inside_the_reachable_shell(tmp_path):
+def example(name: str):
+    """Import examples/<name>.py as a module (its main does not run)."""
+    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
+    sys.path.insert(0, str(EXAMPLES))
+    try:
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(EXAMPLES))
+    return module
+
+
+def test_workspace_prints_the_closed_form_extent_of_the_grid(tmp_path):
+    """Bounding box and shoulder distances of the tips of a 15^3 grid over the YAML's joint
+    limits, recomputed here with the closed form (eq. 10), equal the printed ones to their
+    4 decimals; the example's own Phantom vs closed form difference is below 1e-12 m."""
     result = run("workspace.py", tmp_path, "--samples", "15")
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "workspace.png")
-    assert re.search(r": 3375 of 3375", result.stdout), result.stdout
+    p = cf.shipped_parameters()
+    grid = np.stack(np.meshgrid(*(np.linspace(lo, hi, 15) for lo, hi in zip(p.lower, p.upper)),
+                                indexing="ij"), axis=-1).reshape(-1, 3)
+    tip = cf.forward_kinematics(grid)[:, :3, 3]
+    radius = np.linalg.norm(tip - [0.0, p.l2, -p.l1], axis=1)
+    printed = [float(v) for v in re.findall(r"[-+]?\d+\.\d{4}", result.stdout.split("bounding box")[1])[:8]]
+    expected = [tip[:, 0].min(), tip[:, 0].max(), tip[:, 1].min(), tip[:, 1].max(),
+                tip[:, 2].min(), tip[:, 2].max(), radius.min(), radius.max()]
+    np.testing.assert_allclose(printed, expected, atol=5.1e-5)
+    assert "3375 postures" in result.stdout
+    assert number(r"max difference (\S+) m", result.stdout) < 1e-12
 
 
-def test_trajectory_torques_track_the_path(tmp_path):
+def test_trajectory_torques_follow_the_minimum_jerk_path_and_the_closed_form(tmp_path):
+    """The script runs; its reach(), checked against what it claims: the tip (closed-form
+    FK of theta) on the straight minimum-jerk path typed here, the tip velocity (closed-form
+    Jacobian times dtheta) its derivative, ddtheta the time derivative of dtheta (finite
+    differences), and the torques closed_form.inverse_dynamics."""
     result = run("trajectory_torques.py", tmp_path)
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "trajectory_torques.png")
-    assert number(r"tracking error max (\S+) m", result.stdout) < 1e-9
-    # 301 samples over 0.6 s: second-order differences are good to about 1e-3 rad/s
-    assert number(r"finite differences of theta\(t\): max (\S+) rad/s", result.stdout) < 1e-3
+    module = example("trajectory_torques")
+    start, end = cf.forward_kinematics(module.START)[:3, 3], cf.forward_kinematics(module.END)[:3, 3]
+    duration = 0.6
+    r = module.reach(Phantom(), start, end, duration)
+    s = r["time"] / duration
+    profile = 10 * s**3 - 15 * s**4 + 6 * s**5
+    speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / duration
+    np.testing.assert_allclose(cf.forward_kinematics(r["theta"])[:, :3, 3],
+                               start + np.outer(profile, end - start), atol=1e-12)
+    jacobian = cf.spatial_jacobian(r["theta"])
+    tip = cf.forward_kinematics(r["theta"])[:, :3, 3]
+    velocity = (np.einsum("nij,nj->ni", jacobian[:, :3], r["dtheta"])
+                + np.cross(np.einsum("nij,nj->ni", jacobian[:, 3:], r["dtheta"]), tip))
+    np.testing.assert_allclose(velocity, np.outer(speed, end - start), atol=1e-12)
+    # 301 samples over 0.6 s: second-order differences (measured 3.6e-3 rad/s^2 of 17.6)
+    numeric = np.gradient(r["dtheta"], r["time"], axis=0, edge_order=2)
+    assert np.abs(numeric - r["ddtheta"]).max() < 1e-3 * np.abs(r["ddtheta"]).max()
+    expected = cf.inverse_dynamics(r["theta"], r["dtheta"], r["ddtheta"])
+    assert np.abs(r["torque"] - expected).max() < 1e-9 * np.abs(expected).max()
 
 
 def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
-    """The page renders the arm, with the tip ball on one of the sweep's postures (the
-    browser's clock decides which; test_viewer checks the timing of animations)."""
+    """The page renders the arm at one of the sweep's postures (the browser's clock
+    decides which; test_viewer checks the timing of animations): at that posture the
+    black tip ball is where the kinematics put the tip AND the light grey forearm and
+    upper arm tubes are at their midpoints (the black motors and the dark base, onto
+    which some postures project their tip, cannot fake those)."""
     result = run("visualize.py", tmp_path)
     assert result.returncode == 0, result.stderr
     image = render(tmp_path / "visualize.html", tmp_path / "visualize.png")
     assert np.count_nonzero(np.ptp(image[40:], axis=2) < 30) > 3000
-    spec = importlib.util.spec_from_file_location("visualize", EXAMPLES / "visualize.py")
-    sys.path.insert(0, str(EXAMPLES))
-    try:
-        example = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(example)
-    finally:
-        sys.path.remove(str(EXAMPLES))
     robot = load()
-    _, postures = example.sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-    assert any(dark(patch(image, frame_pose(robot.model, theta, "tip").translation)) for theta in postures)
+    _, postures = example("visualize").sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+
+    def where(theta, frame):
+        return frame_pose(robot.model, theta, frame).translation
+    shown = [theta for theta in postures if dark(patch(image, where(theta, "tip")))
+             and light_grey(patch(image, (where(theta, "tip") + where(theta, "forearm_link")) / 2))
+             and light_grey(patch(image, where(theta, "elbow") / 2))]   # the shoulder is the origin
+    assert shown
 
 
 @pytest.mark.parametrize("script", ["gravity_compensation.py", "simulate.py", "workspace.py",

@@ -103,3 +103,19 @@ def test_bad_loader_attributes_raise_named_errors():
         load(NoFile)
     with pytest.raises(InvalidInputError, match="ref_posture: 'standing'"):
         load(NoPosture)
+
+
+@pytest.mark.parametrize("attribute, text, message", [
+    ("urdf_path", "<robot", "urdf_path: .*not well-formed XML"),
+    ("urdf_path", '<robot name="r"><link name="a"/><joint name="j" type="revolute"><parent link="a"/>'
+                  '<child link="b"/></joint></robot>', "urdf_path: Pinocchio cannot load"),
+    ("urdf_path", b"\xff\xfe\x00binary", "urdf_path: .* is not a text file"),
+    ("srdf_path", "garbage", "srdf_path: Pinocchio cannot read"),
+])
+def test_malformed_urdf_or_srdf_raise_a_named_parameter_file_error(tmp_path, attribute, text, message):
+    path = tmp_path / ("bad.urdf" if attribute == "urdf_path" else "bad.srdf")
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    loader = type("Bad", (PhantomLoader,), {attribute: path})
+    with pytest.raises(ParameterFileError, match=message) as error:
+        load(loader)
+    assert "\n" not in str(error.value)

@@ -1,6 +1,7 @@
 """Phantom (Pinocchio) against closed_form, finite differences and energy conservation."""
 
 import shutil
+import warnings
 
 import numpy as np
 import pinocchio as pin
@@ -26,10 +27,20 @@ def test_coriolis_matrix_equals_closed_form(phantom, states):
     assert relative_error(phantom.coriolis_matrix(theta, dtheta), cf.coriolis_matrix(theta, dtheta)) < TOLERANCE
 
 
-def test_pinocchio_coriolis_on_the_mimic_model_is_wrong_which_is_why_we_project(phantom, states):
-    theta, dtheta, _ = states
-    raw = pin.computeCoriolisMatrix(phantom.model, phantom.model.createData(), theta[0], dtheta[0])
-    assert np.abs(raw - cf.coriolis_matrix(theta[0], dtheta[0])).max() > 1e-6
+def test_coriolis_projection_is_right_and_pinocchio_mimic_coriolis_is_reported(phantom, states):
+    """What we rely on: C = G^T C_tree G equals the closed form (asserted). Whether
+    Pinocchio's own computeCoriolisMatrix on the mimic model is still wrong
+    (DEVELOPERS.md) is reported as a warning, not asserted: a fix upstream must not fail
+    the suite, it only means Phantom.coriolis_matrix could call Pinocchio directly."""
+    theta, dtheta, _ = (s[:50] for s in states)
+    expected = cf.coriolis_matrix(theta, dtheta)
+    assert relative_error(phantom.coriolis_matrix(theta, dtheta), expected) < TOLERANCE
+    data = phantom.model.createData()
+    raw = np.array([pin.computeCoriolisMatrix(phantom.model, data, q, v) for q, v in zip(theta, dtheta)])
+    error = relative_error(raw, expected)
+    warnings.warn(f"pinocchio {pin.__version__}: computeCoriolisMatrix on the mimic model is "
+                  + (f"still wrong (relative error {error:.1e}); Phantom projects the tree model's"
+                     if error > TOLERANCE else "now right: Phantom.coriolis_matrix could call it"))
 
 
 def test_inverse_dynamics_equals_closed_form(phantom, states):
@@ -134,3 +145,81 @@ def test_modified_parameter_file_is_used(tmp_path, states):
     assert relative_error(modified.inverse_dynamics(*(s[:50] for s in states)),
                           cf.inverse_dynamics(*(s[:50] for s in states), modified.parameters)) < TOLERANCE
     assert relative_error(modified.forward_kinematics(theta), cf.forward_kinematics(theta, modified.parameters)) < TOLERANCE
+
+
+@pytest.mark.parametrize("bad, message", [
+    ("abc", "expected numbers"), ({"a": 1}, "expected numbers"), ([[0, 1], [2]], "expected numbers"),
+    ([1j, 0, 0], "expected real numbers"), (np.array([0.1, 0.2, 0.3 + 1e-3j]), "expected real numbers"), (["1", "2", "3"], "expected numbers"),
+])
+@pytest.mark.parametrize("argument", [0, 1, 2])
+def test_inverse_dynamics_single_state_names_every_bad_argument(phantom, bad, message, argument):
+    """The fast path of one state (3,) included: a named InvalidInputError, never a builtin."""
+    values = [np.zeros(3), np.zeros(3), np.zeros(3)]
+    values[argument] = bad
+    name = ("theta", "dtheta", "ddtheta")[argument]
+    with pytest.raises(InvalidInputError, match=f"^{name}: {message}"):
+        phantom.inverse_dynamics(*values)
+
+
+@pytest.mark.parametrize("function", [lambda p, x: cf.mass_matrix(x), lambda p, x: cf.forward_kinematics(x),
+                                      lambda p, x: cf.inverse_dynamics(x, x.real, x.real),
+                                      lambda p, x: p.within_limits(x), lambda p, x: p.gravity(x)])
+def test_complex_input_is_refused_not_truncated(phantom, function):
+    with pytest.raises(InvalidInputError, match="theta: expected real numbers, got complex"):
+        function(phantom, np.array([0.1, 0.2, 0.3 + 0.5j]))
+
+
+def test_overflowing_results_raise_instead_of_returning_nan(phantom):
+    big = np.full(3, 1e200)  # rates whose squares overflow
+    calls = [lambda: phantom.inverse_dynamics(np.zeros(3), big, np.zeros(3)),
+             lambda: phantom.inverse_dynamics([0, 0, 0], big.tolist(), [0, 0, 0]),
+             lambda: phantom.inverse_dynamics(np.zeros((2, 3)), np.stack([big, big]), np.zeros((2, 3))),
+             lambda: phantom.forward_dynamics(np.zeros(3), big, np.zeros(3)),
+             lambda: phantom.inverse_dynamics_derivatives(np.zeros(3), big, np.zeros(3)),
+             lambda: cf.inverse_dynamics(np.zeros(3), big, np.zeros(3))]
+    for call in calls:
+        with pytest.raises(InvalidInputError, match="too large, the result overflows"):
+            call()
+
+
+def test_within_limits_is_the_yaml_box(phantom, tmp_path):
+    """Against the YAML's joint_limits read independently: bounds included, one bool for
+    one state, (N,) bools for a batch."""
+    import yaml
+    limits = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())
+    lower = np.array([limits[j]["lower"] for j in ("joint1", "joint2", "joint3")])
+    upper = np.array([limits[j]["upper"] for j in ("joint1", "joint2", "joint3")])
+    assert phantom.within_limits(lower) is True and phantom.within_limits(upper) is True
+    batch = np.array([lower, upper, (lower + upper) / 2, lower - [0, 0, 1e-12], upper + [0, 1e-12, 0],
+                      [0.0, 0.17, np.pi / 2]])
+    np.testing.assert_array_equal(phantom.within_limits(batch), [True, True, True, False, False, False])
+    assert phantom.within_limits(batch.reshape(2, 3, 3)).shape == (2, 3)
+
+
+def test_inverse_kinematics_agrees_with_the_closed_form_everywhere_on_the_shell(phantom):
+    """Seeded targets on the inner (|l1 - l2|) and outer (l1 + l2) shell boundaries and
+    inside, all round the shoulder (behind it too), both branches: Phantom's Newton and
+    the closed form give the same angles, compared modulo 2 pi. Inside to 1e-9 rad; on a
+    boundary the map is folded and both sides are good only to about sqrt(eps) (measured
+    2.4e-6 rad), so 1e-5 rad there, with the tips within 1e-12 m."""
+    p = phantom.parameters
+    shoulder = np.array([0.0, p.l2, -p.l1])
+    rng = np.random.default_rng(11)
+    direction = np.vstack([rng.normal(size=(60, 3)), np.eye(3), -np.eye(3)])
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    for radius, tolerance in ((abs(p.l1 - p.l2), 1e-5), (p.l1 + p.l2, 1e-5), (0.25, 1e-9)):
+        target = shoulder + radius * direction
+        for branch in ("report", "other"):
+            ours, reference = phantom.inverse_kinematics(target, branch), cf.inverse_kinematics(target, branch)
+            assert np.abs(np.angle(np.exp(1j * (ours - reference)))).max() < tolerance, (radius, branch)
+            np.testing.assert_allclose(cf.forward_kinematics(ours)[:, :3, 3], target, atol=1e-12)
+
+
+def test_inverse_kinematics_behind_the_shoulder_gives_plus_pi_like_the_closed_form(phantom):
+    """Straight behind axis 1 (x = 0, z < -l1), theta1 is pi in both (Newton's to 1e-12
+    rad), not -pi."""
+    target = cf.forward_kinematics([np.pi, 0.2, 0.3])[:3, 3]
+    target[0] = 0.0
+    for theta in (phantom.inverse_kinematics(target), cf.inverse_kinematics(target)):
+        assert abs(theta[0] - np.pi) < 1e-12
+        np.testing.assert_allclose(theta[1:], [0.2, 0.3], atol=1e-9)

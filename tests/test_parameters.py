@@ -3,9 +3,10 @@
 import dataclasses
 import shutil
 
+import numpy as np
 import pytest
 
-from phantom_pin import ParameterFileError, Phantom, load_parameters
+from phantom_pin import InvalidInputError, ParameterFileError, Phantom, load_parameters
 from phantom_pin.description import generate_urdf
 from phantom_pin.parameters import read_overrides, write_overridden
 from phantom_pin.paths import CONFIG_DIR
@@ -17,12 +18,66 @@ def config(tmp_path):
     return tmp_path / "config"
 
 
-def test_shipped_parameters_are_the_report_numbers():
+#: Section 3 of the report, typed from its text: equation number and printed value (SI).
+REPORT = {"l1": (29, 0.215), "l2": (30, 0.170), "l3": (31, 0.0325), "l5": (63, -36.8e-3), "l6": (73, 52.7e-3),
+          "ma": (38, 0.0202), "Iaxx": (40, 0.4864e-4), "Iayy": (41, 0.001843e-4), "Iazz": (42, 0.4864e-4),
+          "mc": (49, 0.0249), "Icxx": (51, 0.959e-4), "Icyy": (52, 0.959e-4), "Iczz": (53, 0.0051e-4),
+          "mbe": (58, 0.2359), "Ibexx": (60, 11.09e-4), "Ibeyy": (61, 10.06e-4), "Ibezz": (62, 0.591e-4),
+          "mdf": (68, 0.1906), "Idfxx": (70, 7.11e-4), "Idfyy": (71, 0.629e-4), "Idfzz": (72, 6.246e-4),
+          "Ibaseyy": (75, 11.87e-4)}
+
+
+@pytest.mark.parametrize("name", sorted(REPORT))
+def test_every_shipped_length_mass_and_inertia_is_the_report_number(name):
+    """Each to 1e-12 relative (the YAML may write 36.8 mm as -0.0368)."""
+    equation, printed = REPORT[name]
+    assert getattr(load_parameters(), name) == pytest.approx(printed, rel=1e-12), f"eq. {equation}"
+
+
+def test_shipped_gravity_and_ratios_are_the_report_numbers():
+    """g = 9.81 (appendix), ratios 13.3 (section 3.5.1) and 11.6 (footnotes of eqs 60, 70)."""
     p = load_parameters()
-    assert (p.l1, p.l2, p.l3, p.l5, p.l6) == (0.215, 0.170, 0.0325, -0.0368, 0.0527)
-    assert (p.ma, p.mc, p.mbe, p.mdf) == (0.0202, 0.0249, 0.2359, 0.1906)
-    assert (p.Ibexx, p.Idfxx, p.Ibaseyy) == (11.09e-4, 7.11e-4, 11.87e-4)
     assert p.ratios == (13.3, 11.6, 11.6) and p.g == 9.81
+
+
+def test_yaml_numbers_without_a_dot_are_numbers(config):
+    """PyYAML reads 11e-7 and 2.0e6 as strings (YAML 1.1); the parameter files read them as
+    numbers, and xacro sees the same numbers (the rotor inertia reaches the armature)."""
+    actuation = config / "actuation.yaml"
+    text = actuation.read_text()
+    rotor = next(line for line in text.splitlines() if "rotor_inertia:" in line)
+    actuation.write_text(text.replace(rotor, "  rotor_inertia: 11e-7"))
+    assert load_parameters(config).rotor_inertia == 1.1e-6
+    ratios = load_parameters(config).ratios
+    np.testing.assert_allclose(Phantom(config).model.armature, [1.1e-6 * r**2 for r in ratios], rtol=1e-12)
+    overrides = config.parent / "params.yaml"
+    overrides.write_text("l1: 21e-2\nsegment_a.mass: +2E-2\n")
+    assert read_overrides(overrides) == {"l1": 0.21, "segment_a.mass": 0.02}
+
+
+def test_binary_and_malformed_files_raise_one_line_naming_the_file(config, tmp_path):
+    (config / "kinematics.yaml").write_bytes(bytes(range(128, 256)))
+    with pytest.raises(ParameterFileError, match="kinematics.yaml: not a text file") as error:
+        load_parameters(config)
+    assert "\n" not in str(error.value)
+    (config / "kinematics.yaml").write_text("l1: 0.215\nl2: [0.17\nl3: 0.0325\n")
+    with pytest.raises(ParameterFileError, match=r"kinematics.yaml: not valid YAML at line \d+") as error:
+        load_parameters(config)
+    assert "\n" not in str(error.value)
+
+
+def test_joint_limits_beyond_one_turn_are_refused(config):
+    limits = config / "joint_limits.yaml"
+    limits.write_text(limits.read_text().replace("joint1: {lower: -1.0, upper: 1.0}",
+                                                 "joint1: {lower: -1.0, upper: 1.0e308}"))
+    with pytest.raises(ParameterFileError, match="joint1.upper must be within one turn"):
+        load_parameters(config)
+
+
+@pytest.mark.parametrize("call", [Phantom, load_parameters, lambda c: generate_urdf(config_dir=c)])
+def test_config_dir_must_be_a_path(call):
+    with pytest.raises(InvalidInputError, match="config_dir: expected a path"):
+        call(123)
 
 
 @pytest.mark.parametrize("file, old, new, message", [

@@ -1,9 +1,14 @@
 """The exported HTML rendered by headless chromium (conftest.render), checked against a
 pinhole projection of Pinocchio's kinematics (conftest.project)."""
 
+import base64
+import json
+import re
+
 import numpy as np
 import pinocchio as pin
 import pytest
+import umsgpack
 
 from conftest import RAISED, RESTING, dark, frame_pose, patch, red, render
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
@@ -102,3 +107,20 @@ def test_wait_reports_a_server_that_died():
         viewer.server.process.kill()
         with pytest.raises(PhantomPinError, match="meshcat server stopped"):
             viewer.wait()
+
+
+def _transforms(html: str) -> list[np.ndarray]:
+    """Every set_transform matrix of an exported page's scene commands."""
+    commands = json.loads(re.search(r"for \(const command of (\[.*?\])\)", html, re.S).group(1))
+    messages = [umsgpack.unpackb(base64.b64decode(c)) for c in commands]
+    return [np.array(m["matrix"], dtype=float) for m in messages if m["type"] == "set_transform"]
+
+
+def test_tiny_force_draws_a_finite_arrow(viewer, tmp_path):
+    """1e-300 N: |f| underflows to 0 if taken directly, which drew a NaN arrow."""
+    viewer.set_force([1e-300, 0.0, 0.0])
+    viewer.show(RAISED)
+    html = viewer.export_html(tmp_path / "tiny.html").read_text()
+    viewer.set_force(np.zeros(3))
+    transforms = _transforms(html)
+    assert transforms and all(np.isfinite(t).all() for t in transforms)

@@ -1,0 +1,34 @@
+"""Documentation that states facts: the README's quick start and the YAML's comments."""
+
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import yaml
+
+from phantom_pin.paths import CONFIG_DIR, URDF_PATH
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_readme_quick_start_says_how_to_get_chromium_for_the_tests():
+    quick_start = (ROOT / "README.md").read_text().split("## Quick start")[1].split("\n## ")[0]
+    assert "sudo apt-get install chromium" in quick_start and ".ci/run" in quick_start
+
+
+def test_motor_offsets_are_from_the_shoulder_in_the_urdf_and_in_the_yaml_comments():
+    """The motor cylinders sit at the offsets from the link origins, which are the shoulder
+    (joint2/joint3 have zero origins in turret_link, itself at the shoulder); the YAML's
+    comments must say so."""
+    text = (CONFIG_DIR / "visual_parameters.yaml").read_text()
+    motor = yaml.safe_load(text)["motor"]
+    root = ET.parse(URDF_PATH).getroot()
+    joints = {j.find("child").get("link"): j for j in root.findall("joint")}
+    for link, key, axis in (("upper_arm_link", "motor_e_offset_z", 0), ("crank_link", "motor_d_offset_y", 2)):
+        assert joints[link].find("origin").get("xyz") == "0 0 0"
+        assert joints["turret_link"].find("origin").get("xyz") == "0 0 0"
+        origins = [[float(v) for v in visual.find("origin").get("xyz").split()]
+                   for visual in root.find(f"link[@name='{link}']").iter("visual")]
+        assert [motor[key] if a == axis else 0.0 for a in range(3)] in origins
+        comment = re.search(rf"{key}:[^#]*#(.*)", text).group(1)
+        assert "from the shoulder" in comment and "centre of mass" not in comment, comment

@@ -1,0 +1,94 @@
+"""physical.check_urdf against the physical laws it states, and the one place it guards:
+generate_urdf (so `phantom-pin urdf` and Phantom(config_dir)) and load()."""
+
+from pathlib import Path
+
+import pytest
+
+from phantom_pin import ParameterFileError, Phantom
+from phantom_pin.cli import main
+from phantom_pin.loader import PhantomLoader, load
+from phantom_pin.parameters import write_overridden
+from phantom_pin.paths import SRDF_PATH, URDF_PATH
+from phantom_pin.physical import check_urdf
+
+#: Overrides that write a non-physical link (the issue's list), and the link they break.
+NON_PHYSICAL = [
+    ("segment_a.inertia.xx=1e-3", "forearm_link: principal moments"),          # triangle
+    ("segment_be.inertia.xx=1e9", "upper_arm_link: principal moments"),        # triangle
+    ("segment_be.com=-0.2", "upper_arm_link: inertia at the centre of mass is not positive"),
+    ("actuation.motor.rotor_inertia=1e-4", "turret_link: inertia at the centre of mass is not positive"),
+    ("segment_g.mass=-1", "turret_link: mass must be a positive"),
+    ("segment_g.mass=0", "turret_link: mass must be a positive"),
+    ("segment_g.inertia_xx=-1", "turret_link: inertia at the centre of mass is not positive"),
+    ("tip_ball.diameter=-1", "forearm_link: visual sphere radius must be positive"),
+]
+
+
+def _link(mass: str, ixx: float, iyy: float, izz: float, ixy: float = 0.0) -> str:
+    return (f'<robot name="r"><link name="frame_only"/><link name="l"><inertial><mass value="{mass}"/>'
+            f'<inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="0" iyy="{iyy!r}" iyz="0" izz="{izz!r}"/>'
+            f'</inertial></link></robot>')
+
+
+@pytest.mark.parametrize("override, message", NON_PHYSICAL)
+def test_urdf_command_refuses_non_physical_links_and_writes_nothing(tmp_path, capsys, override, message):
+    target = tmp_path / "phantom.urdf"
+    code = main(["urdf", "-o", str(target), "--set", override])
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and err.count("\n") == 1 and not target.exists()
+
+
+@pytest.mark.parametrize("override, message", NON_PHYSICAL[:5])
+def test_phantom_refuses_a_non_physical_configuration(tmp_path, override, message):
+    key, value = override.split("=")
+    config = write_overridden({key: float(value)}, tmp_path)   # the YAML itself is well-formed
+    with pytest.raises(ParameterFileError, match=message):
+        Phantom(config)
+
+
+def test_load_refuses_a_non_physical_urdf(tmp_path):
+    urdf = tmp_path / "phantom.urdf"
+    urdf.write_text(URDF_PATH.read_text().replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>'))
+    loader = type("Negative", (PhantomLoader,), {"urdf_path": urdf, "srdf_path": SRDF_PATH})
+    with pytest.raises(ParameterFileError, match="urdf_path: .*forearm_link: mass must be a positive"):
+        load(loader)
+
+
+def test_shipped_urdf_and_pure_frames_pass():
+    check_urdf(URDF_PATH.read_text())
+    check_urdf('<robot name="r"><link name="a"/></robot>')
+
+
+def test_triangle_inequality_at_its_stated_tolerance():
+    """A thin rod (c = a + b, the law's limit) passes; c larger by 1e-6 relative fails;
+    rotating the tensor (off-diagonal terms) does not change the verdict."""
+    check_urdf(_link("1", 0.5, 0.5, 1.0))
+    with pytest.raises(ParameterFileError, match="link l: .*triangle"):
+        check_urdf(_link("1", 0.5, 0.5, 1.0 + 1e-6))
+    # principal moments (1, 2) in the x-y plane rotated by 45 degrees about z, with izz:
+    # (1, 2, 2.9) is valid, (1, 2, 3.1) is not, though the diagonal (1.5, 1.5, 3.1) looks valid
+    check_urdf(_link("1", 1.5, 1.5, 2.9, ixy=0.5))
+    with pytest.raises(ParameterFileError, match="triangle"):
+        check_urdf(_link("1", 1.5, 1.5, 3.1, ixy=0.5))
+    with pytest.raises(ParameterFileError, match="not positive definite"):
+        check_urdf(_link("1", 1.0, 1.0, 1.0, ixy=1.5))   # moments -0.5, 1, 2.5
+
+
+@pytest.mark.parametrize("mass", ["0", "-1", "nan", "abc"])
+def test_mass_must_be_a_positive_number(mass):
+    with pytest.raises(ParameterFileError, match="link l: mass must be a positive"):
+        check_urdf(_link(mass, 1.0, 1.0, 1.0))
+
+
+@pytest.mark.parametrize("geometry", ['<box size="0.1 0 0.1"/>', '<cylinder radius="0.1" length="-1"/>',
+                                      '<sphere radius="inf"/>', '<box size="0.1 0.1"/>'])
+def test_sizes_must_be_positive(geometry):
+    urdf = f'<robot name="r"><link name="g"><collision><geometry>{geometry}</geometry></collision></link></robot>'
+    with pytest.raises(ParameterFileError, match="link g: collision .* must be positive"):
+        check_urdf(urdf)
+
+
+def test_malformed_xml_is_a_parameter_file_error():
+    with pytest.raises(ParameterFileError, match="mine.urdf: not well-formed XML"):
+        check_urdf("<robot", str(Path("mine.urdf")))
