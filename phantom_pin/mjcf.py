@@ -271,7 +271,10 @@ def _scene(scene: dict, turret: ET.Element, robot_file: str, name: str) -> str:
     ET.SubElement(asset, "material", {"name": "table", "rgba": "0.55 0.45 0.35 1"})
     world = ET.SubElement(mujoco, "worldbody")
     ET.SubElement(world, "light", {"pos": "0 0 1.5", "dir": "0 0 -1", "directional": "true"})
+    # the device's fixed base, visual only: its real shape is unknown, and the stops let the
+    # arms hang down past the axis where a column would stand
     ET.SubElement(world, "geom", {"name": "stand", "type": "cylinder", "material": "table",
+                                  "contype": "0", "conaffinity": "0",
                                   "size": _vec([float(scene["stand_radius"]), (plate - top) / 2]),
                                   "pos": _vec([0, 0, (plate + top) / 2])})
     floor = top - float(scene["floor_below_table"])

@@ -38,7 +38,9 @@ class Parameters:
     about their COM, BE and DF about the shoulder, Ibaseyy about axis 1. As in the
     report, Ibexx, Idfxx and Ibaseyy include the motors' reflected rotor inertia
     ``rotor_inertia * ratio**2``. g is gravity (m/s^2), pointing along the report's -y.
-    ``lower`` and ``upper`` are the joint position limits (rad) of theta1..theta3.
+    ``lower`` and ``upper`` are the joint position limits (rad) of theta1..theta3: the
+    URDF's box. ``coupled`` = (max of theta2 - theta3, max of theta3 - theta2) (rad): the
+    parallelogram's stops, which the box cannot express (joint_limits.yaml ``stops``).
     """
 
     l1: float
@@ -68,6 +70,7 @@ class Parameters:
     ratios: tuple[float, float, float]
     lower: tuple[float, float, float]
     upper: tuple[float, float, float]
+    coupled: tuple[float, float]
 
     @property
     def armature(self) -> tuple[float, float, float]:
@@ -185,17 +188,25 @@ def load_parameters(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str
                      for j in joints),
         lower=lower,
         upper=upper,
+        coupled=(_number(lim, lim_path, "stops", "theta2_minus_theta3_max"),
+                 _number(lim, lim_path, "stops", "theta3_minus_theta2_max")),
     )
 
 
 def random_states(params: Parameters, n: int,
                   seed: int | np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``n`` seeded states (theta, dtheta, ddtheta), each (n, 3): theta uniform inside the
-    joint limits (rad), rates and accelerations normal with standard deviations 2 rad/s
-    and 20 rad/s^2. ``seed`` may be a Generator, to draw a long sequence in chunks."""
+    joint limits (rad): the box and the coupled stops (``params.coupled``); rates and
+    accelerations normal with standard deviations 2 rad/s and 20 rad/s^2. ``seed`` may be
+    a Generator, to draw a long sequence in chunks."""
     rng = np.random.default_rng(seed)
-    theta = rng.uniform(params.lower, params.upper, (n, 3))
-    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+    forward, backward = params.coupled
+    theta = np.empty((0, 3))
+    while len(theta) < n:  # rejection: about half of the box is inside the coupled stops
+        draw = rng.uniform(params.lower, params.upper, (2 * n + 16, 3))
+        keep = (draw[:, 1] - draw[:, 2] <= forward) & (draw[:, 2] - draw[:, 1] <= backward)
+        theta = np.concatenate([theta, draw[keep]])
+    return theta[:n], rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
 
 
 def read_overrides(path: Path | str) -> dict[str, float]:

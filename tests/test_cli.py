@@ -217,7 +217,7 @@ def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, capsys, argv
 
 
 @pytest.mark.parametrize("file, old, new, message", [
-    ("joint_limits.yaml", "joint2: {lower: -0.3, upper: 1.0}", "joint2: {lower: -1e308, upper: 1e308}",
+    ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369, upper: 2.076941809873252}", "joint2: {lower: -1e308, upper: 1e308}",
      "joint2.lower must be within one turn"),
     ("actuation.yaml", "motor:", "motor: [", "not valid YAML at line"),
     ("physical_parameters.yaml", "segment_a:", "segment_a: {", "not valid YAML at line"),
@@ -249,10 +249,11 @@ def test_negative_numbers_in_scientific_notation_are_values(capsys):
 
 
 @pytest.mark.parametrize("argv, warned", [
-    (["fk", "0", "0", "3"], "theta [0 0 3] rad is outside the joint limits"),
-    (["dynamics", "--theta", "1.5", "0", "0"], "theta [1.5 0 0] rad is outside the joint limits"),
-    (["ik", "0", "0.17", "0.17"], "the solution theta"),   # theta3 = pi/2 > 1.1
-    (["fk", "1", "1", "1.1"], None),                        # on the limits: inside
+    (["fk", "0", "0", "3.5"], "theta [0 0 3.5] rad is outside the joint limits"),
+    (["dynamics", "--theta", "1.6", "0", "0"], "theta [1.6 0 0] rad is outside the joint limits"),
+    # 0.3 m straight below the shoulder (0, l2, -l1): theta3 = -44.6 deg < -29 deg
+    (["ik", "0", "-0.13", "-0.215"], "the solution theta"),
+    (["fk", "1.5707963267948966", "2.076941809873252", "3.036872898470133"], None),  # on the limits: inside
     (["ik", "0", "0.12", "0.05"], None),
 ])
 def test_out_of_limit_angles_are_computed_with_one_warning_line(capsys, argv, warned):

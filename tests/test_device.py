@@ -220,3 +220,20 @@ def test_device_reads_its_config_folder(tmp_path, phantom):
     (config / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
     device = Device(phantom, config)
     np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB * np.tanh(10), 0, 0], rtol=1e-14)
+
+
+def test_reachable_is_forward_kinematics_inside_the_stops(device):
+    """Every tip of a posture inside the stops is reachable (eq. 10 against the inverse
+    kinematics of Device.reachable); beyond l1 + l2, and straight behind the shoulder where
+    only theta2 > 119 deg would reach, nothing is."""
+    rng = np.random.default_rng(21)
+    p = device.phantom.parameters
+    theta = rng.uniform(device.parameters.stop_lower, device.parameters.stop_upper, (6000, 3))
+    theta = theta[device.within_limits(theta)]
+    assert len(theta) > 1000
+    assert device.reachable(closed_form.forward_kinematics(theta)[:, :3, 3]).all()
+    shoulder = np.array([0.0, p.l2, -p.l1])  # frame s (eqs 4-5)
+    assert not device.reachable(shoulder + [0.0, 0.0, p.l1 + p.l2 + 1e-3])
+    assert device.reachable(shoulder + [0.0, 0.0, 0.3])        # 0.3 m in front, at shoulder height
+    assert not device.reachable(shoulder + [0.0, 0.0, -0.3])   # 0.3 m behind: needs theta2 >= 146 deg
+    assert device.reachable(shoulder + [[0.0, 0.0, 0.3], [0.0, 0.0, -0.3]]).tolist() == [True, False]

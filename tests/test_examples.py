@@ -63,21 +63,24 @@ def example(name: str):
 
 def test_workspace_prints_the_closed_form_extent_of_the_grid(tmp_path):
     """Bounding box and shoulder distances of the tips of a 15^3 grid over the YAML's joint
-    limits, recomputed here with the closed form (eq. 10), equal the printed ones to their
-    4 decimals; the example's own Phantom vs closed form difference is below 1e-12 m."""
-    result = run("workspace.py", tmp_path, "--samples", "15")
+    limits, kept inside the coupled stops (typed here from mahilab: theta2 - theta3 <= 65 deg,
+    theta3 - theta2 <= 55 deg), recomputed here with the closed form (eq. 10), equal the
+    printed ones to their 4 decimals; the example's own Phantom vs closed form difference is
+    below 1e-12 m."""
+    result = run("workspace.py", tmp_path, "--samples", "15", "--placements", "3")
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "workspace.png")
     p = cf.shipped_parameters()
     grid = np.stack(np.meshgrid(*(np.linspace(lo, hi, 15) for lo, hi in zip(p.lower, p.upper)),
                                 indexing="ij"), axis=-1).reshape(-1, 3)
+    grid = grid[(grid[:, 1] - grid[:, 2] <= np.radians(65)) & (grid[:, 2] - grid[:, 1] <= np.radians(55))]
     tip = cf.forward_kinematics(grid)[:, :3, 3]
     radius = np.linalg.norm(tip - [0.0, p.l2, -p.l1], axis=1)
     printed = [float(v) for v in re.findall(r"[-+]?\d+\.\d{4}", result.stdout.split("bounding box")[1])[:8]]
     expected = [tip[:, 0].min(), tip[:, 0].max(), tip[:, 1].min(), tip[:, 1].max(),
                 tip[:, 2].min(), tip[:, 2].max(), radius.min(), radius.max()]
     np.testing.assert_allclose(printed, expected, atol=5.1e-5)
-    assert "3375 postures" in result.stdout
+    assert f"{len(grid)} of 3375 grid postures inside the stops" in result.stdout
     assert number(r"max difference (\S+) m", result.stdout) < 1e-12
 
 

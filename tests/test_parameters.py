@@ -68,7 +68,7 @@ def test_binary_and_malformed_files_raise_one_line_naming_the_file(config, tmp_p
 
 def test_joint_limits_beyond_one_turn_are_refused(config):
     limits = config / "joint_limits.yaml"
-    limits.write_text(limits.read_text().replace("joint1: {lower: -1.0, upper: 1.0}",
+    limits.write_text(limits.read_text().replace("joint1: {lower: -1.5707963267948966, upper: 1.5707963267948966}",
                                                  "joint1: {lower: -1.0, upper: 1.0e308}"))
     with pytest.raises(ParameterFileError, match="joint1.upper must be within one turn"):
         load_parameters(config)
@@ -84,7 +84,7 @@ def test_config_dir_must_be_a_path(call):
     ("kinematics.yaml", "l1: 0.215", "l1: -0.215", "l1 must be positive"),
     ("kinematics.yaml", "l2: 0.170", "l2: abc", "l2 must be a finite number"),
     ("physical_parameters.yaml", "  mass: 0.0202", "  mass_typo: 0.0202", "missing key segment_a.mass"),
-    ("joint_limits.yaml", "joint2: {lower: -0.3", "joint2: {lower: 3.0", "joint2.lower must be below"),
+    ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369", "joint2: {lower: 3.0", "joint2.lower must be below"),
     ("actuation.yaml", "motor:", "motor: [", "not valid YAML"),
 ])
 def test_malformed_files_are_named(config, file, old, new, message):

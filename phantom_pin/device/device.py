@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from phantom_pin import closed_form
 from phantom_pin.device.parameters import DeviceParameters, load_device_parameters
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.model import Phantom
@@ -65,6 +66,33 @@ class Device:
         c = q @ STOP_COORDINATES.T
         inside = np.all((c >= self._stop_lower) & (c <= self._stop_upper), axis=-1)
         return inside if batch else bool(inside)
+
+    def reachable(self, position: object) -> bool | np.ndarray:
+        """True where the tip can reach ``position`` (m, the report's frame s) with every joint
+        inside the real stops: a bool for one position (3,), an (N,) bool array for (N, 3).
+
+        Candidates are the report's inverse kinematics (eqs 11-20, closed_form, with this
+        device's Phantom parameters) on both elbow branches, and the same with axis 1 turned
+        by pi and the arm reaching back over it ((theta1 + pi, pi - theta2, -theta3) puts the
+        tip at the same point), each also shifted by 2 pi in theta2 and theta3.
+        """
+        target, batch = as_states(position, "position")
+        target = target.reshape(-1, 3)
+        p = self.phantom.parameters
+        shoulder = np.array([0.0, p.l2, -p.l1])  # in frame s (eqs 4-5)
+        distance = np.linalg.norm(target - shoulder, axis=-1)
+        shell = (distance > abs(p.l1 - p.l2)) & (distance < p.l1 + p.l2)
+        found = np.zeros(len(target), dtype=bool)
+        if shell.any():
+            wraps = 2 * np.pi * np.array([[0, k2, k3] for k2 in (-1, 0, 1) for k3 in (-1, 0, 1)])
+            for branch in ("report", "other"):
+                front = closed_form.inverse_kinematics(target[shell], branch, p)
+                back = np.stack([front[:, 0] - np.sign(front[:, 0]) * np.pi,
+                                 np.pi - front[:, 1], -front[:, 2]], axis=-1)
+                for theta in (front, back):
+                    candidates = theta[:, None, :] + wraps           # (n, 9, 3)
+                    found[shell] |= self.within_limits(candidates.reshape(-1, 3)).reshape(-1, 9).any(axis=1)
+        return found if batch else bool(found[0])
 
     def _penetration(self, theta: np.ndarray) -> np.ndarray:
         """Signed depth (rad) of each stop coordinate beyond its stop: (..., 4)."""
