@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> None:
     radius = np.linalg.norm(tip - np.array([0.0, p.l2, -p.l1]), axis=1)
     difference = np.abs(tip - closed_form.forward_kinematics(theta, p)[:, :3, 3]).max()
     share, centre = best_placement(device, tip, args.placements)
-    low, high = centre - ADVERTISED / 2, centre + ADVERTISED / 2
+    low = centre - ADVERTISED / 2
     figure, (side, top) = plt.subplots(1, 2, figsize=(11, 5), constrained_layout=True)
     side.scatter(tip[:, 2], tip[:, 1], s=1, c=theta[:, 1], cmap="viridis")
     side.add_patch(plt.Rectangle((low[2], low[1]), ADVERTISED[2], ADVERTISED[1], fill=False, color="red"))

@@ -8,7 +8,6 @@ import json
 import os
 import re
 import sys
-import tempfile
 import webbrowser
 from pathlib import Path
 
@@ -16,14 +15,12 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin import appendix, closed_form
-from phantom_pin.description import generate_srdf, generate_urdf
+from phantom_pin.description import Description, describe, shipped
 from phantom_pin.device import cli as device_cli
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.loader import PhantomLoader, load
-from phantom_pin.mjcf import generate_mjcf
+from phantom_pin.loader import load
 from phantom_pin.model import Phantom
-from phantom_pin.parameters import (CONFIG_DIR, PARAMETER_FILES, random_states, read_overrides,
-                                    write_overridden)
+from phantom_pin.parameters import CONFIG_DIR, PARAMETER_FILES, random_states, read_overrides
 from phantom_pin.validation import output_path, within_box
 
 #: States evaluated at a time by check: memory stays bounded (tens of MB) whatever -n is.
@@ -91,7 +88,7 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
     lines += [f"{lk['name']:15} {lk['mass']:8.4f}  {_vector(lk['com'], '{:7.4f}'):26}"
               f"{_vector(lk['inertia'], '{:.3e}')}" for lk in links]
     lines += ["", f"rotor inertia {p.rotor_inertia:.3e} kg m2 (each motor)"]
-    data["device"], device_lines = device_cli.info(phantom, args.config)  # stops, friction, motor, encoder
+    data["device"], device_lines = device_cli.info(phantom)  # stops, friction, motor, encoder
     lines += ["", *device_lines]
     _print(args, data, "\n".join(lines))
     return 0
@@ -172,41 +169,30 @@ def _parse_set(items: list[str]) -> dict[str, float]:
     return out
 
 
-def _urdf(args: argparse.Namespace, phantom: Phantom | None) -> int:
+def _write(args: argparse.Namespace) -> int:
+    """urdf, srdf, mjcf: the files of describe(--config, --prefix, --params and --set)."""
     output = output_path(args.output, args.force, "--output", "--force")
+    scene = output_path(args.scene, args.force, "--scene", "--force") if getattr(args, "scene", None) else None
     try:
         overrides = read_overrides(args.params) if args.params else {}
     except PhantomPinError as error:
         raise PhantomPinError(f"--params: {error}") from None
     overrides.update(_parse_set(args.set))
-    scene = output_path(args.scene, args.force, "--scene", "--force") if getattr(args, "scene", None) else None
-    with tempfile.TemporaryDirectory() as folder:
-        config = write_overridden(overrides, folder, args.config) if overrides else args.config
-        if args.kind == "mjcf":
-            text, scene_text = generate_mjcf(args.prefix, config, robot_file=output.name)
-        else:
-            text = (generate_urdf if args.kind == "urdf" else generate_srdf)(args.prefix, config)
-    output.write_text(text)
+    description = describe(args.config, prefix=args.prefix, overrides=overrides, robot_file=output.name)
+    output.write_text({"urdf": description.urdf, "srdf": description.srdf, "mjcf": description.mjcf}[args.kind])
     print(f"wrote {output}")
     if scene is not None:
-        scene.write_text(scene_text)
+        scene.write_text(description.scene)
         print(f"wrote {scene}")
     return 0
 
 
-def _show(args: argparse.Namespace, phantom: Phantom | None) -> int:
+def _show(args: argparse.Namespace, description: Description) -> int:
     from phantom_pin.viewer import Viewer  # meshcat is only needed here
 
     if args.html:
         output_path(args.html, args.force, "--html", "--force")
-    with tempfile.TemporaryDirectory() as folder:
-        loader = PhantomLoader
-        if Path(args.config).resolve() != CONFIG_DIR.resolve():
-            urdf, srdf = Path(folder) / "phantom_1_5.urdf", Path(folder) / "phantom_1_5.srdf"
-            urdf.write_text(generate_urdf("", args.config))
-            srdf.write_text(generate_srdf("", args.config))
-            loader = type("ConfigLoader", (PhantomLoader,), {"urdf_path": urdf, "srdf_path": srdf})
-        robot = load(loader)
+    robot = load(description)
     if args.theta is not None:
         _warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
     with Viewer(robot) as viewer:
@@ -276,12 +262,16 @@ def main(argv: list[str] | None = None) -> int:
     an unwritable file (one line on stderr), 130 interrupted by Ctrl-C (128 + SIGINT, one
     line), 141 output pipe closed by its reader (128 + SIGPIPE, silent, as ``yes | head``)."""
     handlers = {"info": _info, "check": _check, "fk": _fk, "ik": _ik, "dynamics": _dynamics,
-                "urdf": _urdf, "srdf": _urdf, "mjcf": _urdf, "show": _show,
                 "simulate": device_cli.simulate_command}
     try:
         args = _parser().parse_args(argv)
-        phantom = None if args.command in ("urdf", "srdf", "mjcf", "show") else Phantom(args.config)
-        code = handlers[args.command](args, phantom)
+        if args.command in ("urdf", "srdf", "mjcf"):
+            code = _write(args)
+        else:  # one Description of --config for every other command
+            shipped_config = Path(args.config).resolve() == CONFIG_DIR.resolve()
+            description = shipped() if shipped_config else describe(args.config)
+            code = (_show(args, description) if args.command == "show"
+                    else handlers[args.command](args, Phantom(description)))
         sys.stdout.flush()  # a closed pipe raises here, not at exit
         return code
     except BrokenPipeError:

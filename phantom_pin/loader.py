@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import tempfile
 from pathlib import Path
 
 import pinocchio as pin
 
+from phantom_pin.description import Description
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.paths import DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
 from phantom_pin.physical import check_urdf
@@ -35,7 +37,16 @@ def _first_line(error: Exception) -> str:
     return lines[0] if lines else type(error).__name__
 
 
-def load(loader: type[PhantomLoader] = PhantomLoader) -> pin.RobotWrapper:
+def load_rotor_parameters(model: pin.Model, srdf_xml: str) -> None:
+    """Set ``model.armature`` from an SRDF text's rotor_params (rotor inertia x ratio^2,
+    kg m^2), as pinocchio.loadRotorParameters, which reads only files."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "rotors.srdf"
+        path.write_text(srdf_xml, encoding="utf-8")
+        pin.loadRotorParameters(model, str(path), False)
+
+
+def load(source: type[PhantomLoader] | Description = PhantomLoader) -> pin.RobotWrapper:
     """The PHANToM 1.5 as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
     joint1..3 = the report's theta1..3 in rad), with ``visual_model``,
     ``collision_model`` (every pair but the SRDF's disabled ones), the SRDF postures in
@@ -43,34 +54,52 @@ def load(loader: type[PhantomLoader] = PhantomLoader) -> pin.RobotWrapper:
     ``model.armature`` = the reflected rotor inertias (kg m^2). World = ``base_link``
     (REP-103: x forward, z up, origin at the shoulder).
 
+    ``source`` is a PhantomLoader (sub)class, whose files are read, or a Description
+    (phantom_pin.describe), whose texts are used with PhantomLoader's other attributes.
     The URDF must pass physical.check_urdf. Raises ParameterFileError naming
     ``urdf_path`` or ``srdf_path`` for a missing, malformed or non-physical file.
     """
-    for name in ("urdf_path", "srdf_path"):
-        if not Path(getattr(loader, name)).is_file():
-            raise ParameterFileError(f"{name}: {getattr(loader, name)} is not a file")
-    urdf, srdf = str(loader.urdf_path), str(loader.srdf_path)
+    if isinstance(source, Description):
+        loader, urdf, srdf = PhantomLoader, source.urdf, source.srdf  # checked by describe()
+        urdf_name, srdf_name = "source: the description's URDF", "source: the description's SRDF"
+    elif isinstance(source, type) and issubclass(source, PhantomLoader):
+        loader = source
+        texts = []
+        for name in ("urdf_path", "srdf_path"):
+            path = Path(getattr(loader, name))
+            if not path.is_file():
+                raise ParameterFileError(f"{name}: {path} is not a file")
+            try:
+                texts.append(path.read_text(encoding="utf-8"))
+            except UnicodeDecodeError as error:
+                raise ParameterFileError(f"{name}: {path} is not a text file") from error
+        urdf, srdf = texts
+        urdf_name, srdf_name = f"urdf_path: {loader.urdf_path}", f"srdf_path: {loader.srdf_path}"
+        check_urdf(urdf, urdf_name)
+    else:
+        raise InvalidInputError(f"source: expected a PhantomLoader class or a Description, got {source!r}")
+    package_dirs = [str(p) for p in loader.package_dirs]
     try:
-        check_urdf(Path(urdf).read_text(encoding="utf-8"), f"urdf_path: {urdf}")
-    except UnicodeDecodeError as error:
-        raise ParameterFileError(f"urdf_path: {urdf} is not a text file") from error
-    try:
-        robot = pin.RobotWrapper.BuildFromURDF(urdf, [str(p) for p in loader.package_dirs], mimic=True)
+        model = pin.buildModelFromXML(urdf, mimic=True)
+        geometry = [pin.buildGeomFromUrdfString(model, urdf, kind, package_dirs=package_dirs)
+                    for kind in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL)]
     except (RuntimeError, ValueError, AttributeError) as error:  # Pinocchio's, several lines
-        raise ParameterFileError(f"urdf_path: Pinocchio cannot load {urdf} ({_first_line(error)})") from error
+        label, what = urdf_name.split(": ", 1)
+        raise ParameterFileError(f"{label}: Pinocchio cannot load {what} ({_first_line(error)})") from error
+    robot = pin.RobotWrapper(model, *geometry)
     try:
-        pin.loadReferenceConfigurations(robot.model, srdf, False)
+        pin.loadReferenceConfigurationsFromXML(robot.model, srdf, False)
         if loader.has_rotor_parameters:
-            pin.loadRotorParameters(robot.model, srdf, False)
+            load_rotor_parameters(robot.model, srdf)
         robot.collision_model.addAllCollisionPairs()
-        pin.removeCollisionPairs(robot.model, robot.collision_model, srdf, False)
+        pin.removeCollisionPairsFromXML(robot.model, robot.collision_model, srdf, False)
     except (RuntimeError, ValueError, AttributeError) as error:
-        raise ParameterFileError(f"srdf_path: Pinocchio cannot read {srdf} ({_first_line(error)})") from error
+        label, what = srdf_name.split(": ", 1)
+        raise ParameterFileError(f"{label}: Pinocchio cannot read {what} ({_first_line(error)})") from error
     postures = [entry.key() for entry in robot.model.referenceConfigurations]
     if loader.ref_posture not in postures:
         raise InvalidInputError(
-            f"ref_posture: {loader.ref_posture!r} is not a posture of {Path(loader.srdf_path).name} "
-            f"(it has {sorted(postures)})")
+            f"ref_posture: {loader.ref_posture!r} is not a posture of the SRDF (it has {sorted(postures)})")
     robot.q0 = robot.model.referenceConfigurations[loader.ref_posture].copy()
     robot.rebuildData()
     return robot

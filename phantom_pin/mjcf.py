@@ -22,15 +22,12 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import numpy as np
-import yaml
 
 from phantom_pin.coupling import read_mimic_tags
-from phantom_pin.description import generate_srdf, generate_urdf
-from phantom_pin.parameters import parameter_paths
-from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.exceptions import ParameterFileError
+from phantom_pin.parameters import Config
 
 #: Names of the generated files in robots/phantom_description/mjcf.
 ROBOT_FILE, SCENE_FILE = "phantom_1_5.xml", "scene.xml"
@@ -102,25 +99,49 @@ def _inertial(body: ET.Element, link: ET.Element) -> None:
     element.set("fullinertia", _vec([i["ixx"], i["iyy"], i["izz"], i["ixy"], i["ixz"], i["iyz"]]))
 
 
-def _read_yaml(path: Path) -> dict:
-    with open(path, encoding="utf-8") as stream:
-        return yaml.safe_load(stream)
+def _vector(config: Config, arg: str, *keys: str, length: int) -> list[float]:
+    """The list of ``length`` finite numbers at ``keys`` of the file ``arg``;
+    ParameterFileError naming the file and the key otherwise."""
+    node: object = config.data[arg]
+    for key in keys:
+        node = node.get(key) if isinstance(node, dict) else None
+    finite = isinstance(node, list) and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in node)
+    if not finite or len(node) != length:
+        raise ParameterFileError(f"{config.paths[arg]}: {'.'.join(keys)} must be a list of "
+                                 f"{length} finite numbers, got {node!r}")
+    return [float(v) for v in node]
 
 
-def generate_mjcf(prefix: str = "", config_dir: Path | str = CONFIG_DIR,
-                  robot_file: str = ROBOT_FILE, **files: Path | str) -> tuple[str, str]:
-    """The MJCF texts (robot, scene) for ``prefix`` and the parameter files.
+def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str = "",
+               robot_file: str = ROBOT_FILE) -> tuple[str, str]:
+    """The MJCF texts (robot, scene) of a URDF and SRDF generated from ``config`` with
+    ``prefix`` (phantom_pin.description.describe does all three in one place).
 
-    ``files`` override single parameter files by xacro argument name, as in
-    parameters.parameter_paths. The URDF and SRDF are generated first (so that their
-    checks apply); the robot MJCF's names equal the URDF's. The scene includes the robot
-    as ``robot_file`` and adds a floor, a light and a table under the device's base plate.
+    The robot MJCF's names equal the URDF's. The scene includes the robot as
+    ``robot_file`` and adds a floor, a light, a table and a stand under the turret.
+    Raises ParameterFileError naming config/mjcf.yaml's key for a bad setting.
     """
-    urdf_xml = generate_urdf(prefix, config_dir, **files)
-    srdf_xml = generate_srdf(prefix, config_dir, **files)
-    paths = parameter_paths(config_dir, **files)
-    settings = _read_yaml(paths["mjcf_file"])
-    actuation = _read_yaml(paths["actuation_file"])
+    settings = {
+        "timestep": config.number("mjcf_file", "timestep", positive=True),
+        "equality_solref_timesteps": config.number("mjcf_file", "equality_solref_timesteps", positive=True),
+        "equality_solref_damping_ratio": config.number("mjcf_file", "equality_solref_damping_ratio",
+                                                       positive=True),
+        "equality_solimp": _vector(config, "mjcf_file", "equality_solimp", length=3),
+    }
+    integrator = config.data["mjcf_file"].get("integrator")
+    if integrator not in ("Euler", "RK4", "implicit", "implicitfast"):
+        raise ParameterFileError(f"{config.paths['mjcf_file']}: integrator must be Euler, RK4, "
+                                 f"implicit or implicitfast, got {integrator!r}")
+    scene = {key: config.number("mjcf_file", "scene", key, positive=True)
+             for key in ("shoulder_height", "stand_radius", "floor_below_table")}
+    scene["table_offset_x"] = config.number("mjcf_file", "scene", "table_offset_x")
+    scene["table_size"] = _vector(config, "mjcf_file", "scene", "table_size", length=3)
+    actuation = {"rotor_inertia": config.number("actuation_file", "motor", "rotor_inertia", positive=True),
+                 "max_continuous_torque": config.number("actuation_file", "motor", "max_continuous_torque",
+                                                        positive=True)}
+    stops = (config.number("joint_limits_file", "stops", "theta3_minus_theta2_max"),
+             config.number("joint_limits_file", "stops", "theta2_minus_theta3_max"))
     urdf = ET.fromstring(urdf_xml)
     srdf = ET.fromstring(srdf_xml)
     mimics = read_mimic_tags(urdf_xml)
@@ -136,7 +157,7 @@ def generate_mjcf(prefix: str = "", config_dir: Path | str = CONFIG_DIR,
     timestep = float(settings["timestep"])
     mujoco = ET.Element("mujoco", {"model": urdf.get("name")})
     ET.SubElement(mujoco, "compiler", {"angle": "radian", "autolimits": "true"})
-    ET.SubElement(mujoco, "option", {"timestep": _num(timestep), "integrator": settings["integrator"]})
+    ET.SubElement(mujoco, "option", {"timestep": _num(timestep), "integrator": integrator})
 
     default = ET.SubElement(ET.SubElement(mujoco, "default"), "default", {"class": "phantom"})
     ET.SubElement(default, "joint", {"axis": "0 -1 0"})
@@ -189,10 +210,8 @@ def generate_mjcf(prefix: str = "", config_dir: Path | str = CONFIG_DIR,
 
     # the parallelogram's coupled stops, which a URDF cannot express, as a fixed tendon
     # theta2 - theta3 limited to [-(theta3 - theta2)_max, (theta2 - theta3)_max]
-    stops = _read_yaml(paths["joint_limits_file"])["stops"]
     tendon = ET.SubElement(ET.SubElement(mujoco, "tendon"), "fixed", {
-        "name": f"{prefix}parallelogram",
-        "range": _vec([-stops["theta3_minus_theta2_max"], stops["theta2_minus_theta3_max"]])})
+        "name": f"{prefix}parallelogram", "range": _vec([-stops[0], stops[1]])})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint2", "coef": "1"})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint3", "coef": "-1"})
 
@@ -206,7 +225,7 @@ def generate_mjcf(prefix: str = "", config_dir: Path | str = CONFIG_DIR,
             "solref": solref, "solimp": _vec(settings["equality_solimp"])})
 
     actuator = ET.SubElement(mujoco, "actuator")
-    torque = actuation["motor"]["max_continuous_torque"]
+    torque = actuation["max_continuous_torque"]
     for name, transmission in transmissions.items():
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
         ET.SubElement(actuator, "motor", {"name": transmission.find("actuator").get("name"),
@@ -220,8 +239,7 @@ def generate_mjcf(prefix: str = "", config_dir: Path | str = CONFIG_DIR,
         ET.SubElement(sensor, "jointvel", {"name": f"{name}_vel", "joint": name})
     ET.SubElement(sensor, "framepos", {"name": f"{prefix}tip_pos", "objtype": "site",
                                        "objname": f"{prefix}tip"})
-    return _text(mujoco), _scene(settings["scene"], links[f"{prefix}turret_link"], robot_file,
-                                 urdf.get("name"))
+    return _text(mujoco), _scene(scene, links[f"{prefix}turret_link"], robot_file, urdf.get("name"))
 
 
 def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
@@ -241,7 +259,7 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
     transmission = transmissions.get(joint.get("name"))
     if transmission is not None:
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
-        attributes["armature"] = _num(actuation["motor"]["rotor_inertia"] * ratio**2)
+        attributes["armature"] = _num(actuation["rotor_inertia"] * ratio**2)
     dynamics = joint.find("dynamics")
     if dynamics is not None:  # MuJoCo's frictionloss is dry friction without smoothing
         attributes["damping"] = _num(float(dynamics.get("damping", 0)))

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from pathlib import Path
 from typing import Callable
 
@@ -12,11 +11,11 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.coupling import Coupling
-from phantom_pin.description import generate_srdf, generate_urdf
+from phantom_pin.description import Description, describe, shipped
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
-from phantom_pin.parameters import Parameters, load_parameters
-from phantom_pin.paths import CONFIG_DIR, SRDF_PATH, URDF_PATH
-from phantom_pin.physical import check_urdf
+from phantom_pin.loader import load_rotor_parameters
+from phantom_pin.parameters import Parameters
+from phantom_pin.paths import CONFIG_DIR
 from phantom_pin.validation import as_states, finite_result, same_batch, within_box, wrap_angle
 
 #: Newton iterations and position tolerance (m) of inverse_kinematics.
@@ -40,7 +39,8 @@ class Phantom:
     ``Phantom()`` loads the shipped URDF and SRDF. ``Phantom(config_dir=...)``, or
     any of the xacro file arguments of ``parameters.PARAMETER_FILES`` (for example
     ``Phantom(physical_parameters_file="mine.yaml")``), generates them through xacro
-    from modified parameter files.
+    from modified parameter files; ``Phantom(description)`` takes a Description
+    (phantom_pin.describe), the one result of reading a configuration.
 
     Joint vectors are the report's theta1..theta3 (rad), which are the URDF's
     joint1..joint3; rates in rad/s, accelerations in rad/s^2, torques in N m. Poses
@@ -48,28 +48,24 @@ class Phantom:
     z forward); the tool frame t is ``tip``. Every method takes one state, shape (3,),
     or a batch, shape (N, 3), and returns fresh arrays.
 
-    Attributes: ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's rotor
+    Attributes: ``description`` (the Description it was built from), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's rotor
     inertias times ratio^2), ``data``, ``coupling`` (the mimic-free tree model and the
     coupling matrix read from the URDF's mimic tags), ``parameters`` (the report's
     numbers), ``threads`` (OpenMP threads of batched inverse dynamics).
     """
 
-    def __init__(self, config_dir: Path | str | None = None, **files: Path | str) -> None:
-        if config_dir is None and not files:
-            self.parameters: Parameters = load_parameters()
-            urdf_xml, srdf_xml = URDF_PATH.read_text(), SRDF_PATH.read_text()
-            check_urdf(urdf_xml, str(URDF_PATH))
+    def __init__(self, config_dir: Description | Path | str | None = None, **files: Path | str) -> None:
+        if isinstance(config_dir, Description):
+            description = config_dir
+        elif config_dir is None and not files:
+            description = shipped()
         else:
-            config_dir = CONFIG_DIR if config_dir is None else config_dir
-            self.parameters = load_parameters(config_dir, **files)
-            urdf_xml = generate_urdf("", config_dir, **files)
-            srdf_xml = generate_srdf("", config_dir, **files)
-        self.coupling = Coupling(urdf_xml)
+            description = describe(CONFIG_DIR if config_dir is None else config_dir, **files)
+        self.description = description
+        self.parameters: Parameters = description.parameters
+        self.coupling = Coupling(description.urdf)
         self.model: pin.Model = self.coupling.reduced
-        with tempfile.TemporaryDirectory() as folder:  # loadRotorParameters reads a file
-            srdf_path = Path(folder) / "phantom_1_5.srdf"
-            srdf_path.write_text(srdf_xml)
-            pin.loadRotorParameters(self.model, str(srdf_path), False)
+        load_rotor_parameters(self.model, description.srdf)
         self.data = self.model.createData()
         self._tree_data = self.coupling.tree.createData()
         self._frame_s = self.model.getFrameId("report_s")

@@ -143,53 +143,136 @@ def parameter_paths(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str
     return paths
 
 
-def load_parameters(config_dir: Path | str = CONFIG_DIR, **overrides: Path | str) -> Parameters:
+@dataclasses.dataclass(frozen=True)
+class Config:
+    """The parameter files of one configuration, each read once: ``paths`` and ``data`` (the
+    YAML mappings, with any overrides applied) by xacro argument name (PARAMETER_FILES).
+    ``overridden`` tells whether overrides were applied. Treat ``data`` as read-only."""
+
+    paths: dict[str, Path]
+    data: dict[str, dict]
+    overridden: bool = False
+
+    def number(self, arg: str, *keys: str, positive: bool = False) -> float:
+        """The number at ``keys`` in the file ``arg``; ParameterFileError naming both."""
+        try:
+            return _number(self.data[arg], self.paths[arg], *keys, positive=positive)
+        except ParameterFileError as error:
+            if self.overridden:
+                raise ParameterFileError(f"after the overrides, {error}") from None
+            raise
+
+
+def read_config(config_dir: Path | str = CONFIG_DIR, overrides: dict[str, object] | None = None,
+                **files: Path | str) -> Config:
+    """Read the parameter files (``config_dir``'s, or ``files`` by xacro argument name as in
+    parameter_paths) once each, and apply ``overrides``.
+
+    Override keys are dotted paths into the files ("l1", "segment_a.mass", "joint2.upper"),
+    optionally qualified by the file's stem ("actuation.motor.rotor_inertia"); an
+    unqualified key must exist in exactly one file. Each must name a number, and each
+    value must be a finite number in the units of that file (SI, radians).
+    Raises ParameterFileError naming the file, or the key.
+    """
+    paths = parameter_paths(config_dir, **files)
+    data = {arg: _read(path) for arg, path in paths.items()}
+    stems = {Path(name).stem: arg for arg, name in PARAMETER_FILES.items()}
+    for key, value in (overrides or {}).items():
+        parts = str(key).split(".")
+        if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
+            holders, parts = [stems[parts[0]]], parts[1:]
+        else:
+            holders = [arg for arg, document in data.items() if parts[0] in document]
+        if not holders:
+            raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
+        if len(holders) > 1:
+            names = [PARAMETER_FILES[arg] for arg in holders]
+            raise ParameterFileError(f"{key}: {' and '.join(names)} both have {parts[0]!r}; "
+                                     f"qualify it, e.g. {Path(names[0]).stem}.{key}")
+        name = PARAMETER_FILES[holders[0]]
+        if parts[0] not in data[holders[0]]:
+            raise ParameterFileError(f"{key}: {name} has no key {parts[0]!r}")
+        node: object = data[holders[0]]
+        for part in parts[:-1]:
+            node = node.get(part) if isinstance(node, dict) else None
+        current = node.get(parts[-1]) if isinstance(node, dict) else None
+        if not _is_number(current):
+            raise ParameterFileError(f"{key}: not a number in {name}, cannot override it")
+        if not _is_number(value) or not math.isfinite(value):
+            raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
+        node[parts[-1]] = float(value)
+    return Config(paths, data, bool(overrides))
+
+
+def write_config(config: Config, destination: Path | str) -> Path:
+    """Write the parameter files of ``config`` into the folder ``destination`` under their
+    usual names and return it. The copies hold plain YAML numbers that any YAML 1.1 reader
+    (xacro's) reads as numbers, whatever form the originals use; comments are not copied."""
+    destination = Path(destination)
+    for arg, name in PARAMETER_FILES.items():
+        with open(destination / name, "w", encoding="utf-8") as stream:
+            yaml.safe_dump(config.data[arg], stream, sort_keys=False)
+    return destination
+
+
+def load_parameters(config_dir: Path | str = CONFIG_DIR, **files: Path | str) -> Parameters:
     """Read and check the parameter files; raise ParameterFileError naming file and key."""
-    paths = parameter_paths(config_dir, **overrides)
-    kin_path, phys_path = paths["kinematics_file"], paths["physical_parameters_file"]
-    act_path, lim_path = paths["actuation_file"], paths["joint_limits_file"]
-    kin, phys, act, lim = (_read(p) for p in (kin_path, phys_path, act_path, lim_path))
+    return parameters_from(read_config(config_dir, **files))
+
+
+def parameters_from(config: Config) -> Parameters:
+    """The report's numbers of ``config``, checked; ParameterFileError naming file and key."""
+    lim_path = config.paths["joint_limits_file"]
+
+    def kin(*keys: str, positive: bool = True) -> float:
+        return config.number("kinematics_file", *keys, positive=positive)
+
+    def phys(*keys: str, positive: bool = True) -> float:
+        return config.number("physical_parameters_file", *keys, positive=positive)
+
+    def act(*keys: str) -> float:
+        return config.number("actuation_file", *keys, positive=True)
+
+    def lim(*keys: str) -> float:
+        return config.number("joint_limits_file", *keys)
 
     def inertia(segment: str, axis: str) -> float:
-        return _number(phys, phys_path, segment, "inertia", axis, positive=True)
+        return phys(segment, "inertia", axis)
 
     joints = ("joint1", "joint2", "joint3")
-    lower = tuple(_number(lim, lim_path, j, "lower") for j in joints)
-    upper = tuple(_number(lim, lim_path, j, "upper") for j in joints)
+    lower = tuple(lim(j, "lower") for j in joints)
+    upper = tuple(lim(j, "upper") for j in joints)
+    prefix = "after the overrides, " if config.overridden else ""
     for joint, lo, hi in zip(joints, lower, upper):
         for side, value in (("lower", lo), ("upper", hi)):
             if abs(value) > JOINT_LIMIT_BOUND:
-                raise ParameterFileError(f"{lim_path}: {joint}.{side} must be within one turn "
+                raise ParameterFileError(f"{prefix}{lim_path}: {joint}.{side} must be within one turn "
                                          f"(|limit| <= 2 pi rad), got {value!r}")
         if lo >= hi:
-            raise ParameterFileError(f"{lim_path}: {joint}.lower must be below {joint}.upper")
+            raise ParameterFileError(f"{prefix}{lim_path}: {joint}.lower must be below {joint}.upper")
     return Parameters(
-        l1=_number(kin, kin_path, "l1", positive=True),
-        l2=_number(kin, kin_path, "l2", positive=True),
-        l3=_number(kin, kin_path, "l3", positive=True),
-        l5=_number(phys, phys_path, "segment_be", "com"),
-        l6=_number(phys, phys_path, "segment_df", "com"),
-        g=_number(phys, phys_path, "gravity", positive=True),
-        ma=_number(phys, phys_path, "segment_a", "mass", positive=True),
+        l1=kin("l1"), l2=kin("l2"), l3=kin("l3"),
+        l5=phys("segment_be", "com", positive=False),
+        l6=phys("segment_df", "com", positive=False),
+        g=phys("gravity"),
+        ma=phys("segment_a", "mass"),
         Iaxx=inertia("segment_a", "xx"), Iayy=inertia("segment_a", "yy"),
         Iazz=inertia("segment_a", "zz"),
-        mc=_number(phys, phys_path, "segment_c", "mass", positive=True),
+        mc=phys("segment_c", "mass"),
         Icxx=inertia("segment_c", "xx"), Icyy=inertia("segment_c", "yy"),
         Iczz=inertia("segment_c", "zz"),
-        mbe=_number(phys, phys_path, "segment_be", "mass", positive=True),
+        mbe=phys("segment_be", "mass"),
         Ibexx=inertia("segment_be", "xx"), Ibeyy=inertia("segment_be", "yy"),
         Ibezz=inertia("segment_be", "zz"),
-        mdf=_number(phys, phys_path, "segment_df", "mass", positive=True),
+        mdf=phys("segment_df", "mass"),
         Idfxx=inertia("segment_df", "xx"), Idfyy=inertia("segment_df", "yy"),
         Idfzz=inertia("segment_df", "zz"),
-        Ibaseyy=_number(phys, phys_path, "segment_g", "inertia_yy", positive=True),
-        rotor_inertia=_number(act, act_path, "motor", "rotor_inertia", positive=True),
-        ratios=tuple(_number(act, act_path, "transmission_ratio", j, positive=True)
-                     for j in joints),
+        Ibaseyy=phys("segment_g", "inertia_yy"),
+        rotor_inertia=act("motor", "rotor_inertia"),
+        ratios=tuple(act("transmission_ratio", j) for j in joints),
         lower=lower,
         upper=upper,
-        coupled=(_number(lim, lim_path, "stops", "theta2_minus_theta3_max"),
-                 _number(lim, lim_path, "stops", "theta3_minus_theta2_max")),
+        coupled=(lim("stops", "theta2_minus_theta3_max"), lim("stops", "theta3_minus_theta2_max")),
     )
 
 
@@ -232,49 +315,10 @@ def read_overrides(path: Path | str) -> dict[str, float]:
 
 def write_overridden(overrides: dict[str, object], destination: Path | str,
                      config_dir: Path | str = CONFIG_DIR, **files: Path | str) -> Path:
-    """Copy the five parameter files (``config_dir``'s, or ``files`` by xacro arg name as
-    in parameter_paths) into the folder ``destination`` with ``overrides`` applied, check
-    them with load_parameters, and return the folder. The copies hold plain YAML numbers
-    that any YAML 1.1 reader (xacro's) reads as numbers, whatever form the originals use.
-
-    Keys are dotted paths into the files ("l1", "segment_a.mass", "joint2.upper"),
-    optionally qualified by the file's stem ("actuation.motor.rotor_inertia"); an
-    unqualified key must exist in exactly one file. Each must name a number, and each
-    value must be a finite number in the units of that file (SI, radians). Comments
-    are not copied.
-    Raises ParameterFileError naming the key.
-    """
-    destination = Path(destination)
-    paths = parameter_paths(config_dir, **files)
-    documents = {name: _read(paths[arg]) for arg, name in PARAMETER_FILES.items()}
-    stems = {Path(name).stem: name for name in documents}
-    for key, value in overrides.items():
-        parts = str(key).split(".")
-        if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
-            holders, parts = [stems[parts[0]]], parts[1:]
-        else:
-            holders = [name for name, data in documents.items() if parts[0] in data]
-        if not holders:
-            raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
-        if len(holders) > 1:
-            raise ParameterFileError(f"{key}: {' and '.join(holders)} both have {parts[0]!r}; "
-                                     f"qualify it, e.g. {Path(holders[0]).stem}.{key}")
-        if parts[0] not in documents[holders[0]]:
-            raise ParameterFileError(f"{key}: {holders[0]} has no key {parts[0]!r}")
-        node: object = documents[holders[0]]
-        for part in parts[:-1]:
-            node = node.get(part) if isinstance(node, dict) else None
-        current = node.get(parts[-1]) if isinstance(node, dict) else None
-        if not _is_number(current):
-            raise ParameterFileError(f"{key}: not a number in {holders[0]}, cannot override it")
-        if not _is_number(value) or not math.isfinite(value):
-            raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
-        node[parts[-1]] = float(value)
-    for name, data in documents.items():
-        with open(destination / name, "w", encoding="utf-8") as stream:
-            yaml.safe_dump(data, stream, sort_keys=False)
-    try:
-        load_parameters(destination)
-    except ParameterFileError as error:  # name the file, not the temporary folder
-        raise ParameterFileError(f"after the overrides, {str(error).replace(f'{destination}{os.sep}', '')}") from None
-    return destination
+    """Write the parameter files of ``config_dir`` (or ``files``) with ``overrides`` applied
+    into the folder ``destination`` (read_config, parameters_from, write_config) and return it.
+    Raises ParameterFileError naming the key or, after the overrides, the file and key;
+    nothing is written then."""
+    config = read_config(config_dir, overrides, **files)
+    parameters_from(config)
+    return write_config(config, destination)

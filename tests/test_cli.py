@@ -109,12 +109,16 @@ def test_urdf_overrides_reach_kinematics_dynamics_and_mimic_tags(tmp_path, capsy
 
 
 def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, capsys):
+    """The SRDF carries the rotor inertia; the whole configuration is checked, so 2e-6 kg m^2
+    (which leaves upper_arm_link's inertia non-physical) writes no SRDF either."""
     target = tmp_path / "phantom.srdf"
-    assert run(capsys, "srdf", "-o", str(target), "--set", "actuation.motor.rotor_inertia=2e-6")[0] == 0
+    assert run(capsys, "srdf", "-o", str(target), "--set", "actuation.motor.rotor_inertia=1.1e-6")[0] == 0
     model = pin.buildModelFromUrdf(str(URDF_PATH), mimic=True)
     pin.loadRotorParameters(model, str(target), False)
-    np.testing.assert_allclose(model.armature, [2e-6 * r**2 for r in cf.shipped_parameters().ratios],
+    np.testing.assert_allclose(model.armature, [1.1e-6 * r**2 for r in cf.shipped_parameters().ratios],
                                rtol=1e-12)
+    code, _, err = run(capsys, "srdf", "-o", str(tmp_path / "bad.srdf"), "--set", "actuation.motor.rotor_inertia=2e-6")
+    assert code == 2 and "upper_arm_link" in err and not (tmp_path / "bad.srdf").exists()
 
 
 @pytest.mark.parametrize("argv, message", [

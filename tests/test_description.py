@@ -11,9 +11,9 @@ import yourdfpy
 from phantom_pin import appendix
 from conftest import relative_error
 from phantom_pin import closed_form
-from phantom_pin.description import generate_srdf, generate_urdf
-from phantom_pin.mjcf import generate_mjcf
-from phantom_pin.paths import DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
+from phantom_pin import parameters
+from phantom_pin.description import describe, generate_srdf, generate_urdf, shipped
+from phantom_pin.paths import CONFIG_DIR, DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
 
 ACTUATED = ["joint1", "joint2", "joint3"]
 # (joint, primary, multiplier) of the parallelogram, as designed in urdf/phantom_1_5_macro.xacro
@@ -38,9 +38,34 @@ def mimic_model():
 def test_committed_files_match_a_fresh_xacro_run():
     assert URDF_PATH.read_text() == generate_urdf(), "run the regeneration in robots/phantom_description/README.md"
     assert SRDF_PATH.read_text() == generate_srdf()
-    robot, scene = generate_mjcf()
-    assert (DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml").read_text() == robot
-    assert (DESCRIPTION_DIR / "mjcf" / "scene.xml").read_text() == scene
+    fresh = describe()
+    assert (DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml").read_text() == fresh.mjcf
+    assert (DESCRIPTION_DIR / "mjcf" / "scene.xml").read_text() == fresh.scene
+    assert (shipped().urdf, shipped().srdf, shipped().mjcf) == (fresh.urdf, fresh.srdf, fresh.mjcf)
+
+
+def test_a_configuration_is_read_once_into_every_model(tmp_path, monkeypatch):
+    """describe() reads each parameter file once and gives the URDF, SRDF and MJCF; Phantom,
+    load() and Device take that one result without reading or generating again."""
+    import shutil
+
+    from phantom_pin import Device, Phantom, load
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    reads = []
+    original = parameters._read
+    monkeypatch.setattr(parameters, "_read", lambda path: reads.append(path.name) or original(path))
+    description = describe(config, overrides={"l1": 0.2096})
+    assert sorted(reads) == sorted(parameters.PARAMETER_FILES.values())
+    phantom = Phantom(description)
+    robot = load(description)
+    device = Device(phantom)
+    assert len(reads) == len(parameters.PARAMETER_FILES)  # nothing read again
+    assert phantom.description is description and device.phantom.parameters.l1 == 0.2096
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, np.zeros(3))
+    assert data.oMf[robot.model.getFrameId("elbow")].translation[0] == pytest.approx(0.2096, abs=1e-15)
+    assert 'name="elbow" class="frame" pos="0.2096 0 0"' in description.mjcf
 
 
 def test_prefix_reaches_every_name():

@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from phantom_pin import Device, InvalidInputError, ParameterFileError, closed_form
+from phantom_pin import Device, InvalidInputError, ParameterFileError, Phantom, closed_form
 from phantom_pin.device import load_device_parameters
 from phantom_pin.paths import CONFIG_DIR
 
@@ -214,12 +214,17 @@ def test_malformed_device_numbers_are_named(tmp_path, file, old, new, message):
 
 
 def test_device_reads_its_config_folder(tmp_path, phantom):
+    """Device(config_dir=DIR) and Device(Phantom(DIR)) take the device numbers of DIR, the
+    folder the rigid body comes from; a phantom and a folder together are refused."""
     config = tmp_path / "config"
     shutil.copytree(CONFIG_DIR, config)
     text = (config / "actuation.yaml").read_text()
     (config / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
-    device = Device(phantom, config)
-    np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB * np.tanh(10), 0, 0], rtol=1e-14)
+    for device in (Device(config_dir=config), Device(Phantom(config))):
+        np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB * np.tanh(10), 0, 0],
+                                   rtol=1e-14)
+    with pytest.raises(InvalidInputError, match="config_dir: give a phantom or a config_dir"):
+        Device(phantom, config)
 
 
 def test_reachable_is_forward_kinematics_inside_the_stops(device):

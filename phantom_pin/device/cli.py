@@ -50,7 +50,7 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     output = Path(args.output) if args.output else None
     if output is not None and output.exists() and not args.force:
         raise PhantomPinError(f"--output: {output} exists; add --force to overwrite it")
-    device = Device(phantom, args.config)
+    device = Device(phantom)
     controller = None
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
@@ -91,9 +91,9 @@ def _csv(result: SimulationResult) -> str:
     return "\n".join([",".join(header), *rows]) + "\n"
 
 
-def info(phantom: Phantom, config_dir: Path) -> tuple[dict, list[str]]:
+def info(phantom: Phantom) -> tuple[dict, list[str]]:
     """The device data of ``phantom-pin info``, as (JSON data, text lines), with sources."""
-    device = Device(phantom, config_dir)
+    device = Device(phantom)
     p = device.parameters
     numbers = dataclasses.asdict(p)
     sections = {

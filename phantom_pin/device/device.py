@@ -9,10 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import closed_form
-from phantom_pin.device.parameters import DeviceParameters, load_device_parameters
+from phantom_pin.device.parameters import DeviceParameters, device_parameters_from
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.model import Phantom
-from phantom_pin.paths import CONFIG_DIR
 from phantom_pin.validation import as_states, same_batch
 
 #: Rows: the stop coordinates as linear maps of theta: theta1, theta2, theta3, theta2 - theta3.
@@ -22,12 +21,11 @@ STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 
 class Device:
     """The PHANToM Premium 1.5 as a device: a Phantom plus its stops, friction, motors, encoders.
 
-    ``Device()`` wraps ``Phantom()`` and reads the device numbers (actuation.yaml and
-    joint_limits.yaml ``stops``) from the shipped config folder. ``Device(config_dir=DIR)``
-    reads both the rigid body and the device numbers from DIR. ``Device(phantom, DIR)``
-    wraps an existing Phantom and reads the device numbers from DIR (default: the shipped
-    folder): pass the folder the Phantom was built from. The transmission ratios are
-    the Phantom's (``phantom.parameters.ratios``), so the currents agree with its armature.
+    ``Device()`` wraps ``Phantom()``; ``Device(phantom)`` wraps a Phantom you built;
+    ``Device(config_dir=DIR)`` wraps ``Phantom(DIR)``. The device numbers (actuation.yaml
+    and joint_limits.yaml ``stops``) come from the same configuration as the Phantom
+    (``phantom.description.config``), so the transmission ratios, and hence the currents
+    and the armature, agree.
 
     Joint vectors are the report's theta1..theta3 (rad), rates rad/s, torques N m at the
     joint, currents A in the motor windings; tip positions and forces are in the report's
@@ -42,13 +40,15 @@ class Device:
     """
 
     def __init__(self, phantom: Phantom | None = None, config_dir: Path | str | None = None) -> None:
+        if phantom is not None and config_dir is not None:
+            raise InvalidInputError("config_dir: give a phantom or a config_dir, not both "
+                                    "(a Phantom carries its configuration)")
         if phantom is None:
             phantom = Phantom() if config_dir is None else Phantom(config_dir)
         if not isinstance(phantom, Phantom):
             raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom or None, got {phantom!r}")
         self.phantom = phantom
-        self.parameters: DeviceParameters = load_device_parameters(
-            CONFIG_DIR if config_dir is None else config_dir)
+        self.parameters: DeviceParameters = device_parameters_from(phantom.description.config)
         p = self.parameters
         #: joint angle = motor angle / ratio (the Phantom's actuation.yaml)
         self.ratios = np.array(phantom.parameters.ratios, dtype=float)

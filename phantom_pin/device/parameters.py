@@ -7,7 +7,7 @@ import dataclasses
 from pathlib import Path
 
 from phantom_pin.exceptions import ParameterFileError
-from phantom_pin.parameters import _number, _read, parameter_paths
+from phantom_pin.parameters import Config, read_config
 from phantom_pin.paths import CONFIG_DIR
 
 _JOINTS = ("joint1", "joint2", "joint3")
@@ -52,62 +52,65 @@ class DeviceParameters:
     sources: dict[str, str]
 
 
-def _non_negative(data: dict, path: Path, *keys: str) -> float:
-    value = _number(data, path, *keys)
-    if value < 0:
-        raise ParameterFileError(f"{path}: {'.'.join(keys)} must not be negative, got {value!r}")
-    return value
-
-
-def _sources(data: dict, path: Path, sections: tuple[str, ...]) -> dict[str, str]:
-    node = data.get("sources")
+def _sources(config: Config, arg: str) -> dict[str, str]:
+    path, node = config.paths[arg], config.data[arg].get("sources")
     if not isinstance(node, dict):
         raise ParameterFileError(f"{path}: missing key sources (a mapping: section -> source)")
-    for section in sections:
+    for section in _SOURCES[arg]:
         if not isinstance(node.get(section), str) or not node[section].strip():
             raise ParameterFileError(f"{path}: sources.{section} must be a non-empty text")
-    return {section: node[section] for section in sections}
+    return {section: node[section] for section in _SOURCES[arg]}
 
 
 def load_device_parameters(config_dir: Path | str = CONFIG_DIR) -> DeviceParameters:
-    """Read actuation.yaml and joint_limits.yaml of ``config_dir``; raise ParameterFileError
-    naming the file and the key of a missing or non-physical number."""
-    paths = parameter_paths(config_dir)
-    act_path, lim_path = paths["actuation_file"], paths["joint_limits_file"]
-    act, lim = _read(act_path), _read(lim_path)
+    """Read actuation.yaml and joint_limits.yaml of ``config_dir`` (device_parameters_from)."""
+    return device_parameters_from(read_config(config_dir))
 
-    def motor(key: str) -> float:
-        return _number(act, act_path, "motor", key, positive=True)
 
-    lower = tuple(_number(lim, lim_path, "stops", j, "lower") for j in _JOINTS)
-    upper = tuple(_number(lim, lim_path, "stops", j, "upper") for j in _JOINTS)
+def device_parameters_from(config: Config) -> DeviceParameters:
+    """The device numbers of ``config`` (actuation.yaml and joint_limits.yaml ``stops``);
+    ParameterFileError naming the file and the key of a missing or non-physical number."""
+    lim_path = config.paths["joint_limits_file"]
+
+    def act(*keys: str, positive: bool = True) -> float:
+        return config.number("actuation_file", *keys, positive=positive)
+
+    def lim(*keys: str, positive: bool = False) -> float:
+        return config.number("joint_limits_file", *keys, positive=positive)
+
+    def non_negative(arg: str, *keys: str) -> float:
+        value = config.number(arg, *keys)
+        if value < 0:
+            raise ParameterFileError(f"{config.paths[arg]}: {'.'.join(keys)} must not be negative, got {value!r}")
+        return value
+
+    lower = tuple(lim("stops", j, "lower") for j in _JOINTS)
+    upper = tuple(lim("stops", j, "upper") for j in _JOINTS)
     for joint, lo, hi in zip(_JOINTS, lower, upper):
         if lo >= hi:
             raise ParameterFileError(f"{lim_path}: stops.{joint}.lower must be below stops.{joint}.upper")
-    forward = _number(lim, lim_path, "stops", "theta2_minus_theta3_max")
-    backward = _number(lim, lim_path, "stops", "theta3_minus_theta2_max")
+    forward, backward = lim("stops", "theta2_minus_theta3_max"), lim("stops", "theta3_minus_theta2_max")
     if forward + backward <= 0:
         raise ParameterFileError(f"{lim_path}: stops.theta2_minus_theta3_max + "
                                  f"stops.theta3_minus_theta2_max must be positive (an open interval)")
     return DeviceParameters(
-        max_continuous_torque=motor("max_continuous_torque"),
-        max_continuous_current=motor("max_continuous_current"),
-        stall_torque=motor("stall_torque"),
-        stall_current=motor("stall_current"),
-        torque_constant=motor("torque_constant"),
-        terminal_resistance=motor("terminal_resistance"),
-        max_speed=motor("max_speed"),
-        cycles_per_revolution=_number(act, act_path, "encoder", "cycles_per_revolution", positive=True),
-        counts_per_cycle=_number(act, act_path, "encoder", "counts_per_cycle", positive=True),
-        viscous=_non_negative(act, act_path, "friction", "viscous"),
-        coulomb=_non_negative(act, act_path, "friction", "coulomb"),
-        smoothing_speed=_number(act, act_path, "friction", "smoothing_speed", positive=True),
+        max_continuous_torque=act("motor", "max_continuous_torque"),
+        max_continuous_current=act("motor", "max_continuous_current"),
+        stall_torque=act("motor", "stall_torque"),
+        stall_current=act("motor", "stall_current"),
+        torque_constant=act("motor", "torque_constant"),
+        terminal_resistance=act("motor", "terminal_resistance"),
+        max_speed=act("motor", "max_speed"),
+        cycles_per_revolution=act("encoder", "cycles_per_revolution"),
+        counts_per_cycle=act("encoder", "counts_per_cycle"),
+        viscous=non_negative("actuation_file", "friction", "viscous"),
+        coulomb=non_negative("actuation_file", "friction", "coulomb"),
+        smoothing_speed=act("friction", "smoothing_speed"),
         stop_lower=lower,
         stop_upper=upper,
         theta2_minus_theta3_max=forward,
         theta3_minus_theta2_max=backward,
-        stop_stiffness=_number(lim, lim_path, "stops", "stiffness", positive=True),
-        stop_damping=_non_negative(lim, lim_path, "stops", "damping"),
-        sources={**_sources(act, act_path, _SOURCES["actuation_file"]),
-                 **_sources(lim, lim_path, _SOURCES["joint_limits_file"])},
+        stop_stiffness=lim("stops", "stiffness", positive=True),
+        stop_damping=non_negative("joint_limits_file", "stops", "damping"),
+        sources={**_sources(config, "actuation_file"), **_sources(config, "joint_limits_file")},
     )

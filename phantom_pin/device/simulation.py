@@ -11,7 +11,7 @@ from typing import Callable
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin.device.device import STOP_COORDINATES, Device
+from phantom_pin.device.device import Device
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.validation import as_state
 
