@@ -1,4 +1,4 @@
-"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, show."""
+"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, mjcf, show, excite, identify."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ import pinocchio as pin
 from phantom_pin import appendix, closed_form
 from phantom_pin.description import generate_srdf, generate_urdf
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.identification import commands as identification
 from phantom_pin.loader import PhantomLoader, load
 from phantom_pin.mjcf import generate_mjcf
 from phantom_pin.model import Phantom
@@ -220,6 +221,7 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--html", help="write a self-contained HTML file instead of serving")
     show.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     show.add_argument("--open", action="store_true", help="open the live viewer in a browser")
+    identification.add_parsers(sub)
     for command in (info, check, fk, ik, dyn):
         command.add_argument("--json", action="store_true", help="print JSON")
     return parser
@@ -228,12 +230,14 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code (0 ok, 1 check failed, 2 bad input)."""
     handlers = {"info": _info, "check": _check, "fk": _fk, "ik": _ik, "dynamics": _dynamics,
-                "urdf": _urdf, "srdf": _urdf, "mjcf": _urdf, "show": _show}
+                "urdf": _urdf, "srdf": _urdf, "mjcf": _urdf, "show": _show,
+                "excite": identification.excite, "identify": identification.identify}
     try:
         args = _parser().parse_args(argv)
         if args.command == "check" and args.n < 1:
             raise PhantomPinError("-n: expected a positive number of states")
-        phantom = None if args.command in ("urdf", "srdf", "mjcf", "show") else Phantom(args.config)
+        phantom = (None if args.command in ("urdf", "srdf", "mjcf", "show", "excite", "identify")
+                   else Phantom(args.config))
         return handlers[args.command](args, phantom)
     except (PhantomPinError, ValueError) as error:
         print(f"phantom-pin: error: {error}", file=sys.stderr)

@@ -1,0 +1,102 @@
+"""Physical consistency: every link's mass positive, inertia at the COM positive definite and
+satisfying the triangle inequality; and the nearest consistent report parameters to an estimate.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import scipy.optimize
+
+from phantom_pin.identification import parameterization
+
+#: Smallest accepted link mass (kg), principal moment and triangle-inequality slack (kg m^2).
+MIN_MASS, MIN_MOMENT, MIN_SLACK = 1e-6, 1e-10, 0.0
+#: Smallest accepted rotor inertia (kg m^2).
+MIN_ROTOR = 1e-9
+
+
+def body_margins(pi_inertial: np.ndarray) -> np.ndarray:
+    """(n_bodies, 3): mass (kg), smallest principal moment at the COM, and the triangle
+    slack lambda1 + lambda2 - lambda3 (kg m^2, principal moments ascending) of each body,
+    from standard parameters [m, h, I_origin] (Pinocchio's order)."""
+    out = []
+    for m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz in np.asarray(pi_inertial).reshape(-1, 10):
+        h = np.array([hx, hy, hz])
+        origin = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+        com = origin - (h @ h * np.eye(3) - np.outer(h, h)) / m if m > 0 else origin
+        moments = np.linalg.eigvalsh(com)
+        out.append([m, moments[0], moments[0] + moments[1] - moments[2]])
+    return np.array(out)
+
+
+def urdf_problems(urdf_xml: str) -> list[str]:
+    """Every violation of the conditions in a URDF's <inertial> elements, as sentences."""
+    problems = []
+    for link in ET.fromstring(urdf_xml).findall("link"):
+        inertial = link.find("inertial")
+        if inertial is None:
+            continue
+        name = link.get("name")
+        mass = float(inertial.find("mass").get("value"))
+        e = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
+        tensor = np.array([[e["ixx"], e["ixy"], e["ixz"]], [e["ixy"], e["iyy"], e["iyz"]],
+                           [e["ixz"], e["iyz"], e["izz"]]])
+        moments = np.linalg.eigvalsh(tensor)
+        if not mass > 0:
+            problems.append(f"{name}: mass {mass} kg is not positive")
+        if not moments[0] > 0:
+            problems.append(f"{name}: inertia is not positive definite (moments {moments})")
+        elif moments[0] + moments[1] < moments[2] * (1 - 1e-12):
+            problems.append(f"{name}: principal moments {moments} violate the triangle inequality")
+    return problems
+
+
+def _constraints(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    pi = affine @ x + offset
+    margins = body_margins(pi[:-3])
+    return np.concatenate([margins[:, 0] - MIN_MASS, (margins[:, 1] - MIN_MOMENT) * 1e4,
+                           (margins[:, 2] - MIN_SLACK) * 1e4, [(x[parameterization.ROTOR] - MIN_ROTOR) * 1e6]])
+
+
+def consistent(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> bool:
+    return bool(_constraints(x, affine, offset).min() >= -1e-12)
+
+
+def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarray,
+            prior: np.ndarray, affine: np.ndarray, offset: np.ndarray,
+            prior_weight: float = 1e-3) -> np.ndarray:
+    """The report parameters x nearest to the estimated constants ``target``:
+    minimise |W (C x - target)|^2 + prior_weight^2 |(x - prior) / prior|^2 subject to
+    every tree body's mass, inertia and triangle conditions and J > 0 (SLSQP). ``weights`` W is
+    a matrix with W^T W = the inverse covariance of ``target`` (or a vector: its diagonal).
+    The prior (the report's values) fixes the directions the data cannot see; its weight is
+    small so that it does not move the identifiable constants measurably."""
+    scale = np.abs(prior)
+    weights = np.diag(weights) if np.ndim(weights) == 1 else np.asarray(weights)
+
+    def residual(z):
+        x = z * scale
+        return np.concatenate([weights @ (constants_matrix @ x - target), prior_weight * (z - prior / scale)])
+
+    def cost(z):
+        r = residual(z)
+        return 0.5 * r @ r
+
+    def gradient(z):
+        jac = np.vstack([weights @ constants_matrix * scale, prior_weight * np.eye(len(z))])
+        return jac.T @ residual(z)
+
+    z0 = prior / scale
+    # start from the unconstrained optimum when it is consistent, else from the prior
+    unconstrained = scipy.optimize.least_squares(residual, z0, method="lm").x
+    start = unconstrained if consistent(unconstrained * scale, affine, offset) else z0
+    result = scipy.optimize.minimize(
+        cost, start, jac=gradient, method="SLSQP",
+        constraints=[{"type": "ineq", "fun": lambda z: _constraints(z * scale, affine, offset)}],
+        options={"maxiter": 500, "ftol": 1e-16})
+    x = result.x * scale
+    if not consistent(x, affine, offset):
+        raise RuntimeError(f"no physically consistent parameters found ({result.message})")
+    return x
