@@ -47,11 +47,12 @@ def main(argv: list[str] | None) -> None:
     print("residual RMS per joint [N m]: " + " ".join(f"{r:.3g}" for r in fit.rms))
     held_out = excitation.optimise(iterations=1, restarts=1, seed=7).trajectory
     log = run_device(held_out, 5.0, truth, 1)
-    theta, dtheta, ddtheta, tau = estimation.filtered(log, 10.0)
+    theta, dtheta, ddtheta, tau = estimation.filtered(log, 20.0)
     phi, _ = estimation.base_regressor(Structured(), theta, dtheta, ddtheta)
     identified = phi @ np.concatenate([fit.constants, fit.beta[8:]])
     report = phi @ constants.nominal()
-    t = np.arange(len(tau)) * (log.t[1] - log.t[0]) * round(len(log.t) / len(tau))
+    step = max(1, int(log.rate / (5 * 20.0)))          # estimation.filtered's decimation
+    t = estimation.EDGE + np.arange(len(tau)) * step / log.rate
     errors = {}
     figure, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     for j, axis in enumerate(axes):
@@ -60,7 +61,7 @@ def main(argv: list[str] | None) -> None:
         axis.plot(t, report[:, j], "C3--", label="report's parameters")
         axis.set_ylabel(f"tau{j + 1} [N m]")
     axes[0].legend(loc="upper right", fontsize=8)
-    axes[-1].set_xlabel("held-out samples [s, decimated]")
+    axes[-1].set_xlabel("time [s]")
     for name, prediction in (("identified", identified), ("report", report)):
         errors[name] = np.sqrt(((prediction - tau) ** 2).mean() / (tau**2).mean())
     figure.suptitle(f"held-out torques: RMS error identified {100 * errors['identified']:.1f} %, "

@@ -23,7 +23,12 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
     table = np.loadtxt(path, delimiter=",", skiprows=1)
     assert np.loadtxt(path, delimiter=",", max_rows=1, dtype=str).tolist() == list(io.TRAJECTORY_COLUMNS)
     limits = Limits.read()
-    assert (limits.slack(table[:, 1:4]) >= 0.045).all()   # 0.05 rad margin on the optimiser grid
+    theta = table[:, 1:4]
+    # the coupled stops of the issue (65 and 55 deg) and the joint box, 0.05 rad margin on the
+    # optimiser's grid
+    assert (theta[:, 1] - theta[:, 2] <= np.deg2rad(65) - 0.045).all()
+    assert (theta[:, 2] - theta[:, 1] <= np.deg2rad(55) - 0.045).all()
+    assert (theta >= np.array([-1.0, -0.3, -0.45]) + 0.045).all() and (theta <= np.array([1.0, 1.0, 1.1]) - 0.045).all()
     assert (np.abs(table[:, 10:13]) <= limits.effort).all()
     np.testing.assert_allclose(table[[0, -1], 4:10], 0, atol=1e-12)    # at rest at both ends
     np.testing.assert_allclose(np.diff(table[:, 0]), 1 / 200, rtol=1e-9)
@@ -32,6 +37,16 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
                                atol=2e-3 * np.abs(table[:, 4:7]).max())
     code, _, err = run(capsys, "excite", "-o", path)
     assert code == 2 and "exists" in err
+
+
+def test_limits_are_the_box_and_the_coupled_stops():
+    limits = Limits.read()
+    np.testing.assert_allclose(limits.lower, [-1.0, -0.3, -0.45])   # the joint box, inside the stops
+    np.testing.assert_allclose(limits.upper, [1.0, 1.0, 1.1])
+    at_stops = np.array([[0.0, 0.9, 0.9 - np.deg2rad(65)], [0.0, 0.0, np.deg2rad(55)]])
+    slack = limits.slack(at_stops)
+    np.testing.assert_allclose([slack[0, 6], slack[1, 7]], 0, atol=1e-15)
+    assert (limits.slack(limits.sample(500, 3)) >= 0).all()
 
 
 def write(path, header, rows):
@@ -82,3 +97,18 @@ def test_identify_refuses_to_overwrite(tmp_path, capsys):
     out.write_text("keep")
     code, _, err = run(capsys, "identify", tmp_path / "missing.csv", "-o", out)
     assert code == 2 and "exists" in err and out.read_text() == "keep"
+
+
+def test_excitation_respects_a_tight_torque_limit():
+    """With 20 % of the continuous torque allowed the constraint is active; the torques,
+    computed independently (closed form + the friction law), stay below it between the
+    optimiser's samples too (2 % slack)."""
+    from phantom_pin import closed_form
+    from phantom_pin.identification import excitation
+
+    result = excitation.optimise(torque_share=0.2, iterations=10, restarts=1)
+    t = np.linspace(0, result.trajectory.period, 2001)
+    theta, dtheta, ddtheta = result.trajectory(t)
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta) + 5e-4 * dtheta + 0.01 * np.tanh(dtheta / 0.1)
+    share = np.abs(tau).max(axis=0) / Limits.read().effort
+    assert share.max() <= 0.2 * 1.02 and share.max() >= 0.15, share

@@ -8,13 +8,14 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from phantom_pin import closed_form, load
+from phantom_pin import Phantom, closed_form, load
 from phantom_pin.cli import main
-from phantom_pin.identification import io, physical, simulation
+from phantom_pin.identification import constants, io, physical, simulation
+from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.excitation import Limits
 from phantom_pin.identification.regressor import smoothing_speed
 from phantom_pin.loader import PhantomLoader
-from phantom_pin.parameters import read_overrides
+from phantom_pin.parameters import read_overrides, write_overridden
 
 #: The simulated device: every report parameter moved by 10-30 % (physically consistent).
 FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
@@ -49,9 +50,26 @@ def identified(tmp_path_factory):
     io.write_log(folder / "log.csv", log.t, log.theta, log.tau)
     overlay = folder / "id.yaml"
     assert main(["identify", str(folder / "log.csv"), "-o", str(overlay)]) == 0
-    for kind in ("urdf", "srdf"):
+    for kind in ("urdf", "srdf", "mjcf"):
         assert main([kind, "--params", str(overlay), "-o", str(folder / f"id.{kind}")]) == 0
     return folder
+
+
+def test_overlay_is_accepted_by_phantom_and_mujoco(identified, tmp_path):
+    import mujoco
+
+    config = write_overridden(read_overrides(identified / "id.yaml"), tmp_path)
+    phantom = Phantom(config)
+    loader = type("Identified", (PhantomLoader,), {"urdf_path": identified / "id.urdf",
+                                                   "srdf_path": identified / "id.srdf"})
+    robot = load(loader)
+    theta = Limits.read().sample(20, 13)
+    for q in theta:
+        np.testing.assert_allclose(phantom.mass_matrix(q), pin.crba(robot.model, robot.data, q), atol=1e-15)
+    model = mujoco.MjModel.from_xml_path(str(identified / "id.mjcf"))
+    np.testing.assert_allclose(model.body_mass[model.body("upper_arm_link").id],
+                               phantom.coupling.tree.inertias[phantom.coupling.tree.getJointId("joint2")].mass,
+                               rtol=1e-12)
 
 
 def test_identified_urdf_predicts_held_out_torques(identified):
@@ -76,5 +94,17 @@ def test_identified_urdf_predicts_held_out_torques(identified):
 
 def test_friction_is_identified_and_written(identified):
     keys = read_overrides(identified / "id.yaml")
-    assert keys["actuation.friction.viscous"] == pytest.approx(VISCOUS, rel=0.2)
-    assert keys["actuation.friction.coulomb"] == pytest.approx(COULOMB, rel=0.1)
+    assert keys["actuation.friction.viscous"] == pytest.approx(VISCOUS, rel=0.1)
+    assert keys["actuation.friction.coulomb"] == pytest.approx(COULOMB, rel=0.05)
+
+
+def test_written_constants_are_the_true_ones(identified, tmp_path):
+    """The eight identifiable combinations of the written parameters vs the simulated device's."""
+    written = pz.report_vector(write_overridden(read_overrides(identified / "id.yaml"), tmp_path))
+    t = truth()
+    true_x = np.array([t.ma, t.Iaxx, t.Iayy, t.Iazz, t.mc, t.Icxx, t.Icyy, t.Iczz, t.mbe, t.mbe * t.l5,
+                       t.Ibexx, t.Ibeyy, t.Ibezz, t.mdf, t.mdf * t.l6, t.Idfxx, t.Idfyy, t.Idfzz,
+                       t.Ibaseyy, t.rotor_inertia])
+    error = constants.report_constants(written) / constants.report_constants(true_x) - 1
+    print("relative error of K1 K2 K3 L M22 M33 N2 N3:", np.array2string(error, precision=4))
+    assert np.abs(error).max() < 0.02

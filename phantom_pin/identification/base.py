@@ -45,7 +45,7 @@ class BaseParameters:
         return len(self.independent)
 
     def words(self, k: int) -> str:
-        """beta_k as a sum, its pivot parameter first, e.g. 'turret_link.Izz + 0.034228 rotor1'."""
+        """beta_k as a sum, its pivot parameter first, e.g. 'turret_link.Izz + upper_arm_link.Ixx + rotor1 + ...'."""
         return words(self.matrix[k], self.names, self.independent[k])
 
     def describe(self) -> list[str]:

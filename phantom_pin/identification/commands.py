@@ -35,7 +35,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                                "into a --params overlay (YAML)")
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
-    identify.add_argument("--cutoff", type=float, default=10.0, help="low-pass cutoff in Hz (default 10)")
+    identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
 
 

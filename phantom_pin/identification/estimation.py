@@ -76,7 +76,7 @@ def base_regressor(structured: Structured, theta, dtheta, ddtheta) -> tuple[np.n
     return np.concatenate([phi_x[..., :n] @ pseudo, phi_x[..., n:]], axis=-1), tau0
 
 
-def estimate(log: Log, config_dir: Path | str = CONFIG_DIR, cutoff: float = 10.0,
+def estimate(log: Log, config_dir: Path | str = CONFIG_DIR, cutoff: float = 20.0,
              prior_weight: float = 1e-3) -> Fit:
     """Identify beta and the nearest consistent report parameters from a device log."""
     theta, dtheta, ddtheta, tau = filtered(log, cutoff)

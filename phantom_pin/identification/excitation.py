@@ -112,9 +112,12 @@ class Excitation:
 
 def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
-             restarts: int = 3, iterations: int = 150, seed: int = 0) -> Excitation:
-    """Minimise the base regressor's condition number over the Fourier coefficients, subject
-    to: positions ``margin`` (rad) inside every stop, and the report model's torque (with the
+             restarts: int = 3, iterations: int = 150, seed: int = 0,
+             amplitude_weight: float = 3.0) -> Excitation:
+    """Minimise log(condition number) - amplitude_weight x mean log(singular value) of the
+    base regressor (columns scaled to unit norm for the first, weighted by the nominal beta
+    for the second, so that the torques grow against the noise) over the Fourier
+    coefficients, subject to: positions ``margin`` (rad) inside every stop, and the report model's torque (with the
     shipped friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
     ``restarts`` seeded random starts; the best feasible result is returned."""
     limits = Limits.read(config_dir)
@@ -130,7 +133,11 @@ def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics
         return states, phi
 
     def cost(free):
-        return np.log(condition_number(evaluate(free)[1]))
+        phi = evaluate(free)[1]
+        # condition number, and (D-optimality) the mean log singular value of the regressor with
+        # columns weighted by the nominal beta: rewards torque signals large against the noise
+        size = np.linalg.svd(phi * np.abs(beta) / np.sqrt(len(phi)), compute_uv=False)
+        return np.log(condition_number(phi)) - amplitude_weight * np.log(size).mean()
 
     def inequalities(free):
         states, phi = evaluate(free)
