@@ -23,6 +23,7 @@ import numpy as np
 import scipy.linalg
 
 from phantom_pin.identification import constants, parameterization
+from phantom_pin.identification.excitation import Limits
 from phantom_pin.identification.regressor import Regressor
 from phantom_pin.paths import CONFIG_DIR
 
@@ -108,7 +109,6 @@ class Structured:
 
 def sample(regressor: Regressor, n: int = 300, seed: int = 0) -> tuple[np.ndarray, ...]:
     """``n`` seeded states inside the joint box and the coupled stops (rad, rad/s, rad/s^2)."""
-    from phantom_pin.identification.excitation import Limits
     theta = Limits.read().sample(n, seed)
     rng = np.random.default_rng(seed + 1)
     return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))

@@ -10,7 +10,7 @@ import numpy as np
 
 from phantom_pin import closed_form
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.parameters import load_parameters, write_overridden
+from phantom_pin.parameters import write_overridden
 
 
 def _refuse(path: Path, force: bool) -> None:
@@ -57,7 +57,7 @@ def excite(args: argparse.Namespace, phantom: object = None) -> int:
     t = np.arange(int(round(periods * args.period * args.rate)) + 1) / args.rate
     theta, dtheta, ddtheta = result.trajectory(t)
     beta = constants.nominal(args.config)
-    tau = constants.regressor(theta, dtheta, ddtheta, load_parameters(args.config), args.config) @ beta
+    tau = constants.regressor(theta, dtheta, ddtheta, args.config) @ beta
     io.write_csv(args.output, io.TRAJECTORY_COLUMNS, np.column_stack([t, theta, dtheta, ddtheta, tau]))
     limits = excitation.Limits.read(args.config)
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
@@ -79,7 +79,7 @@ def identify(args: argparse.Namespace, phantom: object = None) -> int:
         fit = estimation.estimate(log, args.config, args.cutoff)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
-    keys, notes = io.overlay(fit, parameterization.report_vector(args.config))
+    keys, notes = io.overlay(fit)
     with tempfile.TemporaryDirectory() as folder:
         problems = physical.urdf_problems(generate_urdf("", write_overridden(keys, folder, args.config)))
     if problems:
@@ -97,6 +97,10 @@ def identify(args: argparse.Namespace, phantom: object = None) -> int:
         print(f"{name:15} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {written} {ref}  {unit}")
     for note in notes:
         print(note)
-    io.write_overlay(args.output, fit, parameterization.report_vector(args.config), args.log.name)
+    print(f"check of the report's structure: the general rigid-body model ({fit.general_rank} base "
+          "parameters, products of inertia and off-axis centres of mass included) leaves "
+          + ", ".join(f"{r:.3g}" for r in fit.general_rms) + " N m RMS; much less than the fit's "
+          "residual means the report's structure misses something on this device")
+    io.write_overlay(args.output, fit, args.log.name)
     print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
     return 0

@@ -93,7 +93,7 @@ def _linear_parameters(x: np.ndarray, known: Parameters) -> Parameters:
 
 
 def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
-              params: Parameters | None = None, config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+              config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
     """Phi (..., 3, 14) from closed_form's inverse dynamics, one constant at a time (vectorised)."""
     units = _unit_parameters(str(Path(config_dir).resolve()))
     columns = [closed_form.inverse_dynamics(theta, dtheta, ddtheta, p) for p in units]

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.signal
 
 from phantom_pin.identification import constants, parameterization, physical
-from phantom_pin.identification.base import Structured
+from phantom_pin.identification.base import Structured, base_parameters
 from phantom_pin.identification.io import Log, LogError
 from phantom_pin.identification.regressor import Regressor, smoothing_speed
 from phantom_pin.model import Phantom
@@ -38,7 +38,9 @@ FILTER_ORDER, EDGE = 4, 0.25
 class Fit:
     """Result of ``estimate``: beta (14,) and its standard deviations, the residual RMS per
     joint (N m) and the RMS torque (N m), the condition number, the number of samples, the
-    consistent report parameters x (20,) and their constants C x (8,)."""
+    consistent report parameters x (20,) and their constants C x (8,); and, as a check of the
+    report's structure, the residual RMS per joint (N m) and the rank of the general
+    rigid-body model (every standard parameter of every body: ``general_rms``, ``general_rank``)."""
 
     beta: np.ndarray
     sigma: np.ndarray
@@ -48,6 +50,8 @@ class Fit:
     samples: int
     x: np.ndarray
     constants: np.ndarray
+    general_rms: np.ndarray
+    general_rank: int
 
 
 def filtered(log: Log, cutoff: float) -> tuple[np.ndarray, ...]:
@@ -110,5 +114,11 @@ def estimate(log: Log, config_dir: Path | str = CONFIG_DIR, cutoff: float = 20.0
     affine, offset = structured.affine, structured.offset
     prior = parameterization.report_vector(config_dir)
     x = physical.nearest(beta[:n], root, c, prior, affine, offset, prior_weight)
+    general = structured.regressor.stacked(theta, dtheta, ddtheta)
+    base = base_parameters(general, structured.regressor.names)
+    independent = general[:, list(base.independent)]
+    fitted = independent @ np.linalg.lstsq(independent, tau.reshape(-1), rcond=None)[0]
+    general_rms = np.sqrt(((tau.reshape(-1) - fitted).reshape(-1, 3) ** 2).mean(axis=0))
     return Fit(beta, np.sqrt(np.diag(covariance)), np.sqrt((residual**2).mean(axis=0)),
-               np.sqrt(((tau - tau0)**2).mean(axis=0)), condition, len(theta), x, c @ x)
+               np.sqrt(((tau - tau0)**2).mean(axis=0)), condition, len(theta), x, c @ x,
+               general_rms, base.rank)

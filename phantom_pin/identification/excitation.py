@@ -17,7 +17,7 @@ import yaml
 
 from phantom_pin import closed_form
 from phantom_pin.identification import constants
-from phantom_pin.parameters import load_parameters, parameter_paths
+from phantom_pin.parameters import parameter_paths
 from phantom_pin.paths import CONFIG_DIR
 
 
@@ -121,7 +121,6 @@ def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics
     shipped friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
     ``restarts`` seeded random starts; the best feasible result is returned."""
     limits = Limits.read(config_dir)
-    params = load_parameters(config_dir)
     beta = constants.nominal(config_dir)
     t = np.linspace(0.0, period, samples, endpoint=False)
     rng = np.random.default_rng(seed)
@@ -129,7 +128,7 @@ def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics
     def evaluate(free):
         trajectory = Fourier.from_free(free, harmonics, period)
         states = trajectory(t)
-        phi = constants.regressor(*states, params, config_dir).reshape(-1, len(beta))
+        phi = constants.regressor(*states, config_dir).reshape(-1, len(beta))
         return states, phi
 
     def cost(free):

@@ -90,7 +90,7 @@ def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2)
     return mean if ok.all() else None
 
 
-def overlay(fit, report_x: np.ndarray) -> tuple[dict[str, float], list[str]]:
+def overlay(fit) -> tuple[dict[str, float], list[str]]:
     """The --params keys of an identification and the comment lines that explain them."""
     from phantom_pin.identification import constants, parameterization
 
@@ -110,11 +110,11 @@ def overlay(fit, report_x: np.ndarray) -> tuple[dict[str, float], list[str]]:
     return keys, notes
 
 
-def write_overlay(path: Path | str, fit, report_x: np.ndarray, source: str) -> None:
+def write_overlay(path: Path | str, fit, source: str) -> None:
     """Write the identified parameters as a --params YAML file (dotted keys, SI units)."""
     from phantom_pin.identification import constants
 
-    keys, notes = overlay(fit, report_x)
+    keys, notes = overlay(fit)
     lines = [f"# Identified by phantom-pin identify from {source}: a --params overlay for",
              "# phantom-pin urdf/srdf/mjcf and Phantom (docs/identification.md). SI units.",
              f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g}; "

@@ -71,7 +71,9 @@ def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarra
             prior_weight: float = 1e-3) -> np.ndarray:
     """The report parameters x nearest to the estimated constants ``target``:
     minimise |W (C x - target)|^2 + prior_weight^2 |(x - prior) / prior|^2 subject to
-    every tree body's mass, inertia and triangle conditions and J > 0 (SLSQP). ``weights`` W is
+    every tree body's mass, inertia and triangle conditions and J > 0. The unconstrained
+    optimum if it is consistent; else the farthest consistent point from the prior towards it,
+    refined by SLSQP: always consistent. ``weights`` W is
     a matrix with W^T W = the inverse covariance of ``target`` (or a vector: its diagonal).
     The prior (the report's values) fixes the directions the data cannot see; its weight is
     small so that it does not move the identifiable constants measurably."""
