@@ -3,10 +3,12 @@ limits, and malformed logs exit 2 with one line and write nothing."""
 
 import numpy as np
 import pytest
+import yaml
 
 from phantom_pin.cli import main
 from phantom_pin.identification import io
 from phantom_pin.identification.excitation import Limits
+from phantom_pin.paths import CONFIG_DIR
 
 
 def run(capsys, *argv):
@@ -28,7 +30,8 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
     # optimiser's grid
     assert (theta[:, 1] - theta[:, 2] <= np.deg2rad(65) - 0.045).all()
     assert (theta[:, 2] - theta[:, 1] <= np.deg2rad(55) - 0.045).all()
-    assert (theta >= np.array([-1.0, -0.3, -0.45]) + 0.045).all() and (theta <= np.array([1.0, 1.0, 1.1]) - 0.045).all()
+    lower, upper = box()
+    assert (theta >= lower + 0.045).all() and (theta <= upper - 0.045).all()
     assert (np.abs(table[:, 10:13]) <= limits.effort).all()
     np.testing.assert_allclose(table[[0, -1], 4:10], 0, atol=1e-12)    # at rest at both ends
     np.testing.assert_allclose(np.diff(table[:, 0]), 1 / 200, rtol=1e-9)
@@ -39,10 +42,19 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
     assert code == 2 and "exists" in err
 
 
+def box():
+    """The URDF's joint box intersected with the stops' box, read from joint_limits.yaml."""
+    data = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())
+    joints = ("joint1", "joint2", "joint3")
+    lower = [max(data[j]["lower"], data["stops"][j]["lower"]) for j in joints]
+    upper = [min(data[j]["upper"], data["stops"][j]["upper"]) for j in joints]
+    return np.array(lower), np.array(upper)
+
+
 def test_limits_are_the_box_and_the_coupled_stops():
     limits = Limits.read()
-    np.testing.assert_allclose(limits.lower, [-1.0, -0.3, -0.45])   # the joint box, inside the stops
-    np.testing.assert_allclose(limits.upper, [1.0, 1.0, 1.1])
+    np.testing.assert_array_equal(limits.lower, box()[0])
+    np.testing.assert_array_equal(limits.upper, box()[1])
     at_stops = np.array([[0.0, 0.9, 0.9 - np.deg2rad(65)], [0.0, 0.0, np.deg2rad(55)]])
     slack = limits.slack(at_stops)
     np.testing.assert_allclose([slack[0, 6], slack[1, 7]], 0, atol=1e-15)
