@@ -1,4 +1,5 @@
-"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, show, simulate."""
+"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, mjcf, show, simulate,
+excite, identify."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from phantom_pin import appendix, closed_form
 from phantom_pin.description import Description, describe, shipped
 from phantom_pin.device import cli as device_cli
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.identification import commands as identification
 from phantom_pin.loader import load
 from phantom_pin.model import Phantom
 from phantom_pin.parameters import CONFIG_DIR, PARAMETER_FILES, random_states, read_overrides
@@ -252,6 +254,7 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     show.add_argument("--open", action="store_true", help="open the live viewer in a browser")
     device_cli.add_parser(sub)
+    identification.add_parsers(sub)
     for command in (info, check, fk, ik, dyn):
         command.add_argument("--json", action="store_true", help="print JSON")
     return parser
@@ -262,7 +265,8 @@ def main(argv: list[str] | None = None) -> int:
     an unwritable file (one line on stderr), 130 interrupted by Ctrl-C (128 + SIGINT, one
     line), 141 output pipe closed by its reader (128 + SIGPIPE, silent, as ``yes | head``)."""
     handlers = {"info": _info, "check": _check, "fk": _fk, "ik": _ik, "dynamics": _dynamics,
-                "simulate": device_cli.simulate_command}
+                "simulate": device_cli.simulate_command, "excite": identification.excite,
+                "identify": identification.identify}
     try:
         args = _parser().parse_args(argv)
         if args.command in ("urdf", "srdf", "mjcf"):

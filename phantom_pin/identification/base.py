@@ -1,0 +1,136 @@
+"""Base parameters: the combinations of the parameters that the joint torques determine.
+
+For a regressor stacked over many states, W (3N x P), a QR decomposition with column
+pivoting, W P = Q [R1 R2], gives the numerical rank r (|R_kk| > tol |R_11|) and the base
+parameters beta = pi_1 + R1^-1 R2 pi_2 (pi_1 the r pivot columns' parameters), with
+W pi = W_1 beta for every pi. ``BaseParameters.matrix`` is the map K: beta = K pi.
+
+Two models are used (run ``python -m phantom_pin.identification.base`` to print both):
+the general rigid-body model of ``Regressor`` (every standard parameter of every tree body,
+the three rotors and the friction), and the report's structure (``structured``: the report
+parameters of ``parameterization``, where centres of mass lie on the segments' axes and the
+segment axes are principal, plus friction). The second's rigid-body base is the report's
+eight constants K1, K2, K3, L, M22, M33 and the gravity coefficients of eqs 81-94
+(``report_constants``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg
+
+from phantom_pin.identification import constants, parameterization
+from phantom_pin.identification.excitation import Limits
+from phantom_pin.identification.regressor import Regressor
+from phantom_pin.paths import CONFIG_DIR
+
+#: Relative size of |R_kk| below which a column counts as dependent.
+RANK_TOLERANCE = 1e-9
+#: Coefficients below this (relative to the largest) are printed and kept as zero.
+_ZERO = 1e-7
+
+
+@dataclasses.dataclass(frozen=True)
+class BaseParameters:
+    """beta = matrix @ pi. ``independent``: the pivot columns (one per beta); ``names``: pi's."""
+
+    names: tuple[str, ...]
+    independent: tuple[int, ...]
+    matrix: np.ndarray
+
+    @property
+    def rank(self) -> int:
+        return len(self.independent)
+
+    def words(self, k: int) -> str:
+        """beta_k as a sum, its pivot parameter first, e.g. 'turret_link.Izz + upper_arm_link.Ixx + rotor1 + ...'."""
+        return words(self.matrix[k], self.names, self.independent[k])
+
+    def describe(self) -> list[str]:
+        return [f"beta{k + 1:<2} = {self.words(k)}" for k in range(self.rank)]
+
+
+def words(row: np.ndarray, names: tuple[str, ...] | list[str], first: int | None = None) -> str:
+    """A linear combination as a sum, largest coefficients first (``first`` leading)."""
+    keys = -np.abs(row) - (np.arange(len(row)) == first) * 1e300
+    terms = []
+    for j in np.argsort(keys):
+        if abs(row[j]) > _ZERO * np.abs(row).max():
+            coefficient = "" if np.isclose(abs(row[j]), 1.0, rtol=1e-9) else f"{abs(row[j]):.6g} "
+            terms.append(f"{'-' if row[j] < 0 else ''}{coefficient}{names[j]}")
+    return " + ".join(terms).replace("+ -", "- ")
+
+
+def base_parameters(stacked: np.ndarray, names: tuple[str, ...] | list[str],
+                    scale: np.ndarray | None = None) -> BaseParameters:
+    """The base parameters of a stacked regressor (3N, P) whose columns are ``names``.
+
+    ``scale`` (P,), the typical size of each parameter, equilibrates the columns before
+    pivoting, so that the pivots are the parameters that matter most.
+    """
+    scale = np.ones(stacked.shape[1]) if scale is None else np.asarray(scale, float)
+    _, r, order = scipy.linalg.qr(stacked * scale, pivoting=True, mode="economic")
+    diagonal = np.abs(np.diag(r))
+    rank = int(np.sum(diagonal > RANK_TOLERANCE * diagonal[0]))
+    r1, r2 = r[:rank, :rank], r[:rank, rank:]
+    combination = scipy.linalg.solve_triangular(r1, r2)          # in scaled units
+    matrix = np.zeros((rank, stacked.shape[1]))
+    matrix[:, order[:rank]] = np.eye(rank)
+    matrix[:, order[rank:]] = combination * scale[order[:rank], None] / scale[order[rank:]]
+    matrix[np.abs(matrix) < _ZERO * np.abs(matrix).max(axis=1, keepdims=True)] = 0.0
+    return BaseParameters(tuple(names), tuple(int(i) for i in order[:rank]), matrix)
+
+
+class Structured:
+    """The regressor in the report parameters x and friction f: tau = Phi (x, f) + tau_0.
+
+    Phi = [Y_rigid A, Y_friction] with pi = A x + b (parameterization.affine_map); tau_0 =
+    Y_rigid b is the part fixed by the known parameters (zero here: the pins' compensation
+    cancels and the base's fixed parameters do not enter).
+    """
+
+    def __init__(self, regressor: Regressor | None = None, config_dir: Path | str = CONFIG_DIR) -> None:
+        self.regressor = regressor or Regressor()
+        self.config_dir = config_dir
+        self.affine, self.offset = parameterization.affine_map(config_dir)
+        self.names = tuple(parameterization.SYMBOLS) + tuple(
+            f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
+
+    def __call__(self, theta: object, dtheta: object, ddtheta: object) -> tuple[np.ndarray, np.ndarray]:
+        """(Phi (..., 3, 26), tau_0 (..., 3)) at the given states (rad, rad/s, rad/s^2)."""
+        y = self.regressor(theta, dtheta, ddtheta)
+        rigid = y[..., :self.affine.shape[0]]
+        return (np.concatenate([rigid @ self.affine, y[..., self.regressor.friction]], axis=-1),
+                rigid @ self.offset)
+
+
+def sample(regressor: Regressor, n: int = 300, seed: int = 0) -> tuple[np.ndarray, ...]:
+    """``n`` seeded states inside the joint box and the coupled stops (rad, rad/s, rad/s^2)."""
+    theta = Limits.read().sample(n, seed)
+    rng = np.random.default_rng(seed + 1)
+    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+
+
+def main() -> None:
+    regressor = Regressor()
+    states = sample(regressor)
+    full = base_parameters(regressor.stacked(*states), regressor.names,
+                           np.maximum(np.abs(regressor.parameters(5e-4, 0.01)), 1e-6))
+    print(f"General rigid-body model: {regressor.size} parameters "
+          f"({len(regressor.bodies)} tree bodies x 10, 3 rotors, 6 friction), {full.rank} base parameters:")
+    print("\n".join(full.describe()))
+    structured = Structured(regressor)
+    phi = structured(*states)[0].reshape(-1, len(structured.names))
+    x0 = parameterization.report_vector()
+    report = base_parameters(phi, structured.names, np.concatenate([np.abs(x0), [5e-4] * 3 + [0.01] * 3]))
+    print(f"\nThe report's structure: {len(structured.names)} parameters (report parameters and "
+          f"friction), {report.rank} base parameters: the friction and the report's constants")
+    for name, row in zip(constants.NAMES, constants.constants_matrix()):
+        print(f"{name:4} = {words(row, parameterization.SYMBOLS)}")
+
+
+if __name__ == "__main__":
+    main()

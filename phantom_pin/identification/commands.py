@@ -1,0 +1,103 @@
+"""The handlers of ``phantom-pin excite`` and ``phantom-pin identify`` (registered in cli.py)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from phantom_pin.exceptions import PhantomPinError
+
+
+def _refuse(path: Path, force: bool) -> None:
+    if path.exists() and not force:
+        raise PhantomPinError(f"--output: {path} exists; add --force to overwrite it")
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    """Add the excite and identify subcommands to the phantom-pin parser."""
+    excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
+    excite.add_argument("--output", "-o", required=True, type=Path)
+    excite.add_argument("--duration", type=float, default=20.0,
+                        help="seconds of trajectory, rounded up to whole periods (default 20)")
+    excite.add_argument("--rate", type=float, default=1000.0, help="samples per second (default 1000)")
+    excite.add_argument("--period", type=float, default=5.0, help="period of the Fourier series, s (default 5)")
+    excite.add_argument("--harmonics", type=int, default=5, help="harmonics per joint (default 5)")
+    excite.add_argument("--iterations", type=int, default=60, help="SLSQP iterations per start (default 60)")
+    excite.add_argument("--restarts", type=int, default=2, help="random starts (default 2)")
+    excite.add_argument("--seed", type=int, default=0)
+    excite.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+    identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
+                                               "into a --params overlay (YAML)")
+    identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
+    identify.add_argument("--output", "-o", required=True, type=Path)
+    identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
+    identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+
+
+def excite(args: argparse.Namespace, phantom: object = None) -> int:
+    from phantom_pin.identification import constants, excitation, io
+
+    _refuse(args.output, args.force)
+    for name in ("duration", "rate", "period"):
+        if not getattr(args, name) > 0:
+            raise PhantomPinError(f"--{name}: expected a positive number")
+    if args.harmonics < 2 or args.iterations < 1 or args.restarts < 1:
+        raise PhantomPinError("--harmonics must be at least 2, --iterations and --restarts at least 1")
+    try:
+        result = excitation.optimise(args.config, args.period, args.harmonics,
+                                     iterations=args.iterations, restarts=args.restarts, seed=args.seed)
+    except RuntimeError as error:
+        raise PhantomPinError(str(error)) from None
+    periods = int(np.ceil(args.duration / args.period - 1e-9))
+    t = np.arange(int(round(periods * args.period * args.rate)) + 1) / args.rate
+    theta, dtheta, ddtheta = result.trajectory(t)
+    beta = constants.nominal(args.config)
+    tau = constants.regressor(theta, dtheta, ddtheta, args.config) @ beta
+    io.write_csv(args.output, io.TRAJECTORY_COLUMNS, np.column_stack([t, theta, dtheta, ddtheta, tau]))
+    limits = excitation.Limits.read(args.config)
+    print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
+          f"{args.harmonics} harmonics per joint")
+    print(f"condition number of the base regressor (14 columns scaled to unit norm): {result.condition:.3g}")
+    print("peak torque [N m] (report model + shipped friction) / motor continuous limit: "
+          + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(np.abs(tau).max(axis=0), limits.effort)))
+    print(f"nearest approach to a stop: {result.min_slack:.3f} rad; the file starts and ends at rest")
+    return 0
+
+
+def identify(args: argparse.Namespace, phantom: object = None) -> int:
+    from phantom_pin.description import describe
+    from phantom_pin.identification import constants, estimation, io, parameterization
+
+    _refuse(args.output, args.force)
+    log = io.read_log(args.log)
+    try:
+        fit = estimation.estimate(log, args.config, args.cutoff)
+    except RuntimeError as error:
+        raise PhantomPinError(str(error)) from None
+    keys, notes = io.overlay(fit)
+    try:  # the overlay must give a physical URDF (phantom_pin.physical.check_urdf)
+        describe(args.config, overrides=keys)
+    except PhantomPinError as error:
+        raise PhantomPinError(f"identified parameters not physically valid: {error}") from None
+    report = constants.report_constants(parameterization.report_vector(args.config), args.config)
+    print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
+          f"condition number {fit.condition:.3g}")
+    print("residual RMS per joint [N m]: " + ", ".join(
+        f"{r:.3g} ({100 * r / s:.1f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms)))
+    print(f"{'base parameter':15} {'estimate':>12} {'std dev':>10} {'written':>12} {'report':>12}  unit")
+    names = constants.NAMES + constants.FRICTION_NAMES
+    for k, (name, unit) in enumerate(zip(names, constants.UNITS)):
+        written = f"{fit.constants[k]:12.5g}" if k < len(report) else " " * 12
+        ref = f"{report[k]:12.5g}" if k < len(report) else " " * 12
+        print(f"{name:15} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {written} {ref}  {unit}")
+    for note in notes:
+        print(note)
+    print(f"check of the report's structure: the general rigid-body model ({fit.general_rank} base "
+          "parameters, products of inertia and off-axis centres of mass included) leaves "
+          + ", ".join(f"{r:.3g}" for r in fit.general_rms) + " N m RMS; much less than the fit's "
+          "residual means the report's structure misses something on this device")
+    io.write_overlay(args.output, fit, args.log.name)
+    print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
+    return 0

@@ -1,0 +1,113 @@
+"""The report's lumped constants as base parameters: tau = Phi(theta, dtheta, ddtheta) beta.
+
+beta = (K1, K2, K3, L, M22, M33 in kg m^2; N2, N3 in N m; viscous1..3 in N m s/rad;
+coulomb1..3 in N m). The first eight are the constants of the report's eqs 81-94 (corrected
+as closed_form): M11 = K1 + K2/8 cos 2t2 + K3/8 cos 2t3 + L cos t2 sin t3, M22, M33,
+M23 = -L/2 sin(t2 - t3), N2 = n2 cos t2, N3 = n3 sin t3. They are linear in the report
+parameters (lengths fixed): constants = C x (``constants_matrix``), and they span exactly
+the base parameters of the report's structure (tests/test_identification_base.py).
+The friction columns are dtheta_i and tanh(dtheta_i / smoothing_speed).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from phantom_pin import closed_form
+from phantom_pin.identification import parameterization
+from phantom_pin.identification.regressor import smoothing_speed
+from phantom_pin.parameters import Parameters, load_parameters, parameter_paths
+from phantom_pin.paths import CONFIG_DIR
+
+#: The report's lumped constants (eqs 81-94), then the friction, in beta's order.
+NAMES = ("K1", "K2", "K3", "L", "M22", "M33", "N2", "N3")
+FRICTION_NAMES = tuple(f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
+#: Units of each entry of beta.
+UNITS = ("kg m^2",) * 6 + ("N m",) * 2 + ("N m s/rad",) * 3 + ("N m",) * 3
+
+
+def report_constants(x: np.ndarray, config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+    """K1, K2, K3, L, M22, M33 (kg m^2), N2, N3 (N m) of the report parameters ``x``, read
+    off closed_form's M and N (eqs 81-85, 93-94): M11 = K1 + K2/8 cos 2t2 + K3/8 cos 2t3 +
+    L cos t2 sin t3, M23 = -L/2 sin(t2 - t3), N2 = n2 cos t2, N3 = n3 sin t3."""
+    p = _parameters(np.asarray(x, float), load_parameters(config_dir))
+    h = np.pi / 2
+    states = np.array([[0, 0, 0], [0, h, 0], [0, 0, h], [0, h / 2, h / 3]])
+    m = closed_form.mass_matrix(states, p)
+    rows = np.array([[1, np.cos(2 * t2) / 8, np.cos(2 * t3) / 8, np.cos(t2) * np.sin(t3)]
+                     for _, t2, t3 in states])
+    k1, k2, k3, lam = np.linalg.solve(rows, m[:, 0, 0])
+    n = closed_form.gravity([0.0, 0.0, h], p)
+    return np.array([k1, k2, k3, lam, m[0, 1, 1], m[0, 2, 2], closed_form.gravity([0.0, 0.0, 0.0], p)[1], n[2]])
+
+
+def _parameters(x: np.ndarray, known: Parameters) -> Parameters:
+    values = dict(zip(parameterization.SYMBOLS, x))
+    return dataclasses.replace(
+        known, ma=values["ma"], Iaxx=values["Iaxx"], Iayy=values["Iayy"], Iazz=values["Iazz"],
+        mc=values["mc"], Icxx=values["Icxx"], Icyy=values["Icyy"], Iczz=values["Iczz"],
+        mbe=values["mbe"], l5=values["mbe*l5"] / values["mbe"], Ibexx=values["Ibexx"],
+        Ibeyy=values["Ibeyy"], Ibezz=values["Ibezz"], mdf=values["mdf"],
+        l6=values["mdf*l6"] / values["mdf"], Idfxx=values["Idfxx"], Idfyy=values["Idfyy"],
+        Idfzz=values["Idfzz"], Ibaseyy=values["Ibaseyy"], rotor_inertia=values["J"])
+
+
+def constants_matrix(config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+    """C (8, 20) with report_constants(x) = C x: the constants are linear in x (lengths fixed).
+    Unit steps (1 kg, 1 kg m, 1 kg m^2) keep the differences exact to rounding."""
+    x0 = parameterization.report_vector(config_dir)
+    c0 = report_constants(x0, config_dir)
+    columns = []
+    for k in range(len(x0)):
+        x = x0.copy()
+        x[k] += 1.0
+        columns.append(report_constants(x, config_dir) - c0)
+    return np.stack(columns, axis=1)
+
+
+@functools.lru_cache(maxsize=4)
+def _unit_parameters(config_dir: str) -> tuple[Parameters, ...]:
+    """One Parameters per constant whose constants are e_k (x = C^+ e_k)."""
+    known = load_parameters(config_dir)
+    c = constants_matrix(config_dir)
+    pseudo = np.linalg.pinv(c)
+    return tuple(_linear_parameters(pseudo[:, k], known) for k in range(len(NAMES)))
+
+
+def _linear_parameters(x: np.ndarray, known: Parameters) -> Parameters:
+    """Parameters that closed_form reads linearly in x: mbe and mdf enter closed_form only as
+    mbe * l5 and mdf * l6 (eqs 93-94), so they carry the first moments with l5 = l6 = 1 m."""
+    values = dict(zip(parameterization.SYMBOLS, x))
+    return dataclasses.replace(
+        known, ma=values["ma"], Iaxx=values["Iaxx"], Iayy=values["Iayy"], Iazz=values["Iazz"],
+        mc=values["mc"], Icxx=values["Icxx"], Icyy=values["Icyy"], Iczz=values["Iczz"],
+        mbe=values["mbe*l5"], l5=1.0, Ibexx=values["Ibexx"], Ibeyy=values["Ibeyy"],
+        Ibezz=values["Ibezz"], mdf=values["mdf*l6"], l6=1.0, Idfxx=values["Idfxx"],
+        Idfyy=values["Idfyy"], Idfzz=values["Idfzz"], Ibaseyy=values["Ibaseyy"],
+        rotor_inertia=values["J"])
+
+
+def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
+              config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+    """Phi (..., 3, 14) from closed_form's inverse dynamics, one constant at a time (vectorised)."""
+    units = _unit_parameters(str(Path(config_dir).resolve()))
+    columns = [closed_form.inverse_dynamics(theta, dtheta, ddtheta, p) for p in units]
+    dtheta = np.asarray(dtheta, float)
+    speed = smoothing_speed(config_dir)
+    eye = np.eye(3)
+    viscous = dtheta[..., :, None] * eye
+    coulomb = np.tanh(dtheta / speed)[..., :, None] * eye
+    return np.concatenate([np.stack(columns, axis=-1), viscous, coulomb], axis=-1)
+
+
+def nominal(config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+    """beta of a configuration: its report constants and its friction (the same on each joint)."""
+    with open(parameter_paths(config_dir)["actuation_file"], encoding="utf-8") as stream:
+        friction = yaml.safe_load(stream)["friction"]
+    return np.concatenate([report_constants(parameterization.report_vector(config_dir), config_dir),
+                           [friction["viscous"]] * 3, [friction["coulomb"]] * 3])

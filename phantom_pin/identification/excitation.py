@@ -1,0 +1,166 @@
+"""Excitation: a periodic finite Fourier series inside the real stops, optimised for the
+condition number of the base regressor.
+
+theta_i(t) = q0_i + sum_k a_ik/(k w) sin(k w t) - b_ik/(k w) cos(k w t), k = 1..H, w = 2 pi/T
+(rad; rates rad/s, accelerations rad/s^2). The last harmonic's coefficients are set so that
+the trajectory starts and ends each period at rest (dtheta = ddtheta = 0 at t = 0).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import scipy.optimize
+import yaml
+
+from phantom_pin.identification import constants
+from phantom_pin.parameters import parameter_paths
+from phantom_pin.paths import CONFIG_DIR
+
+
+@dataclasses.dataclass(frozen=True)
+class Limits:
+    """Where and how hard the arm may move: the joint box (rad) intersected with the stops' box,
+    the coupled stops theta2 - theta3 <= d23, theta3 - theta2 <= d32 (rad), and each motor's
+    continuous torque at the joint (N m)."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    d23: float
+    d32: float
+    effort: np.ndarray
+
+    @classmethod
+    def read(cls, config_dir: Path | str = CONFIG_DIR) -> "Limits":
+        paths = parameter_paths(config_dir)
+        with open(paths["joint_limits_file"], encoding="utf-8") as stream:
+            lim = yaml.safe_load(stream)
+        with open(paths["actuation_file"], encoding="utf-8") as stream:
+            act = yaml.safe_load(stream)
+        joints = ("joint1", "joint2", "joint3")
+        stops = lim["stops"]
+        lower = np.array([max(lim[j]["lower"], stops[j]["lower"]) for j in joints], float)
+        upper = np.array([min(lim[j]["upper"], stops[j]["upper"]) for j in joints], float)
+        effort = np.array([act["motor"]["max_continuous_torque"] * act["transmission_ratio"][j]
+                           for j in joints], float)
+        return cls(lower, upper, float(stops["theta2_minus_theta3_max"]),
+                   float(stops["theta3_minus_theta2_max"]), effort)
+
+    def slack(self, theta: np.ndarray) -> np.ndarray:
+        """Distance (rad) to every limit at each state, (..., 8): >= 0 inside."""
+        t = np.asarray(theta, float)
+        return np.concatenate([self.upper - t, t - self.lower,
+                               (self.d23 - (t[..., 1] - t[..., 2]))[..., None],
+                               (self.d32 - (t[..., 2] - t[..., 1]))[..., None]], axis=-1)
+
+    def sample(self, n: int, seed: int, margin: float = 0.0) -> np.ndarray:
+        """``n`` seeded postures (rad), uniform inside the box and the coupled stops."""
+        rng = np.random.default_rng(seed)
+        out = np.empty((0, 3))
+        while len(out) < n:
+            theta = rng.uniform(self.lower, self.upper, (4 * n, 3))
+            out = np.vstack([out, theta[(self.slack(theta) >= margin).all(axis=1)]])
+        return out[:n]
+
+
+@dataclasses.dataclass(frozen=True)
+class Fourier:
+    """A finite Fourier series: offsets q0 (3,) rad, coefficients a, b (3, H) rad/s, period (s)."""
+
+    q0: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    period: float
+
+    @classmethod
+    def from_free(cls, free: np.ndarray, harmonics: int, period: float) -> "Fourier":
+        """From q0 and the first H-1 harmonics; the H-th makes dtheta(0) = ddtheta(0) = 0."""
+        q0, rest = free[:3], free[3:].reshape(2, 3, harmonics - 1)
+        k = np.arange(1, harmonics)
+        a = np.hstack([rest[0], -rest[0].sum(axis=1, keepdims=True)])
+        b = np.hstack([rest[1], -(rest[1] * k).sum(axis=1, keepdims=True) / harmonics])
+        return cls(np.asarray(q0, float), a, b, float(period))
+
+    def __call__(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(theta, dtheta, ddtheta), each (len(t), 3), at times t (s)."""
+        w = 2 * np.pi / self.period
+        k = np.arange(1, self.a.shape[1] + 1)
+        phase = np.multiply.outer(np.asarray(t, float), k * w)          # (N, H)
+        s, c = np.sin(phase), np.cos(phase)
+        theta = self.q0 + (s / (k * w)) @ self.a.T - (c / (k * w)) @ self.b.T
+        dtheta = c @ self.a.T + s @ self.b.T
+        ddtheta = (-s * k * w) @ self.a.T + (c * k * w) @ self.b.T
+        return theta, dtheta, ddtheta
+
+
+def condition_number(phi: np.ndarray) -> float:
+    """Condition number of a stacked base regressor after scaling its columns to unit norm."""
+    norms = np.linalg.norm(phi, axis=0)
+    return float(np.linalg.cond(phi / np.where(norms > 0, norms, 1.0)))
+
+
+@dataclasses.dataclass(frozen=True)
+class Excitation:
+    trajectory: Fourier
+    condition: float        # of the base regressor over one period (columns scaled to unit norm)
+    peak_torque: np.ndarray  # N m per joint, report model with the shipped friction
+    min_slack: float        # rad, nearest approach to a stop
+
+
+def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics: int = 5,
+             samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
+             restarts: int = 3, iterations: int = 150, seed: int = 0,
+             amplitude_weight: float = 3.0) -> Excitation:
+    """Minimise log(condition number) - amplitude_weight x mean log(singular value) of the
+    base regressor (columns scaled to unit norm for the first, weighted by the nominal beta
+    for the second, so that the torques grow against the noise) over the Fourier
+    coefficients, subject to: positions ``margin`` (rad) inside every stop, and the report model's torque (with the
+    shipped friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
+    ``restarts`` seeded random starts; the best feasible result is returned."""
+    limits = Limits.read(config_dir)
+    beta = constants.nominal(config_dir)
+    t = np.linspace(0.0, period, samples, endpoint=False)
+    rng = np.random.default_rng(seed)
+
+    def evaluate(free):
+        trajectory = Fourier.from_free(free, harmonics, period)
+        states = trajectory(t)
+        phi = constants.regressor(*states, config_dir).reshape(-1, len(beta))
+        return states, phi
+
+    def cost(free):
+        phi = evaluate(free)[1]
+        # condition number, and (D-optimality) the mean log singular value of the regressor with
+        # columns weighted by the nominal beta: rewards torque signals large against the noise
+        size = np.linalg.svd(phi * np.abs(beta) / np.sqrt(len(phi)), compute_uv=False)
+        return np.log(condition_number(phi)) - amplitude_weight * np.log(size).mean()
+
+    def inequalities(free):
+        states, phi = evaluate(free)
+        torque = (phi @ beta).reshape(-1, 3)
+        return np.concatenate([limits.slack(states[0]).ravel() - margin,
+                               (torque_share * limits.effort - np.abs(torque)).ravel() * 10])
+
+    start_q0 = np.array([0.0, 0.35, 0.35])
+    best, best_cost = None, np.inf
+    for _ in range(restarts):
+        free0 = np.concatenate([start_q0, rng.normal(0, 0.05, 2 * 3 * (harmonics - 1))])
+        result = scipy.optimize.minimize(cost, free0, method="SLSQP",
+                                         constraints=[{"type": "ineq", "fun": inequalities}],
+                                         options={"maxiter": iterations, "ftol": 1e-6})
+        # an unfinished run may end outside the limits: step back towards the (small) start
+        for alpha in (1.0, 0.8, 0.6, 0.4, 0.2, 0.0):
+            candidate = free0 + alpha * (result.x - free0)
+            if inequalities(candidate).min() >= -1e-9:
+                if cost(candidate) < best_cost:
+                    best, best_cost = candidate, cost(candidate)
+                break
+    if best is None:
+        raise RuntimeError("excitation: no feasible trajectory found; raise --restarts")
+    trajectory = Fourier.from_free(best, harmonics, period)
+    states, phi = evaluate(best)
+    torque = (phi @ beta).reshape(-1, 3)
+    return Excitation(trajectory, condition_number(phi), np.abs(torque).max(axis=0),
+                      float(limits.slack(states[0]).min()))

@@ -1,0 +1,129 @@
+"""CSV files of identification: the excitation trajectory and the device log.
+
+Log: header ``t,theta1,theta2,theta3,tau1,tau2,tau3`` (more columns allowed, any order): time
+(s) at a fixed rate, joint angles (rad, the report's theta, as measured) and joint torques
+(N m, as commanded). ``read_log`` raises LogError with one line on a malformed log.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from phantom_pin.exceptions import PhantomPinError
+
+LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
+TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3",
+                      "ddtheta1", "ddtheta2", "ddtheta3", "tau1", "tau2", "tau3")
+#: Shortest accepted log (s) and largest relative spread of the sampling interval.
+MIN_DURATION, RATE_TOLERANCE = 2.0, 0.01
+
+
+class LogError(PhantomPinError, ValueError):
+    """A log file is missing, malformed, or not usable for identification."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Log:
+    t: np.ndarray       # (N,) s
+    theta: np.ndarray   # (N, 3) rad
+    tau: np.ndarray     # (N, 3) N m
+
+    @property
+    def rate(self) -> float:
+        return float((len(self.t) - 1) / (self.t[-1] - self.t[0]))
+
+
+def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> None:
+    np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.17g")
+
+
+def write_log(path: Path | str, t: np.ndarray, theta: np.ndarray, tau: np.ndarray) -> None:
+    write_csv(path, LOG_COLUMNS, np.column_stack([t, theta, tau]))
+
+
+def read_log(path: Path | str) -> Log:
+    path = Path(path)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as error:
+        raise LogError(f"{path}: cannot read ({error})") from None
+    if not lines:
+        raise LogError(f"{path}: empty file")
+    header = [name.strip() for name in lines[0].split(",")]
+    missing = [c for c in LOG_COLUMNS if c not in header]
+    if missing:
+        raise LogError(f"{path}: missing column(s) {', '.join(missing)} (header must name "
+                       f"{','.join(LOG_COLUMNS)})")
+    try:
+        table = np.array([[float(v) for v in line.split(",")] for line in lines[1:] if line.strip()])
+    except ValueError as error:
+        raise LogError(f"{path}: not a number ({error})") from None
+    if table.ndim != 2 or table.shape[1] != len(header):
+        raise LogError(f"{path}: every row must have {len(header)} values")
+    if not np.isfinite(table).all():
+        row = int(np.where(~np.isfinite(table).all(axis=1))[0][0]) + 2
+        raise LogError(f"{path}: NaN or inf on line {row}")
+    column = {name: table[:, header.index(name)] for name in LOG_COLUMNS}
+    t = column["t"]
+    step = np.diff(t)
+    if len(t) < 2 or not (step > 0).all():
+        raise LogError(f"{path}: time is not strictly increasing"
+                       + (f" (line {int(np.argmin(step > 0)) + 3})" if len(t) >= 2 else ""))
+    if t[-1] - t[0] < MIN_DURATION:
+        raise LogError(f"{path}: too short ({t[-1] - t[0]:.3g} s; at least {MIN_DURATION} s)")
+    if np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
+        raise LogError(f"{path}: not at a fixed rate (intervals {step.min():.4g}..{step.max():.4g} s)")
+    return Log(t, np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)]),
+               np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)]))
+
+
+def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2) -> float | None:
+    """One value for all three joints (inverse-variance mean) if each joint's estimate lies
+    within max(3 sigma, ``spread`` x mean) of it, else None: actuation.yaml holds one friction
+    law for every joint."""
+    weights = 1.0 / np.asarray(sigma) ** 2
+    mean = float((weights * values).sum() / weights.sum())
+    ok = np.abs(values - mean) <= np.maximum(3 * np.asarray(sigma), spread * abs(mean))
+    return mean if ok.all() else None
+
+
+def overlay(fit) -> tuple[dict[str, float], list[str]]:
+    """The --params keys of an identification and the comment lines that explain them."""
+    from phantom_pin.identification import constants, parameterization
+
+    keys = parameterization.overrides(fit.x)
+    notes = []
+    n = len(constants.NAMES)
+    for kind, first in (("viscous", n), ("coulomb", n + 3)):
+        values, sigma = fit.beta[first:first + 3], fit.sigma[first:first + 3]
+        common = friction_overlay(values, sigma)
+        listed = ", ".join(f"{v:.4g} +- {s:.2g}" for v, s in zip(values, sigma))
+        if common is None:
+            notes.append(f"friction.{kind} per joint: {listed} (the joints differ: not written; "
+                         "actuation.yaml holds one value for all joints)")
+        else:
+            keys[f"actuation.friction.{kind}"] = common
+            notes.append(f"friction.{kind} per joint: {listed}; written as their mean")
+    return keys, notes
+
+
+def write_overlay(path: Path | str, fit, source: str) -> None:
+    """Write the identified parameters as a --params YAML file (dotted keys, SI units)."""
+    from phantom_pin.identification import constants
+
+    keys, notes = overlay(fit)
+    lines = [f"# Identified by phantom-pin identify from {source}: a --params overlay for",
+             "# phantom-pin urdf/srdf/mjcf and Phantom (docs/identification.md). SI units.",
+             f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g}; "
+             "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms),
+             "# base parameters (estimate +- standard deviation; of the written parameters):"]
+    for name, unit, value, sigma, written in zip(constants.NAMES, constants.UNITS, fit.beta,
+                                                 fit.sigma, fit.constants):
+        lines.append(f"#   {name:4} = {value:.6g} +- {sigma:.2g} {unit}; written {written:.6g}")
+    lines += [f"# {note}" for note in notes]
+    lines += ["# Directions the torques do not determine are kept near the report's values (prior)."]
+    lines += [f"{key}: {value!r}" for key, value in keys.items()]
+    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -1,0 +1,99 @@
+"""The joint-torque regressor in the report's coordinates: tau = Y(theta, dtheta, ddtheta) pi.
+
+pi stacks, in this order (``Regressor.names``):
+
+- the 10 standard inertial parameters of each moving body of the mimic-free tree model,
+  in Pinocchio's order [m, m c_x, m c_y, m c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz]
+  (kg, kg m, kg m^2), c the centre of mass and I the inertia *about the joint frame's
+  origin*, both in the body's joint frame (the URDF link frame);
+- the reflected rotor inertia of each motor, J r_i^2 (kg m^2), acting on ddtheta_i;
+- per joint, a viscous coefficient (N m s/rad) on dtheta_i and a Coulomb torque (N m) on
+  tanh(dtheta_i / smoothing_speed): actuation.yaml's friction law.
+
+Pinocchio refuses computeJointTorqueRegressor on mimic models, so it runs on the tree
+model at the tree state (q_tree from the mimic tags, v_tree = G dtheta, a_tree = G ddtheta)
+and is projected: Y = G^T Y_tree. Gravity is the model's (base_link -z).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import yaml
+
+from phantom_pin.model import Phantom
+from phantom_pin.parameters import parameter_paths
+from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.validation import as_states, same_batch
+
+#: Pinocchio's order of the standard parameters of one body (pin.Inertia.toDynamicParameters).
+INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+
+
+def smoothing_speed(config_dir=CONFIG_DIR) -> float:
+    """actuation.yaml friction.smoothing_speed (rad/s) of the Coulomb term's tanh."""
+    with open(parameter_paths(config_dir)["actuation_file"], encoding="utf-8") as stream:
+        return float(yaml.safe_load(stream)["friction"]["smoothing_speed"])
+
+
+def body_names(tree: pin.Model) -> list[str]:
+    """The URDF link carried by each moving joint of ``tree`` (joint 1 .. njoints-1)."""
+    body: dict[int, str] = {}
+    for frame in tree.frames:
+        if frame.type == pin.FrameType.BODY:
+            body.setdefault(frame.parentJoint, frame.name)
+    return [body[i] for i in range(1, tree.njoints)]
+
+
+class Regressor:
+    """Y(theta, dtheta, ddtheta) of a Phantom: (..., 3, n_parameters), see the module doc."""
+
+    def __init__(self, phantom: Phantom | None = None, speed: float | None = None) -> None:
+        self.phantom = phantom or Phantom()
+        self.coupling = self.phantom.coupling
+        self.tree = self.coupling.tree
+        self._data = self.tree.createData()
+        self.smoothing_speed = smoothing_speed() if speed is None else float(speed)
+        self.bodies = body_names(self.tree)
+        self.n_inertial = 10 * len(self.bodies)
+        self.names = ([f"{b}.{p}" for b in self.bodies for p in INERTIAL_NAMES]
+                      + [f"rotor{j}" for j in (1, 2, 3)] + [f"viscous{j}" for j in (1, 2, 3)]
+                      + [f"coulomb{j}" for j in (1, 2, 3)])
+        #: column slices: inertial (tree bodies), rotors, friction
+        self.inertial = slice(0, self.n_inertial)
+        self.rotors = slice(self.n_inertial, self.n_inertial + 3)
+        self.friction = slice(self.n_inertial + 3, self.n_inertial + 9)
+
+    @property
+    def size(self) -> int:
+        return len(self.names)
+
+    def parameters(self, viscous: object = 0.0, coulomb: object = 0.0) -> np.ndarray:
+        """pi of the loaded model: its tree inertias, its armature, and the given friction
+        (scalars or one value per joint, N m s/rad and N m)."""
+        inertial = [self.tree.inertias[i].toDynamicParameters() for i in range(1, self.tree.njoints)]
+        return np.concatenate(inertial + [np.asarray(self.phantom.model.armature, float),
+                                          np.broadcast_to(np.asarray(viscous, float), 3),
+                                          np.broadcast_to(np.asarray(coulomb, float), 3)])
+
+    def _one(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        c = self.coupling
+        tree_y = pin.computeJointTorqueRegressor(self.tree, self._data, c.configuration(q),
+                                                 c.tangent(v), c.tangent(a))
+        return np.hstack([c.matrix.T @ tree_y, np.diag(a), np.diag(v),
+                          np.diag(np.tanh(v / self.smoothing_speed))])
+
+    def __call__(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
+        """Y at one state (3, P) or a batch (N, 3, P); rad, rad/s, rad/s^2 -> N m per unit."""
+        q, batch = as_states(theta, "theta")
+        v, _ = as_states(dtheta, "dtheta")
+        a, _ = as_states(ddtheta, "ddtheta")
+        same_batch(("theta", "dtheta", "ddtheta"), q, v, a)
+        if not batch:
+            return self._one(q, v, a)
+        flat = [self._one(*row) for row in zip(q.reshape(-1, 3), v.reshape(-1, 3), a.reshape(-1, 3))]
+        return np.stack(flat).reshape(q.shape[:-1] + (3, self.size))
+
+    def stacked(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
+        """Y of a batch stacked into (3N, P): rows tau1, tau2, tau3 of state 0, then state 1..."""
+        return self(theta, dtheta, ddtheta).reshape(-1, self.size)

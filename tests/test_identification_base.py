@@ -1,0 +1,79 @@
+"""Base parameters: the numerical rank of the general and the report-structured regressor,
+and the report-structured base against the report's constants of eqs 81-94."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from phantom_pin import closed_form
+from phantom_pin.identification import constants, parameterization as pz
+from phantom_pin.identification.base import Structured, base_parameters
+from phantom_pin.identification.estimation import base_regressor
+from phantom_pin.identification.regressor import Regressor, smoothing_speed
+from test_identification_regressor import states
+
+
+@pytest.fixture(scope="module")
+def structured():
+    return Structured(Regressor())
+
+
+def test_general_model_has_26_base_parameters():
+    regressor = Regressor()
+    base = base_parameters(regressor.stacked(*states(300, 5)), regressor.names)
+    # 20 inertial combinations (the report's 8 + 6 products of inertia + 6 off-plane first
+    # moments) and the 6 friction coefficients
+    assert base.rank == 26
+    assert sum(name.startswith(("viscous", "coulomb")) for name in np.array(base.names)[list(base.independent)]) == 6
+
+
+def test_report_structure_base_is_the_report_constants(structured):
+    phi = structured(*states(300, 6))[0].reshape(-1, len(structured.names))
+    x0 = pz.report_vector()
+    base = base_parameters(phi, structured.names, np.concatenate([np.abs(x0), [1e-3] * 6]))
+    assert base.rank == 14
+    c = constants.constants_matrix()
+    assert np.linalg.matrix_rank(c) == 8
+    # every constant is a combination of the base parameters and vice versa: the same span
+    rigid = base.matrix[:, :20]
+    rigid = rigid[np.abs(rigid).sum(axis=1) > 0]
+    for a, b in ((c, rigid), (rigid, c)):
+        coefficients = np.linalg.lstsq(b.T, a.T, rcond=None)[0]
+        assert np.abs(b.T @ coefficients - a.T).max() <= 1e-10 * np.abs(a).max()
+
+
+def test_constants_equal_the_report_equations_at_the_shipped_values():
+    p = closed_form.shipped_parameters()
+    k1, k2, k3, lam = closed_form._coefficients(p)
+    expected = [k1, k2, k3, lam, p.Ibexx + p.Icxx + p.l1**2 * p.ma + p.l1**2 * p.mc / 4,     # eq 82
+                p.Iaxx + p.Idfxx + p.l2**2 * p.ma / 4 + p.l3**2 * p.mc,                     # eq 85
+                p.g / 2 * (2 * p.l1 * p.ma + 2 * p.l5 * p.mbe + p.l1 * p.mc),               # eq 93
+                p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf)]               # eq 94
+    x0 = pz.report_vector()
+    np.testing.assert_allclose(constants.report_constants(x0), expected, rtol=1e-12)
+    np.testing.assert_allclose(constants.constants_matrix() @ x0, expected, rtol=1e-12)
+
+
+def test_pinocchio_base_regressor_equals_the_closed_form_one(structured):
+    theta, dtheta, ddtheta = states(200, 7)
+    phi, tau0 = base_regressor(structured, theta, dtheta, ddtheta)
+    closed = constants.regressor(theta, dtheta, ddtheta)
+    assert np.abs(phi - closed).max() <= 1e-11 * np.abs(closed).max()
+    beta = constants.nominal()
+    friction = 5e-4 * dtheta + 0.01 * np.tanh(dtheta / smoothing_speed())
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta) + friction
+    assert np.abs(phi @ beta + tau0 - tau).max() <= 1e-12 * np.abs(tau).max()
+
+
+def test_constants_follow_other_parameters():
+    """report_constants is linear in x: C x at perturbed parameters equals closed_form's."""
+    p = closed_form.shipped_parameters()
+    q = dataclasses.replace(p, ma=1.3 * p.ma, Ibeyy=0.8 * p.Ibeyy, mdf=1.2 * p.mdf, l6=0.9 * p.l6)
+    x = np.array([q.ma, q.Iaxx, q.Iayy, q.Iazz, q.mc, q.Icxx, q.Icyy, q.Iczz, q.mbe, q.mbe * q.l5,
+                  q.Ibexx, q.Ibeyy, q.Ibezz, q.mdf, q.mdf * q.l6, q.Idfxx, q.Idfyy, q.Idfzz,
+                  q.Ibaseyy, q.rotor_inertia])
+    theta, dtheta, ddtheta = states(50, 8)
+    phi = constants.regressor(theta, dtheta, ddtheta)[..., :8]
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, q)
+    assert np.abs(phi @ (constants.constants_matrix() @ x) - tau).max() <= 1e-12 * np.abs(tau).max()

@@ -1,0 +1,126 @@
+"""phantom-pin excite and identify: the trajectory stays inside the stops and the torque
+limits, and malformed logs exit 2 with one line and write nothing."""
+
+import numpy as np
+import pytest
+import yaml
+
+from phantom_pin.cli import main
+from phantom_pin.identification import io
+from phantom_pin.identification.excitation import Limits
+from phantom_pin.paths import CONFIG_DIR
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
+    path = tmp_path / "traj.csv"
+    code, out, _ = run(capsys, "excite", "-o", path, "--duration", "5", "--rate", "200",
+                       "--iterations", "5", "--restarts", "1")
+    assert code == 0 and "condition number" in out
+    table = np.loadtxt(path, delimiter=",", skiprows=1)
+    assert np.loadtxt(path, delimiter=",", max_rows=1, dtype=str).tolist() == list(io.TRAJECTORY_COLUMNS)
+    limits = Limits.read()
+    theta = table[:, 1:4]
+    # the coupled stops of the issue (65 and 55 deg) and the joint box, 0.05 rad margin on the
+    # optimiser's grid
+    assert (theta[:, 1] - theta[:, 2] <= np.deg2rad(65) - 0.045).all()
+    assert (theta[:, 2] - theta[:, 1] <= np.deg2rad(55) - 0.045).all()
+    lower, upper = box()
+    assert (theta >= lower + 0.045).all() and (theta <= upper - 0.045).all()
+    assert (np.abs(table[:, 10:13]) <= limits.effort).all()
+    np.testing.assert_allclose(table[[0, -1], 4:10], 0, atol=1e-12)    # at rest at both ends
+    np.testing.assert_allclose(np.diff(table[:, 0]), 1 / 200, rtol=1e-9)
+    # the velocities are the positions' derivatives
+    np.testing.assert_allclose(np.gradient(table[:, 1:4], 1 / 200, axis=0)[1:-1], table[1:-1, 4:7],
+                               atol=2e-3 * np.abs(table[:, 4:7]).max())
+    code, _, err = run(capsys, "excite", "-o", path)
+    assert code == 2 and "exists" in err
+
+
+def box():
+    """The URDF's joint box intersected with the stops' box, read from joint_limits.yaml."""
+    data = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())
+    joints = ("joint1", "joint2", "joint3")
+    lower = [max(data[j]["lower"], data["stops"][j]["lower"]) for j in joints]
+    upper = [min(data[j]["upper"], data["stops"][j]["upper"]) for j in joints]
+    return np.array(lower), np.array(upper)
+
+
+def test_limits_are_the_box_and_the_coupled_stops():
+    limits = Limits.read()
+    np.testing.assert_array_equal(limits.lower, box()[0])
+    np.testing.assert_array_equal(limits.upper, box()[1])
+    at_stops = np.array([[0.0, 0.9, 0.9 - np.deg2rad(65)], [0.0, 0.0, np.deg2rad(55)]])
+    slack = limits.slack(at_stops)
+    np.testing.assert_allclose([slack[0, 6], slack[1, 7]], 0, atol=1e-15)
+    assert (limits.slack(limits.sample(500, 3)) >= 0).all()
+
+
+def write(path, header, rows):
+    path.write_text(header + "\n" + "\n".join(",".join(str(v) for v in row) for row in rows) + "\n")
+
+
+def good_rows(n=3000, rate=1000.0):
+    t = np.arange(n) / rate
+    theta = 0.2 * np.sin(np.outer(t, [1.0, 1.3, 1.7]))
+    return np.column_stack([t, theta, 0.01 * theta])
+
+
+@pytest.mark.parametrize("case, message", [
+    ("missing", "missing column(s) tau3"),
+    ("nan", "NaN or inf on line"),
+    ("time", "time is not strictly increasing"),
+    ("short", "too short"),
+    ("rate", "not at a fixed rate"),
+    ("text", "not a number"),
+    ("flat", "not exciting enough"),
+])
+def test_malformed_logs_exit_2_with_one_line(tmp_path, capsys, case, message):
+    header, rows = "t,theta1,theta2,theta3,tau1,tau2,tau3", good_rows()
+    if case == "missing":
+        header, rows = "t,theta1,theta2,theta3,tau1,tau2", rows[:, :6]
+    elif case == "nan":
+        rows[10, 2] = np.nan
+    elif case == "time":
+        rows[100, 0] = rows[99, 0]
+    elif case == "short":
+        rows = rows[:1000]
+    elif case == "flat":   # only joint 1 moves: gravity and the parallelogram are not excited
+        rows[:, 2:4] = 0.3
+    elif case == "rate":
+        rows[500:, 0] += 0.0005
+    log = tmp_path / "log.csv"
+    write(log, header, rows)
+    if case == "text":
+        log.write_text(log.read_text().replace("0.001,", "abc,", 1))
+    out = tmp_path / "id.yaml"
+    code, _, err = run(capsys, "identify", log, "-o", out)
+    assert code == 2 and message in err and err.count("\n") == 1, err
+    assert not out.exists()
+
+
+def test_identify_refuses_to_overwrite(tmp_path, capsys):
+    out = tmp_path / "id.yaml"
+    out.write_text("keep")
+    code, _, err = run(capsys, "identify", tmp_path / "missing.csv", "-o", out)
+    assert code == 2 and "exists" in err and out.read_text() == "keep"
+
+
+def test_excitation_respects_a_tight_torque_limit():
+    """With 20 % of the continuous torque allowed the constraint is active; the torques,
+    computed independently (closed form + the friction law), stay below it between the
+    optimiser's samples too (2 % slack)."""
+    from phantom_pin import closed_form
+    from phantom_pin.identification import excitation
+
+    result = excitation.optimise(torque_share=0.2, iterations=10, restarts=1)
+    t = np.linspace(0, result.trajectory.period, 2001)
+    theta, dtheta, ddtheta = result.trajectory(t)
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta) + 5e-4 * dtheta + 0.01 * np.tanh(dtheta / 0.1)
+    share = np.abs(tau).max(axis=0) / Limits.read().effort
+    assert share.max() <= 0.2 * 1.02 and share.max() >= 0.15, share
