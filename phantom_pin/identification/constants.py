@@ -16,12 +16,11 @@ import functools
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from phantom_pin import closed_form
 from phantom_pin.identification import parameterization
 from phantom_pin.identification.regressor import smoothing_speed
-from phantom_pin.parameters import Parameters, load_parameters, parameter_paths
+from phantom_pin.parameters import Parameters, load_parameters, read_config
 from phantom_pin.paths import CONFIG_DIR
 
 #: The report's lumped constants (eqs 81-94), then the friction, in beta's order.
@@ -107,7 +106,8 @@ def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
 
 def nominal(config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
     """beta of a configuration: its report constants and its friction (the same on each joint)."""
-    with open(parameter_paths(config_dir)["actuation_file"], encoding="utf-8") as stream:
-        friction = yaml.safe_load(stream)["friction"]
+    config = read_config(config_dir)
+    viscous = config.number("actuation_file", "friction", "viscous")
+    coulomb = config.number("actuation_file", "friction", "coulomb")
     return np.concatenate([report_constants(parameterization.report_vector(config_dir), config_dir),
-                           [friction["viscous"]] * 3, [friction["coulomb"]] * 3])
+                           [viscous] * 3, [coulomb] * 3])

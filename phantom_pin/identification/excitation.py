@@ -13,10 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import scipy.optimize
-import yaml
 
 from phantom_pin.identification import constants
-from phantom_pin.parameters import parameter_paths
+from phantom_pin.device.parameters import device_parameters_from
+from phantom_pin.parameters import parameters_from, read_config
 from phantom_pin.paths import CONFIG_DIR
 
 
@@ -34,19 +34,12 @@ class Limits:
 
     @classmethod
     def read(cls, config_dir: Path | str = CONFIG_DIR) -> "Limits":
-        paths = parameter_paths(config_dir)
-        with open(paths["joint_limits_file"], encoding="utf-8") as stream:
-            lim = yaml.safe_load(stream)
-        with open(paths["actuation_file"], encoding="utf-8") as stream:
-            act = yaml.safe_load(stream)
-        joints = ("joint1", "joint2", "joint3")
-        stops = lim["stops"]
-        lower = np.array([max(lim[j]["lower"], stops[j]["lower"]) for j in joints], float)
-        upper = np.array([min(lim[j]["upper"], stops[j]["upper"]) for j in joints], float)
-        effort = np.array([act["motor"]["max_continuous_torque"] * act["transmission_ratio"][j]
-                           for j in joints], float)
-        return cls(lower, upper, float(stops["theta2_minus_theta3_max"]),
-                   float(stops["theta3_minus_theta2_max"]), effort)
+        config = read_config(config_dir)
+        p, device = parameters_from(config), device_parameters_from(config)
+        lower = np.maximum(p.lower, device.stop_lower)
+        upper = np.minimum(p.upper, device.stop_upper)
+        effort = device.max_continuous_torque * np.array(p.ratios)
+        return cls(lower, upper, device.theta2_minus_theta3_max, device.theta3_minus_theta2_max, effort)
 
     def slack(self, theta: np.ndarray) -> np.ndarray:
         """Distance (rad) to every limit at each state, (..., 8): >= 0 inside."""

@@ -21,11 +21,10 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from phantom_pin.coupling import Coupling
 from phantom_pin.description import generate_urdf
-from phantom_pin.parameters import load_parameters, parameter_paths, write_overridden
+from phantom_pin.parameters import load_parameters, write_overridden
 from phantom_pin.paths import CONFIG_DIR
 
 #: The report parameters, named by their --params key (first moments: mass * com).
@@ -68,9 +67,7 @@ def urdf(x: np.ndarray, config_dir: Path | str = CONFIG_DIR) -> str:
 
 
 def _ratios(config_dir: Path | str) -> np.ndarray:
-    with open(parameter_paths(config_dir)["actuation_file"], encoding="utf-8") as stream:
-        ratio = yaml.safe_load(stream)["transmission_ratio"]
-    return np.array([float(ratio[j]) for j in ("joint1", "joint2", "joint3")])
+    return np.array(load_parameters(config_dir).ratios)
 
 
 def tree_parameters(urdf_xml: str, rotor_inertia: float, ratios: np.ndarray) -> np.ndarray:

@@ -19,10 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-import yaml
 
 from phantom_pin.model import Phantom
-from phantom_pin.parameters import parameter_paths
+from phantom_pin.parameters import read_config
 from phantom_pin.paths import CONFIG_DIR
 from phantom_pin.validation import as_states, same_batch
 
@@ -32,8 +31,7 @@ INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz
 
 def smoothing_speed(config_dir=CONFIG_DIR) -> float:
     """actuation.yaml friction.smoothing_speed (rad/s) of the Coulomb term's tanh."""
-    with open(parameter_paths(config_dir)["actuation_file"], encoding="utf-8") as stream:
-        return float(yaml.safe_load(stream)["friction"]["smoothing_speed"])
+    return read_config(config_dir).number("actuation_file", "friction", "smoothing_speed", positive=True)
 
 
 def body_names(tree: pin.Model) -> list[str]:
