@@ -1,4 +1,4 @@
-"""The arm in meshcat: a 4 s sweep across the joint ranges with a 1 N downward force
+"""The arm in meshcat: a 4 s sweep across the real stops with a 1 N downward force
 on the tip, written as a self-contained HTML file (open it in any browser), or served
 live on 127.0.0.1 with --serve until Ctrl-C.
 """
@@ -8,17 +8,22 @@ from __future__ import annotations
 import numpy as np
 
 import common
-from phantom_pin import load
+from phantom_pin import closed_form, load
 from phantom_pin.viewer import Viewer
 
 
-def sweep(lower: np.ndarray, upper: np.ndarray, duration: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
-    """Times (s) and postures (rad): each joint swings smoothly across 10%..90% of its
-    range, joints 1 and 2 once and joint 3 twice, so at duration / 2 the arm rests at
-    90%, 90% and 10% of the ranges."""
+def sweep(lower: np.ndarray, upper: np.ndarray, coupled: tuple[float, float],
+          duration: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) and postures (rad) inside the joint box ``lower``..``upper`` and the
+    coupled stops ``coupled`` = (max theta2 - theta3, max theta3 - theta2): joints 1 and 2
+    swing smoothly across 10%..90% of their ranges once, and theta3 - theta2 across
+    10%..90% of its coupled range twice (theta3 then clipped to its box)."""
     t = np.linspace(0.0, duration, 121)
-    phase = 2 * np.pi * t[:, None] / duration * np.array([1.0, 1.0, 2.0])
-    return t, lower + (upper - lower) * (0.1 + 0.8 * (1 - np.cos(phase)) / 2)
+    swing = 0.1 + 0.8 * (1 - np.cos(2 * np.pi * t[:, None] / duration * np.array([1.0, 1.0, 2.0]))) / 2
+    theta = lower + (upper - lower) * swing
+    forward, backward = coupled
+    theta[:, 2] = np.clip(theta[:, 1] - forward + (forward + backward) * swing[:, 2], lower[2], upper[2])
+    return t, theta
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -29,7 +34,8 @@ def main(argv: list[str] | None = None) -> None:
     robot = load()
     with Viewer(robot) as viewer:
         viewer.set_force([0.0, -1.0, 0.0])          # N, frame s: y is up
-        viewer.animate(*sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit),
+        viewer.animate(*sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
+                              closed_form.shipped_parameters().coupled),
                        repetitions=1000)
         if html_path is not None:
             print(f"wrote {viewer.export_html(html_path, force=args.force)}")

@@ -13,7 +13,7 @@ import pytest
 from PIL import Image
 
 from conftest import dark, frame_pose, light_grey, patch, render
-from phantom_pin import Phantom, closed_form as cf, load
+from phantom_pin import Device, Phantom, closed_form as cf, load
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -124,7 +124,9 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
     image = render(tmp_path / "visualize.html", tmp_path / "visualize.png")
     assert np.count_nonzero(np.ptp(image[40:], axis=2) < 30) > 3000
     robot = load()
-    _, postures = example("visualize").sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+    _, postures = example("visualize").sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
+                                             cf.shipped_parameters().coupled)
+    assert Device().within_limits(postures).all()
 
     def where(theta, frame):
         return frame_pose(robot.model, theta, frame).translation
