@@ -22,12 +22,14 @@ TRIANGLE_TOLERANCE = 1e-9
 #: The parameter-file keys that feed each link's <inertial>, by link name (without prefix).
 _SOURCES = {
     "turret_link": "segment_g.mass, segment_g.inertia_*, actuation.motor.rotor_inertia, "
-                   "transmission_ratio.joint1",
+                   "transmission_ratio.joint1, hinge_pin.inertia.zz",
     "upper_arm_link": "segment_be.mass, segment_be.com, segment_be.inertia, "
                       "actuation.motor.rotor_inertia, transmission_ratio.joint2",
     "crank_link": "segment_df.mass, segment_df.com, segment_df.inertia, "
-                  "actuation.motor.rotor_inertia, transmission_ratio.joint3",
-    "lower_bar_link": "segment_c.mass, segment_c.inertia",
+                  "actuation.motor.rotor_inertia, transmission_ratio.joint3, hinge_pin.mass",
+    "crank_pin_link": "hinge_pin.mass, hinge_pin.inertia",
+    "lower_bar_link": "segment_c.mass, segment_c.inertia, hinge_pin.mass",
+    "forearm_pin_link": "hinge_pin.mass, hinge_pin.inertia",
     "forearm_link": "segment_a.mass, segment_a.inertia",
 }
 #: Attributes of each URDF primitive that are sizes (m).
