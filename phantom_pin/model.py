@@ -54,6 +54,16 @@ def _is_state(value: object) -> bool:
             and _isfinite(sum(value.tolist())))
 
 
+def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray) -> np.ndarray:
+    """``function`` of each row of ``arrays`` (each (N, k)), stacked into one new array."""
+    first = function(*(a[0] for a in arrays))
+    out = np.empty((len(arrays[0]),) + np.shape(first))
+    out[0] = first
+    for i, row in enumerate(zip(*(a[1:] for a in arrays)), 1):
+        out[i] = function(*row)
+    return out
+
+
 def _solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:
     """x with m x = r for a symmetric 3x3 ``m`` (nested lists; the upper triangle is read),
     by its adjugate; None unless m is positive definite (Sylvester: leading minors > 0)."""
@@ -142,13 +152,19 @@ class Phantom:
         arrays = cls._states(names, *values)
         if arrays[0].ndim == 1:
             return finite_result(function(*arrays), ", ".join(names))
-        rows = [a.reshape(-1, 3) for a in arrays]
-        first = function(*(r[0] for r in rows))
-        out = np.empty((len(rows[0]),) + first.shape)
-        out[0] = first
-        for i, row in enumerate(zip(*(r[1:] for r in rows)), 1):
-            out[i] = function(*row)
-        return finite_result(out.reshape(arrays[0].shape[:-1] + first.shape), ", ".join(names))
+        out = _rows(function, *(a.reshape(-1, a.shape[-1]) for a in arrays))
+        return finite_result(out.reshape(arrays[0].shape[:-1] + out.shape[1:]), ", ".join(names))
+
+    def _tree_batch(self, function: Callable[..., np.ndarray], names: tuple[str, ...],
+                    theta: np.ndarray, *rates: np.ndarray) -> np.ndarray:
+        """``function`` of tree configurations and tangents over checked batches (..., 3):
+        the coupling maps the whole batch, Pinocchio runs per row, the results (N, ...,
+        tree.nv, tree.nv) are projected at once; checked for finiteness."""
+        coupling = self.coupling
+        tree = _rows(function, coupling.configuration(theta.reshape(-1, 3)),
+                     *(coupling.tangent(r.reshape(-1, 3)) for r in rates))
+        out = coupling.project(tree)
+        return finite_result(out.reshape(theta.shape[:-1] + out.shape[1:]), ", ".join(names))
 
     def within_limits(self, theta: object) -> bool | np.ndarray:
         """True where ``theta`` (rad), shape (3,) or (..., 3), lies inside the URDF's box
@@ -293,15 +309,25 @@ class Phantom:
             out = self._coriolis(theta, dtheta)
             if _finite(out):
                 return out
-        return self._each(self._coriolis, ("theta", "dtheta"), theta, dtheta)
+        names = ("theta", "dtheta")
+        q, v = self._states(names, theta, dtheta)
+        if q.ndim == 1:
+            return finite_result(self._coriolis(q, v), ", ".join(names))
+        tree, data = self.coupling.tree, self._tree_data
+        return self._tree_batch(lambda x, dx: pin.computeCoriolisMatrix(tree, data, x, dx), names, q, v)
 
     def gravity(self, theta: object) -> np.ndarray:
         """Gravity torque N(theta) (eqs 93-94): (..., 3), N m.
 
         A batch: rnea at zero rates and accelerations, by rneaInParallel.
         """
-        if _is_state(theta):  # finite, as mass_matrix
-            return pin.computeGeneralizedGravity(self.model, self.data, theta)
+        try:  # the fast path, as inverse_dynamics': NaN/inf in theta reaches N
+            if theta.shape == _ONE:
+                torque = pin.computeGeneralizedGravity(self.model, self.data, theta)
+                if _isfinite(sum(torque.tolist())):
+                    return torque
+        except (AttributeError, TypeError):
+            pass
         (q,) = self._states(("theta",), theta)
         if q.ndim == 1:
             return finite_result(self._gravity(q), "theta")
@@ -322,14 +348,15 @@ class Phantom:
         One state: pinocchio.rnea on the mimic model. A batch (N, 3):
         pinocchio.rneaInParallel over ``threads`` OpenMP threads.
         """
-        if (type(theta) is type(dtheta) is type(ddtheta) is np.ndarray  # the fast path: one
-                and theta.shape == dtheta.shape == ddtheta.shape == _ONE     # real state (3,)
-                and theta.dtype is dtheta.dtype is ddtheta.dtype is _FLOAT):
-            tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
-            # NaN/inf in any input, or an overflow, reaches tau (tests/test_model.py); only
-            # then are the inputs inspected, to name the bad one.
-            if _isfinite(sum(tau.tolist())):
-                return tau
+        try:  # the fast path: one state (3,); eigenpy refuses (TypeError) complex and object
+            if theta.shape == dtheta.shape == ddtheta.shape == _ONE:  # arrays, converts others
+                tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
+                # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
+                # only then are the inputs inspected, to name the bad one.
+                if _isfinite(sum(tau.tolist())):
+                    return tau
+        except (AttributeError, TypeError):  # no shape (lists), or not for eigenpy
+            pass
         names = ("theta", "dtheta", "ddtheta")
         q, v, a = self._states(names, theta, dtheta, ddtheta)
         if q.ndim == 1:
@@ -373,14 +400,10 @@ class Phantom:
         acc = np.linalg.solve(mass, rhs[..., None])[..., 0]
         return finite_result(acc, ", ".join(names))
 
-    def _derivatives(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> np.ndarray:
-        coupling = self.coupling
-        d_q, d_v, _ = pin.computeRNEADerivatives(
-            coupling.tree, self._tree_data, coupling.configuration(theta),
-            coupling.tangent(dtheta), coupling.tangent(ddtheta))
-        both = np.empty((2, 3, 3))
-        both[0], both[1] = coupling.project(d_q), coupling.project(d_v)
-        return both
+    def _tree_derivatives(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> np.ndarray:
+        """d tau_tree / d q and d tau_tree / d v of the tree model, (2, tree.nv, tree.nv)."""
+        return np.array(pin.computeRNEADerivatives(self.coupling.tree, self._tree_data, theta,
+                                                   dtheta, ddtheta)[:2])
 
     def inverse_dynamics_derivatives(self, theta: object, dtheta: object,
                                      ddtheta: object) -> tuple[np.ndarray, np.ndarray]:
@@ -389,9 +412,17 @@ class Phantom:
         Pinocchio's RNEA derivatives refuse mimic models; they run on the tree model
         and are projected: d tau/d theta = G^T (d tau_tree/d q) G, and likewise for dtheta.
         """
+        coupling = self.coupling
         if _is_state(theta) and _is_state(dtheta) and _is_state(ddtheta):
-            both = self._derivatives(theta, dtheta, ddtheta)
+            both = coupling.project(self._tree_derivatives(
+                coupling.configuration(theta), coupling.tangent(dtheta), coupling.tangent(ddtheta)))
             if _finite(both):
                 return both[0], both[1]
-        both = self._each(self._derivatives, ("theta", "dtheta", "ddtheta"), theta, dtheta, ddtheta)
+        names = ("theta", "dtheta", "ddtheta")
+        q, v, a = self._states(names, theta, dtheta, ddtheta)
+        if q.ndim == 1:
+            both = finite_result(coupling.project(self._tree_derivatives(
+                coupling.configuration(q), coupling.tangent(v), coupling.tangent(a))), ", ".join(names))
+        else:
+            both = self._tree_batch(self._tree_derivatives, names, q, v, a)
         return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()

@@ -112,18 +112,18 @@ def test_batches_still_check_shapes_and_overflow(phantom):
 
 
 def test_closed_form_batches_span_chunks_and_equal_single_states(states):
-    """5000 states cross the chunk boundaries of closed_form.inverse_dynamics (4096)."""
-    theta, dtheta, ddtheta = (np.concatenate([s] * 5) for s in states)
+    """50000 states: they cross the chunk boundaries of closed_form.inverse_dynamics (8192)."""
+    theta, dtheta, ddtheta = (np.concatenate([s] * 50) for s in states)
     tau = cf.inverse_dynamics(theta, dtheta, ddtheta)
     m, c, n = cf.mass_matrix(theta), cf.coriolis_matrix(theta, dtheta), cf.gravity(theta)
     expected = np.einsum("nij,nj->ni", m, ddtheta) + np.einsum("nij,nj->ni", c, dtheta) + n
     assert relative_error(tau, expected) < 1e-12
-    for k in (0, 4095, 4096, 4999):
+    for k in (0, 8191, 8192, 16384, 49999):
         np.testing.assert_allclose(cf.inverse_dynamics(theta[k], dtheta[k], ddtheta[k]), tau[k],
                                    rtol=1e-13, atol=1e-15)
         np.testing.assert_array_equal(cf.mass_matrix(theta[k]), m[k])
         np.testing.assert_array_equal(cf.gravity(theta[k]), n[k])
-    shaped = cf.inverse_dynamics(*(s.reshape(50, 100, 3) for s in (theta, dtheta, ddtheta)))
+    shaped = cf.inverse_dynamics(*(s.reshape(500, 100, 3) for s in (theta, dtheta, ddtheta)))
     np.testing.assert_array_equal(shaped.reshape(-1, 3), tau)
 
 
@@ -154,3 +154,29 @@ def test_projection_by_the_kronecker_product_equals_two_products():
     np.testing.assert_allclose(coupling.project(np.asfortranarray(a)), g.T @ a @ g, rtol=1e-14, atol=1e-15)
     q = np.array([0.1, -0.2, 0.3])
     np.testing.assert_array_equal(coupling.configuration(q), g @ q)
+
+
+@pytest.mark.parametrize("method, count", METHODS)
+def test_fast_paths_return_fresh_arrays(phantom, method, count):
+    """A single state's result is not overwritten by the next call (no view of Pinocchio's data)."""
+    function = getattr(phantom, method)
+    first = [np.array([0.1, 0.2, 0.3])] * count
+    result = _stacked(function(*first))
+    kept = result.copy()
+    function(*[-x for x in first])
+    np.testing.assert_array_equal(result, kept)
+
+
+def test_inverse_dynamics_fast_path_takes_what_the_checked_path_takes(phantom):
+    """Its fast path checks only shapes and lets eigenpy convert: int, bool, float32 and
+    object arrays of numbers give the float64 numbers; complex and (3, 1) are refused by name."""
+    theta = np.array([0, 1, -1])
+    expected = phantom.inverse_dynamics(*[theta.astype(float)] * 3)
+    for value in (theta, theta.astype(np.float32), theta.astype(object), theta.tolist()):
+        np.testing.assert_array_equal(phantom.inverse_dynamics(value, value, value), expected)
+    np.testing.assert_array_equal(phantom.inverse_dynamics(*[np.array([True, False, True])] * 3),
+                                  phantom.inverse_dynamics(*[np.array([1.0, 0.0, 1.0])] * 3))
+    with pytest.raises(InvalidInputError, match=r"^dtheta: expected shape \(3,\) or \(N, 3\)"):
+        phantom.inverse_dynamics(theta, theta[:, None], theta)
+    with pytest.raises(InvalidInputError, match="^ddtheta: expected real numbers"):
+        phantom.inverse_dynamics(theta, theta, theta + 1j)
