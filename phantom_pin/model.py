@@ -41,11 +41,6 @@ def _finite(array: np.ndarray) -> bool:
     return math.isfinite(sum(array.ravel("K").tolist()))
 
 
-def _is_vector(value: object) -> bool:
-    """True for a float64 ndarray of shape (3,)."""
-    return type(value) is np.ndarray and value.shape == _ONE and value.dtype is _FLOAT
-
-
 def _is_state(value: object) -> bool:
     """True for a finite float64 ndarray of shape (3,). The fast paths take such inputs
     and, where rates enter (products that can overflow), check their results; anything
@@ -305,7 +300,7 @@ class Phantom:
         Pinocchio's computeCoriolisMatrix is silently wrong on mimic models, so it runs
         on the tree model and is projected: C = G^T C_tree G.
         """
-        if _is_state(theta) and _is_state(dtheta):
+        if _is_state(theta) and _is_state(dtheta):  # (inf * 0 in G dtheta would warn)
             out = self._coriolis(theta, dtheta)
             if _finite(out):
                 return out
@@ -380,15 +375,18 @@ class Phantom:
         its adjugate; np.linalg.cholesky raises LinAlgError if M is not positive definite.
         A batch: the bias torques by rneaInParallel, M per state, one batched solve.
         """
-        if _is_state(theta) and _is_vector(dtheta) and _is_vector(tau):
-            # NaN/inf in dtheta or tau reaches every acceleration (0 * NaN is NaN); theta1
-            # enters neither M nor the bias torques, so theta is checked first
-            bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
-            t0, t1, t2 = tau.tolist()
-            acc = _solve_spd(pin.crba(self.model, self.data, theta).tolist(),
-                             (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
-            if acc is not None and _isfinite(sum(acc)):  # rates can overflow
-                return np.array(acc)
+        try:  # the fast path, as inverse_dynamics': NaN/inf in dtheta or tau reaches every
+            # acceleration (0 * NaN is NaN); theta1 enters neither M nor the bias torques,
+            # so theta is checked first
+            if theta.shape == dtheta.shape == tau.shape == _ONE and _isfinite(sum(theta.tolist())):
+                bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
+                t0, t1, t2 = tau.tolist()
+                acc = _solve_spd(pin.crba(self.model, self.data, theta).tolist(),
+                                 (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
+                if acc is not None and _isfinite(sum(acc)):  # rates can overflow
+                    return np.array(acc)
+        except (AttributeError, TypeError):  # no shape, not for eigenpy, complex tau
+            pass
         names = ("theta", "dtheta", "tau")
         q, v, torque = self._states(names, theta, dtheta, tau)
         if q.ndim == 1:

@@ -167,16 +167,19 @@ def test_fast_paths_return_fresh_arrays(phantom, method, count):
     np.testing.assert_array_equal(result, kept)
 
 
-def test_inverse_dynamics_fast_path_takes_what_the_checked_path_takes(phantom):
-    """Its fast path checks only shapes and lets eigenpy convert: int, bool, float32 and
-    object arrays of numbers give the float64 numbers; complex and (3, 1) are refused by name."""
+@pytest.mark.parametrize("method, third", [("inverse_dynamics", "ddtheta"), ("forward_dynamics", "tau"),
+                                           ("gravity", None)])
+def test_shape_only_fast_paths_take_what_the_checked_path_takes(phantom, method, third):
+    """These fast paths check shapes and let eigenpy convert: int, bool, float32 and object
+    arrays of numbers give the numbers of the checked path; complex and (3, 1) are refused by name."""
+    function = getattr(phantom, method)
+    count = 1 if third is None else 3
     theta = np.array([0, 1, -1])
-    expected = phantom.inverse_dynamics(*[theta.astype(float)] * 3)
-    for value in (theta, theta.astype(np.float32), theta.astype(object), theta.tolist()):
-        np.testing.assert_array_equal(phantom.inverse_dynamics(value, value, value), expected)
-    np.testing.assert_array_equal(phantom.inverse_dynamics(*[np.array([True, False, True])] * 3),
-                                  phantom.inverse_dynamics(*[np.array([1.0, 0.0, 1.0])] * 3))
-    with pytest.raises(InvalidInputError, match=r"^dtheta: expected shape \(3,\) or \(N, 3\)"):
-        phantom.inverse_dynamics(theta, theta[:, None], theta)
-    with pytest.raises(InvalidInputError, match="^ddtheta: expected real numbers"):
-        phantom.inverse_dynamics(theta, theta, theta + 1j)
+    for value in (theta, theta.astype(np.float32), theta.astype(object), theta.tolist(),
+                  np.array([True, False, True])):
+        expected = function(*[np.asarray(value).astype(float)] * count)
+        np.testing.assert_array_equal(function(*[value] * count), expected)
+    with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(N, 3\)"):
+        function(theta[:, None], *[theta] * (count - 1))
+    with pytest.raises(InvalidInputError, match=f"^{third or 'theta'}: expected real numbers"):
+        function(*[theta] * (count - 1), theta + 1j)
