@@ -20,7 +20,7 @@ from phantom_pin.validation import as_states, finite_result, same_batch, wrap_an
 #: Relative slack on the law-of-cosines arguments before a target counts as unreachable.
 _ACOS_SLACK = 1e-12
 #: States per chunk of the batched dynamics: the NumPy temporaries of a chunk fit in cache.
-_CHUNK = 4096
+_CHUNK = 8192
 
 
 @functools.lru_cache(maxsize=1)
@@ -188,13 +188,14 @@ def _coriolis_entries(trig: _Trig, d1: np.ndarray, d2: np.ndarray, d3: np.ndarra
     a = trig.s2 * (k2 / 4 * trig.c2 + lam / 2 * trig.s3)
     b = trig.c3 * (lam / 2 * trig.c2 - k3 / 4 * trig.s3)
     h = lam / 2 * trig.cos_23()
+    a_d1, b_d1 = a * d1, b * d1
     return {
         (0, 0): b * d3 - a * d2,                                                    # eq 86
-        (0, 1): -a * d1,                                                            # eq 87
-        (0, 2): b * d1,                                                             # eq 88
-        (1, 0): a * d1,                                                             # eq 89
+        (0, 1): -a_d1,                                                              # eq 87
+        (0, 2): b_d1,                                                               # eq 88
+        (1, 0): a_d1,                                                               # eq 89
         (1, 2): h * d3,                                                             # eq 90
-        (2, 0): -b * d1,                                                            # eq 91
+        (2, 0): -b_d1,                                                              # eq 91
         (2, 1): -h * d2,                                                            # eq 92
     }
 
@@ -269,7 +270,7 @@ def inverse_dynamics(theta: object, dtheta: object, ddtheta: object,
     tau = np.empty(flat[0].shape)
     with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result
         for start in range(0, len(tau), _CHUNK):  # chunks: the temporaries stay in cache
-            t, d, a = (x[start:start + _CHUNK].T for x in flat)
+            t, d, a = (np.ascontiguousarray(x[start:start + _CHUNK].T) for x in flat)
             trig = _Trig(t[1], t[2])
             out = np.zeros(t.shape)
             for (i, j), value in _mass_entries(trig, p).items():

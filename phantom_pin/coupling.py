@@ -75,17 +75,16 @@ class Coupling:
                             source.idx_v:source.idx_v + joint.nv] = np.eye(joint.nv)
                 self._copy_slots.append((joint.idx_q, source.idx_q, joint.nq))
         self._transpose = np.ascontiguousarray(self.matrix.T)
-        # G^T A G = reshape((G^T kron G^T) @ A.ravel()): one product instead of two, for
-        # small models (the Kronecker product has (tree.nv reduced.nv)^2 entries)
-        self._kron = (np.kron(self._transpose, self._transpose)
-                      if self.tree.nv <= _KRON_MAX_NV else None)
+        # G^T A G = reshape(A.ravel() . (G kron G)): one product instead of two, for small
+        # models (the Kronecker product has (tree.nv reduced.nv)^2 entries)
+        self._kron = np.kron(self.matrix, self.matrix) if self.tree.nv <= _KRON_MAX_NV else None
         # with only 1-coordinate joints, the configuration map is affine: q_tree = A q + b
         self._affine: tuple[np.ndarray, np.ndarray | None] | None = None
         if self.tree.nq == self.tree.nv and self.reduced.nq == self.reduced.nv:
             offset = np.zeros(self.tree.nq)
             for tree_q, _, _, _, _, angle in self._mimic_slots:
                 offset[tree_q] = angle
-            self._affine = self.matrix.copy(), (offset if offset.any() else None)
+            self._affine = self._transpose.copy(), (offset if offset.any() else None)
 
     def _add_mimic(self, joint: pin.JointModel, tag: Mimic) -> None:
         if tag.primary in self.mimics:
@@ -100,10 +99,12 @@ class Coupling:
                                   tag.multiplier, tag.offset))
 
     def configuration(self, q_reduced: np.ndarray) -> np.ndarray:
-        """Tree configuration (tree.nq,) of a reduced configuration (reduced.nq,)."""
+        """Tree configuration (tree.nq,) of a reduced configuration (reduced.nq,); a batch
+        (N, reduced.nq) too when every joint has one coordinate (no continuous joints)."""
         if self._affine is not None:
-            matrix, offset = self._affine
-            return matrix.dot(q_reduced) if offset is None else matrix.dot(q_reduced) + offset
+            transposed, offset = self._affine
+            q = np.asarray(q_reduced).dot(transposed)
+            return q if offset is None else q + offset
         q = np.empty(self.tree.nq)
         for tree_q, reduced_q, nq in self._copy_slots:
             q[tree_q:tree_q + nq] = q_reduced[reduced_q:reduced_q + nq]
@@ -117,15 +118,17 @@ class Coupling:
         return q
 
     def tangent(self, v_reduced: np.ndarray) -> np.ndarray:
-        """Tree velocity or acceleration (tree.nv,) of a reduced one: G v."""
-        return self.matrix.dot(v_reduced)
+        """Tree velocity or acceleration (tree.nv,) of a reduced one: G v; (N, tree.nv) of (N, reduced.nv)."""
+        return np.asarray(v_reduced).dot(self._transpose)
 
     def project(self, tree_matrix: np.ndarray) -> np.ndarray:
-        """G^T A G for a (tree.nv, tree.nv) matrix A (mass, Coriolis, derivatives)."""
+        """G^T A G for a (..., tree.nv, tree.nv) matrix A (mass, Coriolis, derivatives)."""
         if self._kron is None:
             return self._transpose @ tree_matrix @ self.matrix
+        shape = tree_matrix.shape
+        flat = tree_matrix.reshape(shape[:-2] + (shape[-2] * shape[-1],))
         size = self.matrix.shape[1]
-        return self._kron.dot(tree_matrix.ravel()).reshape(size, size)
+        return flat.dot(self._kron).reshape(shape[:-2] + (size, size))
 
     def project_force(self, tree_torque: np.ndarray) -> np.ndarray:
         """G^T tau: generalized force on the reduced coordinates."""
