@@ -74,6 +74,22 @@ def _solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, 
             (cof_c * r0 + cof_e * r1 + minor2 * r2) / det)
 
 
+def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Callable[..., np.ndarray]:
+    """A Phantom method: the tip's frame Jacobian in ``reference`` of the model rooted at
+    frame s; a closure, so that its fast path is as short as forward_kinematics'."""
+    def method(self: Phantom, theta: object) -> np.ndarray:
+        model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
+        try:  # the fast path, as forward_kinematics'
+            if theta.shape == _ONE and _isfinite(sum(theta.tolist())):
+                return pin.computeFrameJacobian(model, data, theta, tip, reference)
+        except (AttributeError, TypeError):
+            pass
+        return self._each(lambda x: pin.computeFrameJacobian(model, data, x, tip, reference),
+                          ("theta",), theta)
+    method.__name__, method.__qualname__, method.__doc__ = name, f"Phantom.{name}", doc
+    return method
+
+
 class Phantom:
     """The PHANToM 1.5 in the report's coordinates, computed by Pinocchio.
 
@@ -185,14 +201,6 @@ class Phantom:
     def _gravity(self, theta: np.ndarray) -> np.ndarray:
         return pin.computeGeneralizedGravity(self.model, self.data, theta)
 
-    def _spatial_jacobian(self, theta: np.ndarray) -> np.ndarray:
-        return pin.computeFrameJacobian(self._kinematics, self._kinematics_data, theta,
-                                        self._frame_tip, pin.WORLD)
-
-    def _body_jacobian(self, theta: np.ndarray) -> np.ndarray:
-        return pin.computeFrameJacobian(self._kinematics, self._kinematics_data, theta,
-                                        self._frame_tip, pin.LOCAL)
-
     def _batched(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> np.ndarray:
         """rneaInParallel over checked (..., 3) arrays: tau, shape (..., 3), not yet checked."""
         if self._pool is None or self._pool.size() < self.threads:
@@ -206,10 +214,13 @@ class Phantom:
     # -- kinematics ------------------------------------------------------------------
     def forward_kinematics(self, theta: object) -> np.ndarray:
         """Pose g_st of the tool frame t in frame s (eq. 10): shape (..., 4, 4), metres."""
-        if _is_state(theta):  # functions of sines and cosines: finite
-            pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
-            return pin.updateFramePlacement(self._kinematics, self._kinematics_data,
-                                            self._frame_tip).homogeneous
+        try:  # the fast path (_is_state's checks, the dtype left to eigenpy: TypeError)
+            if theta.shape == _ONE and _isfinite(sum(theta.tolist())):  # finite: sin, cos
+                pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
+                return pin.updateFramePlacement(self._kinematics, self._kinematics_data,
+                                                self._frame_tip).homogeneous
+        except (AttributeError, TypeError):
+            pass
         return self._each(self._pose, ("theta",), theta)
 
     def inverse_kinematics(self, position: object, branch: str = "report") -> np.ndarray:
@@ -265,28 +276,20 @@ class Phantom:
             theta = theta + step * min(1.0, _IK_MAX_STEP / np.abs(step).max())
         return None
 
-    def spatial_jacobian(self, theta: object) -> np.ndarray:
-        """Spatial Jacobian J^s (eq. 22): (..., 6, 3), twist (v, omega) in frame s.
+    spatial_jacobian = _frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3), twist (v, omega) in frame s.
 
         Pinocchio's WORLD frame Jacobian of ``tip`` in the model rooted at frame s.
-        """
-        if _is_state(theta):  # results of sines, cosines and constants: finite
-            return pin.computeFrameJacobian(self._kinematics, self._kinematics_data, theta,
-                                            self._frame_tip, pin.WORLD)
-        return self._each(self._spatial_jacobian, ("theta",), theta)
-
-    def body_jacobian(self, theta: object) -> np.ndarray:
-        """Body Jacobian J^b (eq. 24): (..., 6, 3), twist (v, omega) in the tool frame t."""
-        if _is_state(theta):
-            return pin.computeFrameJacobian(self._kinematics, self._kinematics_data, theta,
-                                            self._frame_tip, pin.LOCAL)
-        return self._each(self._body_jacobian, ("theta",), theta)
+        """)
+    body_jacobian = _frame_jacobian("body_jacobian", pin.LOCAL, """Body Jacobian J^b (eq. 24): (..., 6, 3), twist (v, omega) in the tool frame t.""")
 
     # -- dynamics --------------------------------------------------------------------
     def mass_matrix(self, theta: object) -> np.ndarray:
         """Joint-space inertia M(theta) (eqs 81-85), with the rotors' armature: (..., 3, 3)."""
-        if _is_state(theta):
-            return pin.crba(self.model, self.data, theta)
+        try:  # the fast path, as forward_kinematics'
+            if theta.shape == _ONE and _isfinite(sum(theta.tolist())):
+                return pin.crba(self.model, self.data, theta)
+        except (AttributeError, TypeError):
+            pass
         return self._each(self._mass, ("theta",), theta)
 
     def _coriolis(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:

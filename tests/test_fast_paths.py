@@ -168,7 +168,9 @@ def test_fast_paths_return_fresh_arrays(phantom, method, count):
 
 
 @pytest.mark.parametrize("method, third", [("inverse_dynamics", "ddtheta"), ("forward_dynamics", "tau"),
-                                           ("gravity", None)])
+                                           ("gravity", None), ("mass_matrix", None),
+                                           ("forward_kinematics", None), ("spatial_jacobian", None),
+                                           ("body_jacobian", None)])
 def test_shape_only_fast_paths_take_what_the_checked_path_takes(phantom, method, third):
     """These fast paths check shapes and let eigenpy convert: int, bool, float32 and object
     arrays of numbers give the numbers of the checked path; complex and (3, 1) are refused by name."""
