@@ -19,6 +19,8 @@ from phantom_pin.validation import as_states, finite_result, same_batch, wrap_an
 
 #: Relative slack on the law-of-cosines arguments before a target counts as unreachable.
 _ACOS_SLACK = 1e-12
+#: States per chunk of the batched dynamics: the NumPy temporaries of a chunk fit in cache.
+_CHUNK = 8192
 
 
 @functools.lru_cache(maxsize=1)
@@ -137,6 +139,79 @@ def _coefficients(p: Parameters) -> tuple[float, float, float, float]:
     return k1, k2, k3, p.l1 * (p.l2 * p.ma + p.l3 * p.mc)
 
 
+class _Trig:
+    """sin and cos of theta2, theta3 (rad), evaluated once for every equation below; the
+    double and difference angles by their identities."""
+
+    def __init__(self, t2: np.ndarray, t3: np.ndarray) -> None:
+        self.s2, self.c2, self.s3, self.c3 = np.sin(t2), np.cos(t2), np.sin(t3), np.cos(t3)
+
+    def sin_2(self) -> np.ndarray:       # sin 2 theta2
+        return 2 * self.s2 * self.c2
+
+    def cos_2(self) -> np.ndarray:       # cos 2 theta2
+        return 1 - 2 * self.s2 * self.s2
+
+    def sin_3(self) -> np.ndarray:       # sin 2 theta3
+        return 2 * self.s3 * self.c3
+
+    def cos_3(self) -> np.ndarray:       # cos 2 theta3
+        return 1 - 2 * self.s3 * self.s3
+
+    def sin_23(self) -> np.ndarray:      # sin(theta2 - theta3)
+        return self.s2 * self.c3 - self.c2 * self.s3
+
+    def cos_23(self) -> np.ndarray:      # cos(theta2 - theta3)
+        return self.c2 * self.c3 + self.s2 * self.s3
+
+
+# The equations, each written once as its nonzero entries {(row, column): value}; the
+# functions below assemble matrices from them, and inverse_dynamics sums them per component
+# (no (N, 3, 3) intermediates: a batch runs at NumPy's speed on (N,) arrays).
+
+def _mass_entries(trig: _Trig, p: Parameters) -> dict[tuple[int, int], np.ndarray | float]:
+    k1, k2, k3, lam = _coefficients(p)
+    m12 = -lam / 2 * trig.sin_23()                                                  # eqs 83-84
+    return {
+        (0, 0): k1 + k2 / 8 * trig.cos_2() + k3 / 8 * trig.cos_3() + lam * trig.c2 * trig.s3,  # eq 81
+        (1, 1): p.Ibexx + p.Icxx + p.l1**2 * p.ma + p.l1**2 * p.mc / 4,             # eq 82 (E8)
+        (1, 2): m12, (2, 1): m12,
+        (2, 2): p.Iaxx + p.Idfxx + p.l2**2 * p.ma / 4 + p.l3**2 * p.mc,             # eq 85
+    }
+
+
+def _coriolis_entries(trig: _Trig, d1: np.ndarray, d2: np.ndarray, d3: np.ndarray,
+                      p: Parameters) -> dict[tuple[int, int], np.ndarray]:
+    _, k2, k3, lam = _coefficients(p)
+    # a = (k2 sin 2theta2 + 4 L sin theta2 sin theta3) / 8, b = (4 L cos theta2 cos theta3
+    # - k3 sin 2theta3) / 8, with sin 2x = 2 sin x cos x, factored
+    a = trig.s2 * (k2 / 4 * trig.c2 + lam / 2 * trig.s3)
+    b = trig.c3 * (lam / 2 * trig.c2 - k3 / 4 * trig.s3)
+    h = lam / 2 * trig.cos_23()
+    a_d1, b_d1 = a * d1, b * d1
+    return {
+        (0, 0): b * d3 - a * d2,                                                    # eq 86
+        (0, 1): -a_d1,                                                              # eq 87
+        (0, 2): b_d1,                                                               # eq 88
+        (1, 0): a_d1,                                                               # eq 89
+        (1, 2): h * d3,                                                             # eq 90
+        (2, 0): -b_d1,                                                              # eq 91
+        (2, 1): -h * d2,                                                            # eq 92
+    }
+
+
+def _gravity_entries(trig: _Trig, p: Parameters) -> dict[int, np.ndarray]:
+    return {1: p.g / 2 * (2 * p.l1 * p.ma + 2 * p.l5 * p.mbe + p.l1 * p.mc) * trig.c2,  # eq 93
+            2: p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf) * trig.s3}  # eq 94
+
+
+def _matrix(entries: dict[tuple[int, int], np.ndarray | float], shape: tuple[int, ...]) -> np.ndarray:
+    out = np.zeros(shape + (3, 3))
+    for (i, j), value in entries.items():
+        out[..., i, j] = value
+    return out
+
+
 def mass_matrix(theta: object, params: Parameters | None = None) -> np.ndarray:
     """Joint-space inertia matrix M(theta), eqs 81-85 (corrected): (..., 3, 3), kg m^2.
 
@@ -145,13 +220,7 @@ def mass_matrix(theta: object, params: Parameters | None = None) -> np.ndarray:
     """
     p = params or shipped_parameters()
     _, t2, t3 = _state(theta)
-    k1, k2, k3, lam = _coefficients(p)
-    m = np.zeros(t2.shape + (3, 3))
-    m[..., 0, 0] = k1 + k2 / 8 * np.cos(2 * t2) + k3 / 8 * np.cos(2 * t3) + lam * np.cos(t2) * np.sin(t3)
-    m[..., 1, 1] = p.Ibexx + p.Icxx + p.l1**2 * p.ma + p.l1**2 * p.mc / 4           # eq 82 (E8)
-    m[..., 1, 2] = m[..., 2, 1] = -lam / 2 * np.sin(t2 - t3)                        # eqs 83-84
-    m[..., 2, 2] = p.Iaxx + p.Idfxx + p.l2**2 * p.ma / 4 + p.l3**2 * p.mc           # eq 85
-    return m
+    return _matrix(_mass_entries(_Trig(t2, t3), p), t2.shape)
 
 
 def coriolis_matrix(theta: object, dtheta: object, params: Parameters | None = None) -> np.ndarray:
@@ -164,18 +233,7 @@ def coriolis_matrix(theta: object, dtheta: object, params: Parameters | None = N
     _, t2, t3 = _state(theta)
     d1, d2, d3 = _state(dtheta, "dtheta")
     same_batch(("theta", "dtheta"), t2, d1)
-    _, k2, k3, lam = _coefficients(p)
-    a = k2 * np.sin(2 * t2) + 4 * lam * np.sin(t2) * np.sin(t3)
-    b = 4 * lam * np.cos(t2) * np.cos(t3) - k3 * np.sin(2 * t3)
-    c = np.zeros(t2.shape + (3, 3))
-    c[..., 0, 0] = (-a * d2 + b * d3) / 8                                           # eq 86
-    c[..., 0, 1] = -a * d1 / 8                                                      # eq 87
-    c[..., 0, 2] = b * d1 / 8                                                       # eq 88
-    c[..., 1, 0] = a * d1 / 8                                                       # eq 89
-    c[..., 1, 2] = lam / 2 * np.cos(t2 - t3) * d3                                   # eq 90
-    c[..., 2, 0] = -b * d1 / 8                                                      # eq 91
-    c[..., 2, 1] = -lam / 2 * np.cos(t2 - t3) * d2                                  # eq 92
-    return c
+    return _matrix(_coriolis_entries(_Trig(t2, t3), d1, d2, d3, p), t2.shape)
 
 
 def gravity(theta: object, params: Parameters | None = None) -> np.ndarray:
@@ -183,8 +241,8 @@ def gravity(theta: object, params: Parameters | None = None) -> np.ndarray:
     p = params or shipped_parameters()
     _, t2, t3 = _state(theta)
     n = np.zeros(t2.shape + (3,))
-    n[..., 1] = p.g / 2 * (2 * p.l1 * p.ma + 2 * p.l5 * p.mbe + p.l1 * p.mc) * np.cos(t2)
-    n[..., 2] = p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf) * np.sin(t3)
+    for i, value in _gravity_entries(_Trig(t2, t3), p).items():
+        n[..., i] = value
     return n
 
 
@@ -208,8 +266,18 @@ def inverse_dynamics(theta: object, dtheta: object, ddtheta: object,
     vel, _ = as_states(dtheta, "dtheta")
     pos, _ = as_states(theta, "theta")
     same_batch(("theta", "dtheta", "ddtheta"), pos, vel, acc)
-    m = mass_matrix(pos, p)
-    c = coriolis_matrix(pos, vel, p)
+    flat = [x.reshape(-1, 3) for x in (pos, vel, acc)]
+    tau = np.empty(flat[0].shape)
     with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result
-        return finite_result((m @ acc[..., None])[..., 0] + (c @ vel[..., None])[..., 0] + gravity(pos, p),
-                             "theta, dtheta, ddtheta")
+        for start in range(0, len(tau), _CHUNK):  # chunks: the temporaries stay in cache
+            t, d, a = (np.ascontiguousarray(x[start:start + _CHUNK].T) for x in flat)
+            trig = _Trig(t[1], t[2])
+            out = np.zeros(t.shape)
+            for (i, j), value in _mass_entries(trig, p).items():
+                out[i] += value * a[j]
+            for (i, j), value in _coriolis_entries(trig, d[0], d[1], d[2], p).items():
+                out[i] += value * d[j]
+            for i, value in _gravity_entries(trig, p).items():
+                out[i] += value
+            tau[start:start + _CHUNK] = out.T
+    return finite_result(tau.reshape(pos.shape), "theta, dtheta, ddtheta")

@@ -18,6 +18,9 @@ import pinocchio as pin
 
 from phantom_pin.exceptions import ParameterFileError
 
+#: Largest tree model (velocity dimension) whose projections use the Kronecker product.
+_KRON_MAX_NV = 16
+
 
 @dataclasses.dataclass(frozen=True)
 class Mimic:
@@ -71,6 +74,17 @@ class Coupling:
                 self.matrix[joint.idx_v:joint.idx_v + joint.nv,
                             source.idx_v:source.idx_v + joint.nv] = np.eye(joint.nv)
                 self._copy_slots.append((joint.idx_q, source.idx_q, joint.nq))
+        self._transpose = np.ascontiguousarray(self.matrix.T)
+        # G^T A G = reshape(A.ravel() . (G kron G)): one product instead of two, for small
+        # models (the Kronecker product has (tree.nv reduced.nv)^2 entries)
+        self._kron = np.kron(self.matrix, self.matrix) if self.tree.nv <= _KRON_MAX_NV else None
+        # with only 1-coordinate joints, the configuration map is affine: q_tree = A q + b
+        self._affine: tuple[np.ndarray, np.ndarray | None] | None = None
+        if self.tree.nq == self.tree.nv and self.reduced.nq == self.reduced.nv:
+            offset = np.zeros(self.tree.nq)
+            for tree_q, _, _, _, _, angle in self._mimic_slots:
+                offset[tree_q] = angle
+            self._affine = self._transpose.copy(), (offset if offset.any() else None)
 
     def _add_mimic(self, joint: pin.JointModel, tag: Mimic) -> None:
         if tag.primary in self.mimics:
@@ -85,7 +99,12 @@ class Coupling:
                                   tag.multiplier, tag.offset))
 
     def configuration(self, q_reduced: np.ndarray) -> np.ndarray:
-        """Tree configuration (tree.nq,) of a reduced configuration (reduced.nq,)."""
+        """Tree configuration (tree.nq,) of a reduced configuration (reduced.nq,); a batch
+        (N, reduced.nq) too when every joint has one coordinate (no continuous joints)."""
+        if self._affine is not None:
+            transposed, offset = self._affine
+            q = np.asarray(q_reduced).dot(transposed)
+            return q if offset is None else q + offset
         q = np.empty(self.tree.nq)
         for tree_q, reduced_q, nq in self._copy_slots:
             q[tree_q:tree_q + nq] = q_reduced[reduced_q:reduced_q + nq]
@@ -99,16 +118,21 @@ class Coupling:
         return q
 
     def tangent(self, v_reduced: np.ndarray) -> np.ndarray:
-        """Tree velocity or acceleration (tree.nv,) of a reduced one: G v."""
-        return self.matrix @ v_reduced
+        """Tree velocity or acceleration (tree.nv,) of a reduced one: G v; (N, tree.nv) of (N, reduced.nv)."""
+        return np.asarray(v_reduced).dot(self._transpose)
 
     def project(self, tree_matrix: np.ndarray) -> np.ndarray:
-        """G^T A G for a (tree.nv, tree.nv) matrix A (mass, Coriolis, derivatives)."""
-        return self.matrix.T @ tree_matrix @ self.matrix
+        """G^T A G for a (..., tree.nv, tree.nv) matrix A (mass, Coriolis, derivatives)."""
+        if self._kron is None:
+            return self._transpose @ tree_matrix @ self.matrix
+        shape = tree_matrix.shape
+        flat = tree_matrix.reshape(shape[:-2] + (shape[-2] * shape[-1],))
+        size = self.matrix.shape[1]
+        return flat.dot(self._kron).reshape(shape[:-2] + (size, size))
 
     def project_force(self, tree_torque: np.ndarray) -> np.ndarray:
         """G^T tau: generalized force on the reduced coordinates."""
-        return self.matrix.T @ tree_torque
+        return self._transpose @ tree_torque
 
     def project_jacobian(self, tree_jacobian: np.ndarray) -> np.ndarray:
         """J G: a (k, tree.nv) Jacobian as a Jacobian of the reduced coordinates."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -31,6 +31,63 @@ _IK_SEEDS = {"report": ((0.35, 0.3), (0.9, 1.0)), "other": ((-0.35, -2.8), (0.9,
 
 
 _FLOAT = np.dtype(float)  # a singleton: ``array.dtype is _FLOAT`` for float64 arrays
+_ONE = (3,)
+_isfinite = math.isfinite
+
+
+def _finite(array: np.ndarray) -> bool:
+    """Cheap: True if ``array`` holds no NaN or inf (False also when its sum overflows,
+    which only sends the caller to its slow path, where the full checks name the culprit)."""
+    return math.isfinite(sum(array.ravel("K").tolist()))
+
+
+def _is_state(value: object) -> bool:
+    """True for a finite float64 ndarray of shape (3,). The fast paths take such inputs
+    and, where rates enter (products that can overflow), check their results; anything
+    else goes through as_states, whose errors name the argument."""
+    return (type(value) is np.ndarray and value.shape == _ONE and value.dtype is _FLOAT
+            and _isfinite(sum(value.tolist())))
+
+
+def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray) -> np.ndarray:
+    """``function`` of each row of ``arrays`` (each (N, k)), stacked into one new array."""
+    first = function(*(a[0] for a in arrays))
+    out = np.empty((len(arrays[0]),) + np.shape(first))
+    out[0] = first
+    for i, row in enumerate(zip(*(a[1:] for a in arrays)), 1):
+        out[i] = function(*row)
+    return out
+
+
+def _solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:
+    """x with m x = r for a symmetric 3x3 ``m`` (nested lists; the upper triangle is read),
+    by its adjugate; None unless m is positive definite (Sylvester: leading minors > 0)."""
+    (a, b, c), (_, d, e), (_, _, f) = m
+    cof_a, cof_b, cof_c = d * f - e * e, c * e - b * f, b * e - c * d
+    minor2, det = a * d - b * b, a * cof_a + b * cof_b + c * cof_c
+    if not (a > 0 and minor2 > 0 and det > 0):
+        return None
+    cof_d, cof_e = a * f - c * c, b * c - a * e
+    r0, r1, r2 = r
+    return ((cof_a * r0 + cof_b * r1 + cof_c * r2) / det,
+            (cof_b * r0 + cof_d * r1 + cof_e * r2) / det,
+            (cof_c * r0 + cof_e * r1 + minor2 * r2) / det)
+
+
+def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Callable[..., np.ndarray]:
+    """A Phantom method: the tip's frame Jacobian in ``reference`` of the model rooted at
+    frame s; a closure, so that its fast path is as short as forward_kinematics'."""
+    def method(self: Phantom, theta: object) -> np.ndarray:
+        model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
+        try:  # the fast path, as forward_kinematics'
+            if theta.shape == _ONE and _isfinite(sum(theta.tolist())):
+                return pin.computeFrameJacobian(model, data, theta, tip, reference)
+        except (AttributeError, TypeError):
+            pass
+        return self._each(lambda x: pin.computeFrameJacobian(model, data, x, tip, reference),
+                          ("theta",), theta)
+    method.__name__, method.__qualname__, method.__doc__ = name, f"Phantom.{name}", doc
+    return method
 
 
 class Phantom:
@@ -71,12 +128,27 @@ class Phantom:
         self._frame_s = self.model.getFrameId("report_s")
         self._frame_tip = self.model.getFrameId("tip")
         pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
-        #: report_s is fixed to base_link: Ad(g_s^-1) maps world twists to frame s.
-        self._world_to_s = self.data.oMf[self._frame_s].inverse().action
+        # report_s is fixed to the world: a copy of the model whose world is frame s gives
+        # g_st and J^s directly (its joints' placements on the world premultiplied by g_s^-1)
+        self._kinematics = self._rooted_at(self.data.oMf[self._frame_s].inverse())
+        self._kinematics_data = self._kinematics.createData()
         self.threads = os.cpu_count() or 1
         self._pool: pin.ModelPool | None = None
 
     # -- helpers ---------------------------------------------------------------------
+    def _rooted_at(self, world_to_s: pin.SE3) -> pin.Model:
+        """A copy of the model expressed in frame s: every placement on the world, joints'
+        and frames', premultiplied by ``world_to_s`` (gravity rotated alike)."""
+        model = self.model.copy()
+        for jid in range(1, model.njoints):
+            if model.parents[jid] == 0:
+                model.jointPlacements[jid] = world_to_s * model.jointPlacements[jid]
+        for frame in model.frames:
+            if frame.parentJoint == 0:
+                frame.placement = world_to_s * frame.placement
+        model.gravity = world_to_s.act(model.gravity)
+        return model
+
     @staticmethod
     def _states(names: tuple[str, ...], *values: object) -> list[np.ndarray]:
         arrays = [as_states(v, n)[0] for n, v in zip(names, values)]
@@ -90,11 +162,20 @@ class Phantom:
         leading axes; raise InvalidInputError naming them if the result is not finite."""
         arrays = cls._states(names, *values)
         if arrays[0].ndim == 1:
-            out = function(*arrays)
-        else:
-            out = np.stack([function(*row) for row in zip(*(a.reshape(-1, 3) for a in arrays))])
-            out = out.reshape(arrays[0].shape[:-1] + out.shape[1:])
-        return finite_result(out, ", ".join(names))
+            return finite_result(function(*arrays), ", ".join(names))
+        out = _rows(function, *(a.reshape(-1, a.shape[-1]) for a in arrays))
+        return finite_result(out.reshape(arrays[0].shape[:-1] + out.shape[1:]), ", ".join(names))
+
+    def _tree_batch(self, function: Callable[..., np.ndarray], names: tuple[str, ...],
+                    theta: np.ndarray, *rates: np.ndarray) -> np.ndarray:
+        """``function`` of tree configurations and tangents over checked batches (..., 3):
+        the coupling maps the whole batch, Pinocchio runs per row, the results (N, ...,
+        tree.nv, tree.nv) are projected at once; checked for finiteness."""
+        coupling = self.coupling
+        tree = _rows(function, coupling.configuration(theta.reshape(-1, 3)),
+                     *(coupling.tangent(r.reshape(-1, 3)) for r in rates))
+        out = coupling.project(tree)
+        return finite_result(out.reshape(theta.shape[:-1] + out.shape[1:]), ", ".join(names))
 
     def within_limits(self, theta: object) -> bool | np.ndarray:
         """True where ``theta`` (rad), shape (3,) or (..., 3), lies inside the URDF's box
@@ -107,19 +188,40 @@ class Phantom:
         """
         return within_box(theta, self.model.lowerPositionLimit, self.model.upperPositionLimit)
 
-    def _placement(self, theta: np.ndarray) -> pin.SE3:
-        """Pose of tip in report_s after forward kinematics at theta."""
-        pin.framesForwardKinematics(self.model, self.data, theta)
-        return self.data.oMf[self._frame_s].actInv(self.data.oMf[self._frame_tip])
+    def _pose(self, theta: np.ndarray) -> np.ndarray:
+        """g_st (4, 4) at theta: the tip's placement in the model rooted at frame s."""
+        pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
+        return pin.updateFramePlacement(self._kinematics, self._kinematics_data,
+                                        self._frame_tip).homogeneous
 
-    def _symmetric_mass(self, theta: np.ndarray) -> np.ndarray:
-        upper = pin.crba(self.model, self.data, theta)
-        return np.triu(upper) + np.triu(upper, 1).T
+    def _mass(self, theta: np.ndarray) -> np.ndarray:
+        # the binding of crba returns the full symmetric matrix (DEVELOPERS.md), not data.M
+        return pin.crba(self.model, self.data, theta)
+
+    def _gravity(self, theta: np.ndarray) -> np.ndarray:
+        return pin.computeGeneralizedGravity(self.model, self.data, theta)
+
+    def _batched(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> np.ndarray:
+        """rneaInParallel over checked (..., 3) arrays: tau, shape (..., 3), not yet checked."""
+        if self._pool is None or self._pool.size() < self.threads:
+            self._pool = pin.ModelPool(self.model, self.threads)
+        shape = theta.shape
+        tau = np.empty((3, math.prod(shape[:-1])), order="F")
+        pin.rneaInParallel(self.threads, self._pool, theta.reshape(-1, 3).T,
+                           dtheta.reshape(-1, 3).T, ddtheta.reshape(-1, 3).T, tau)
+        return tau.T.reshape(shape)
 
     # -- kinematics ------------------------------------------------------------------
     def forward_kinematics(self, theta: object) -> np.ndarray:
         """Pose g_st of the tool frame t in frame s (eq. 10): shape (..., 4, 4), metres."""
-        return self._each(lambda x: self._placement(x).homogeneous, ("theta",), theta)
+        try:  # the fast path (_is_state's checks, the dtype left to eigenpy: TypeError)
+            if theta.shape == _ONE and _isfinite(sum(theta.tolist())):  # finite: sin, cos
+                pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
+                return pin.updateFramePlacement(self._kinematics, self._kinematics_data,
+                                                self._frame_tip).homogeneous
+        except (AttributeError, TypeError):
+            pass
+        return self._each(self._pose, ("theta",), theta)
 
     def inverse_kinematics(self, position: object, branch: str = "report") -> np.ndarray:
         """Joint angles (rad) that put the tip at ``position`` (m, frame s).
@@ -138,8 +240,8 @@ class Phantom:
 
     def _solve_ik(self, target: np.ndarray, branch: str) -> np.ndarray:
         p = self.parameters
-        shoulder = np.array([0.0, p.l2, -p.l1])  # the shoulder in frame s (eqs 4-5)
-        distance = float(np.linalg.norm(target - shoulder))
+        x, y, z = target.tolist()
+        distance = math.hypot(x, y - p.l2, z + p.l1)  # from the shoulder (0, l2, -l1) in s
         if not abs(p.l1 - p.l2) * (1 - 1e-12) <= distance <= (p.l1 + p.l2) * (1 + 1e-12):
             raise UnreachableTargetError(
                 f"position: {np.array2string(target, precision=4)} m is {distance:.4f} m from "
@@ -147,7 +249,7 @@ class Phantom:
                 f"{p.l1 + p.l2:.4f}] m")
         sign = 1.0 if branch == "report" else -1.0
         for seed in _IK_SEEDS[branch]:
-            theta = self._newton(target, np.array([math.atan2(target[0], target[2] + p.l1), *seed]))
+            theta = self._newton((x, y, z), np.array([math.atan2(x, z + p.l1), *seed]))
             # the report's branch has the elbow open forwards, cos(theta3 - theta2) =
             # sin(alpha) >= 0; on the shell's boundaries (alpha = 0 or pi) both branches
             # meet, where Newton's angles are good to about sqrt(tolerance / l) ~ 1e-6 rad
@@ -156,41 +258,44 @@ class Phantom:
         raise UnreachableTargetError(
             f"position: no {branch}-branch solution found for {target} m")
 
-    def _newton(self, target: np.ndarray, theta: np.ndarray) -> np.ndarray | None:
+    def _newton(self, target: tuple[float, float, float], theta: np.ndarray) -> np.ndarray | None:
         """Damped Newton on the tip position from ``theta``; None if it does not converge."""
+        model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
         for _ in range(_IK_ITERATIONS):
-            tip = self._placement(theta).translation
-            error = target - tip
-            if np.linalg.norm(error) < _IK_TOLERANCE:
+            # rows 0-2 of the LOCAL_WORLD_ALIGNED Jacobian: the tip point's velocity in s
+            linear = pin.computeFrameJacobian(model, data, theta, tip, pin.LOCAL_WORLD_ALIGNED)[:3]
+            error = [t - x for t, x in zip(target, data.oMf[tip].translation.tolist())]
+            if math.hypot(*error) < _IK_TOLERANCE:
                 return theta
-            jacobian = self._spatial_jacobian(theta)
-            # velocity of the tip point in s: v + omega x p (J^s is taken at s's origin)
-            linear = jacobian[:3] + np.cross(jacobian[3:].T, tip).T
-            step = np.linalg.solve(linear.T @ linear + _IK_DAMPING * np.eye(3), linear.T @ error)
+            normal = (linear.T @ linear).tolist()
+            for i in range(3):
+                normal[i][i] += _IK_DAMPING
+            gradient = (linear.T @ error).tolist()
+            step = _solve_spd(normal, gradient)
+            step = np.linalg.solve(np.array(normal), gradient) if step is None else np.array(step)
             theta = theta + step * min(1.0, _IK_MAX_STEP / np.abs(step).max())
         return None
 
-    def _spatial_jacobian(self, theta: np.ndarray) -> np.ndarray:
-        return self._world_to_s @ pin.computeFrameJacobian(self.model, self.data, theta,
-                                                            self._frame_tip, pin.WORLD)
+    spatial_jacobian = _frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3), twist (v, omega) in frame s.
 
-    def spatial_jacobian(self, theta: object) -> np.ndarray:
-        """Spatial Jacobian J^s (eq. 22): (..., 6, 3), twist (v, omega) in frame s.
-
-        Pinocchio's WORLD frame Jacobian of ``tip``, moved to frame s by Ad(g_s^-1).
-        """
-        return self._each(self._spatial_jacobian, ("theta",), theta)
-
-    def body_jacobian(self, theta: object) -> np.ndarray:
-        """Body Jacobian J^b (eq. 24): (..., 6, 3), twist (v, omega) in the tool frame t."""
-        def one(x: np.ndarray) -> np.ndarray:
-            return pin.computeFrameJacobian(self.model, self.data, x, self._frame_tip, pin.LOCAL)
-        return self._each(one, ("theta",), theta)
+        Pinocchio's WORLD frame Jacobian of ``tip`` in the model rooted at frame s.
+        """)
+    body_jacobian = _frame_jacobian("body_jacobian", pin.LOCAL, """Body Jacobian J^b (eq. 24): (..., 6, 3), twist (v, omega) in the tool frame t.""")
 
     # -- dynamics --------------------------------------------------------------------
     def mass_matrix(self, theta: object) -> np.ndarray:
         """Joint-space inertia M(theta) (eqs 81-85), with the rotors' armature: (..., 3, 3)."""
-        return self._each(self._symmetric_mass, ("theta",), theta)
+        try:  # the fast path, as forward_kinematics'
+            if theta.shape == _ONE and _isfinite(sum(theta.tolist())):
+                return pin.crba(self.model, self.data, theta)
+        except (AttributeError, TypeError):
+            pass
+        return self._each(self._mass, ("theta",), theta)
+
+    def _coriolis(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
+        coupling = self.coupling
+        return coupling.project(pin.computeCoriolisMatrix(
+            coupling.tree, self._tree_data, coupling.configuration(theta), coupling.tangent(dtheta)))
 
     def coriolis_matrix(self, theta: object, dtheta: object) -> np.ndarray:
         """Coriolis matrix C(theta, dtheta) (eqs 86-92): (..., 3, 3), N m s/rad.
@@ -198,18 +303,34 @@ class Phantom:
         Pinocchio's computeCoriolisMatrix is silently wrong on mimic models, so it runs
         on the tree model and is projected: C = G^T C_tree G.
         """
-        tree, coupling = self.coupling.tree, self.coupling
-
-        def one(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
-            c = pin.computeCoriolisMatrix(tree, self._tree_data, coupling.configuration(x),
-                                          coupling.tangent(dx))
-            return coupling.project(c)
-        return self._each(one, ("theta", "dtheta"), theta, dtheta)
+        if _is_state(theta) and _is_state(dtheta):  # (inf * 0 in G dtheta would warn)
+            out = self._coriolis(theta, dtheta)
+            if _finite(out):
+                return out
+        names = ("theta", "dtheta")
+        q, v = self._states(names, theta, dtheta)
+        if q.ndim == 1:
+            return finite_result(self._coriolis(q, v), ", ".join(names))
+        tree, data = self.coupling.tree, self._tree_data
+        return self._tree_batch(lambda x, dx: pin.computeCoriolisMatrix(tree, data, x, dx), names, q, v)
 
     def gravity(self, theta: object) -> np.ndarray:
-        """Gravity torque N(theta) (eqs 93-94): (..., 3), N m."""
-        return self._each(lambda x: pin.computeGeneralizedGravity(self.model, self.data, x).copy(),
-                          ("theta",), theta)
+        """Gravity torque N(theta) (eqs 93-94): (..., 3), N m.
+
+        A batch: rnea at zero rates and accelerations, by rneaInParallel.
+        """
+        try:  # the fast path, as inverse_dynamics': NaN/inf in theta reaches N
+            if theta.shape == _ONE:
+                torque = pin.computeGeneralizedGravity(self.model, self.data, theta)
+                if _isfinite(sum(torque.tolist())):
+                    return torque
+        except (AttributeError, TypeError):
+            pass
+        (q,) = self._states(("theta",), theta)
+        if q.ndim == 1:
+            return finite_result(self._gravity(q), "theta")
+        zero = np.zeros_like(q)
+        return finite_result(self._batched(q, zero, zero), "theta")
 
     def potential_energy(self, theta: object) -> np.ndarray:
         """Potential energy V(theta) (J), zero with every centre of mass at shoulder height."""
@@ -225,37 +346,65 @@ class Phantom:
         One state: pinocchio.rnea on the mimic model. A batch (N, 3):
         pinocchio.rneaInParallel over ``threads`` OpenMP threads.
         """
-        if (type(theta) is type(dtheta) is type(ddtheta) is np.ndarray  # the fast path: one
-                and theta.dtype is dtheta.dtype is ddtheta.dtype is _FLOAT     # real state (3,)
-                and theta.shape == dtheta.shape == ddtheta.shape == (3,)):
-            tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)
-            # NaN/inf in any input, or an overflow, reaches tau; only then are the
-            # inputs inspected, to name the bad one.
-            if math.isfinite(tau[0]) and math.isfinite(tau[1]) and math.isfinite(tau[2]):
-                return tau.copy()
+        try:  # the fast path: one state (3,); eigenpy refuses (TypeError) complex and object
+            if theta.shape == dtheta.shape == ddtheta.shape == _ONE:  # arrays, converts others
+                tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
+                # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
+                # only then are the inputs inspected, to name the bad one.
+                if _isfinite(sum(tau.tolist())):
+                    return tau
+        except (AttributeError, TypeError):  # no shape (lists), or not for eigenpy
+            pass
         names = ("theta", "dtheta", "ddtheta")
         q, v, a = self._states(names, theta, dtheta, ddtheta)
         if q.ndim == 1:
-            return finite_result(pin.rnea(self.model, self.data, q, v, a).copy(), ", ".join(names))
-        if self._pool is None or self._pool.size() < self.threads:
-            self._pool = pin.ModelPool(self.model, self.threads)
-        shape = q.shape
-        tau = np.empty((3, math.prod(shape[:-1])), order="F")
-        pin.rneaInParallel(self.threads, self._pool, q.reshape(-1, 3).T, v.reshape(-1, 3).T,
-                           a.reshape(-1, 3).T, tau)
-        return finite_result(tau.T.reshape(shape), ", ".join(names))
+            return finite_result(pin.rnea(self.model, self.data, q, v, a), ", ".join(names))
+        return finite_result(self._batched(q, v, a), ", ".join(names))
+
+    def _forward(self, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
+        mass = pin.crba(self.model, self.data, theta)
+        acc = _solve_spd(mass.tolist(), [t - b for t, b in zip(tau.tolist(), bias)])
+        if acc is None:  # M not positive definite (or not finite): Cholesky decides, as ever
+            factor = np.linalg.cholesky(mass)
+            return np.linalg.solve(factor.T, np.linalg.solve(factor, tau - bias))
+        return np.array(acc)
 
     def forward_dynamics(self, theta: object, dtheta: object, tau: object) -> np.ndarray:
         """Joint accelerations (rad/s^2) under torques ``tau`` (N m): M^-1 (tau - C dtheta - N).
 
         pinocchio.aba refuses mimic models, so M (crba) and the bias torques
-        (nonLinearEffects) come from Pinocchio and the 3x3 system is solved by Cholesky.
+        (nonLinearEffects) come from Pinocchio and the symmetric 3x3 system is solved by
+        its adjugate; np.linalg.cholesky raises LinAlgError if M is not positive definite.
+        A batch: the bias torques by rneaInParallel, M per state, one batched solve.
         """
-        def one(x: np.ndarray, dx: np.ndarray, torque: np.ndarray) -> np.ndarray:
-            bias = pin.nonLinearEffects(self.model, self.data, x, dx)
-            factor = np.linalg.cholesky(self._symmetric_mass(x))
-            return np.linalg.solve(factor.T, np.linalg.solve(factor, torque - bias))
-        return self._each(one, ("theta", "dtheta", "tau"), theta, dtheta, tau)
+        try:  # the fast path, as inverse_dynamics': NaN/inf in dtheta or tau reaches every
+            # acceleration (0 * NaN is NaN); theta1 enters neither M nor the bias torques,
+            # so theta is checked first
+            if theta.shape == dtheta.shape == tau.shape == _ONE and _isfinite(sum(theta.tolist())):
+                bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
+                t0, t1, t2 = tau.tolist()
+                acc = _solve_spd(pin.crba(self.model, self.data, theta).tolist(),
+                                 (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
+                if acc is not None and _isfinite(sum(acc)):  # rates can overflow
+                    return np.array(acc)
+        except (AttributeError, TypeError):  # no shape, not for eigenpy, complex tau
+            pass
+        names = ("theta", "dtheta", "tau")
+        q, v, torque = self._states(names, theta, dtheta, tau)
+        if q.ndim == 1:
+            return finite_result(self._forward(q, v, torque), ", ".join(names))
+        with np.errstate(invalid="ignore", over="ignore"):  # reported by finite_result
+            rhs = torque - self._batched(q, v, np.zeros_like(q))
+        mass = self._each(self._mass, ("theta",), q)
+        np.linalg.cholesky(mass)  # LinAlgError unless every M is positive definite
+        acc = np.linalg.solve(mass, rhs[..., None])[..., 0]
+        return finite_result(acc, ", ".join(names))
+
+    def _tree_derivatives(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> np.ndarray:
+        """d tau_tree / d q and d tau_tree / d v of the tree model, (2, tree.nv, tree.nv)."""
+        return np.array(pin.computeRNEADerivatives(self.coupling.tree, self._tree_data, theta,
+                                                   dtheta, ddtheta)[:2])
 
     def inverse_dynamics_derivatives(self, theta: object, dtheta: object,
                                      ddtheta: object) -> tuple[np.ndarray, np.ndarray]:
@@ -264,12 +413,17 @@ class Phantom:
         Pinocchio's RNEA derivatives refuse mimic models; they run on the tree model
         and are projected: d tau/d theta = G^T (d tau_tree/d q) G, and likewise for dtheta.
         """
-        tree, coupling = self.coupling.tree, self.coupling
-
-        def one(x: np.ndarray, dx: np.ndarray, ddx: np.ndarray) -> np.ndarray:
-            d_q, d_v, _ = pin.computeRNEADerivatives(
-                tree, self._tree_data, coupling.configuration(x), coupling.tangent(dx),
-                coupling.tangent(ddx))
-            return np.stack([coupling.project(d_q), coupling.project(d_v)])
-        both = self._each(one, ("theta", "dtheta", "ddtheta"), theta, dtheta, ddtheta)
+        coupling = self.coupling
+        if _is_state(theta) and _is_state(dtheta) and _is_state(ddtheta):
+            both = coupling.project(self._tree_derivatives(
+                coupling.configuration(theta), coupling.tangent(dtheta), coupling.tangent(ddtheta)))
+            if _finite(both):
+                return both[0], both[1]
+        names = ("theta", "dtheta", "ddtheta")
+        q, v, a = self._states(names, theta, dtheta, ddtheta)
+        if q.ndim == 1:
+            both = finite_result(coupling.project(self._tree_derivatives(
+                coupling.configuration(q), coupling.tangent(v), coupling.tangent(a))), ", ".join(names))
+        else:
+            both = self._tree_batch(self._tree_derivatives, names, q, v, a)
         return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()

@@ -1,0 +1,187 @@
+"""The fast paths of issue 11 against the slow ones: single-state float64 shortcuts, batches
+checked once, closed_form's chunked batches; and the Pinocchio facts they rely on."""
+
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from conftest import relative_error
+from phantom_pin import InvalidInputError, closed_form as cf
+from phantom_pin.coupling import Coupling
+from phantom_pin.model import _solve_spd
+from phantom_pin.paths import URDF_PATH
+
+# method, number of (3,) arguments; inverse_kinematics takes positions (below)
+METHODS = [("forward_kinematics", 1), ("spatial_jacobian", 1), ("body_jacobian", 1),
+           ("mass_matrix", 1), ("gravity", 1), ("potential_energy", 1), ("coriolis_matrix", 2),
+           ("inverse_dynamics", 3), ("forward_dynamics", 3), ("inverse_dynamics_derivatives", 3)]
+
+
+def _arguments(states, method, count):
+    values = list(states[:count])
+    if method == "forward_dynamics":
+        values[2] = cf.inverse_dynamics(*states)
+    return values
+
+
+def _stacked(result):
+    return np.stack(result) if isinstance(result, tuple) else result
+
+
+def test_crba_binding_returns_the_full_symmetric_matrix(phantom, states):
+    """Phantom.mass_matrix returns pin.crba's result as it is: the binding fills the lower
+    triangle (data.M holds only the upper one). Bit-identical to the symmetrised matrix over
+    every state; a Pinocchio returning the upper triangle alone fails here (and against
+    closed_form in test_model.py)."""
+    data = phantom.model.createData()
+    for theta in states[0]:
+        m = pin.crba(phantom.model, data, theta)
+        assert m[1, 2] != 0
+        np.testing.assert_array_equal(m, np.triu(m) + np.triu(m, 1).T)
+
+
+@pytest.mark.parametrize("method, count", METHODS)
+def test_batches_equal_single_states_and_closed_form(phantom, states, method, count):
+    values = [v[:300] for v in _arguments(states, method, count)]
+    function = getattr(phantom, method)
+    batch = _stacked(function(*values))
+    single = np.stack([_stacked(function(*row)) for row in zip(*values)])
+    if isinstance(function(*values), tuple):
+        single = np.moveaxis(single, 1, 0)
+    assert relative_error(batch, single) < 1e-12
+    # any leading axes, lists and integer arrays take the checked path to the same numbers
+    shaped = _stacked(function(*(v.reshape(10, 30, 3) for v in values)))
+    np.testing.assert_array_equal(shaped.reshape(batch.shape), batch)
+    listed = _stacked(function(*(v[7].tolist() for v in values)))
+    np.testing.assert_array_equal(listed, _stacked(function(*(v[7] for v in values))))
+    if hasattr(cf, method):
+        reference = getattr(cf, method)(*values)
+        if method == "potential_energy":
+            batch, reference = batch - batch[0], reference - reference[0]
+        assert relative_error(batch, reference) < 1e-9
+
+
+def test_single_state_inputs_other_than_float64_give_the_same_numbers(phantom):
+    theta = np.array([0, 1, -1])
+    for method in ("forward_kinematics", "spatial_jacobian", "body_jacobian", "mass_matrix", "gravity"):
+        function = getattr(phantom, method)
+        expected = function(theta.astype(float))
+        for value in (theta, theta.tolist(), tuple(theta), theta.astype(np.float32)):
+            np.testing.assert_array_equal(function(value), expected)
+        with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(N, 3\)"):
+            function(theta.astype(float)[:, None])
+
+
+@pytest.mark.parametrize("method, count", METHODS + [("inverse_kinematics", 1)])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_nan_or_inf_in_any_component_raises_naming_the_argument(phantom, method, count, bad):
+    """Single states (the fast paths) and batches; no RuntimeWarning on the way."""
+    base = np.array([0.05, 0.02, 0.03]) if method == "inverse_kinematics" else np.array([0.2, 0.4, 0.5])
+    name = "position" if method == "inverse_kinematics" else None
+    for argument in range(count):
+        for component in range(3):
+            for batch in (False, True):
+                values = [np.tile(base, (4, 1)) if batch else base.copy() for _ in range(count)]
+                values[argument][..., component] = bad
+                if name is None:
+                    name_ = ("theta", "dtheta", "tau" if method == "forward_dynamics" else "ddtheta")[argument]
+                else:
+                    name_ = name
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error")
+                    with pytest.raises(InvalidInputError, match=f"^{name_}: contains NaN or inf"):
+                        getattr(phantom, method)(*values)
+
+
+def test_batches_still_check_shapes_and_overflow(phantom):
+    with pytest.raises(InvalidInputError, match="^arguments must have the same shape"):
+        phantom.forward_dynamics(np.zeros((4, 3)), np.zeros((4, 3)), np.zeros((5, 3)))
+    with pytest.raises(InvalidInputError, match="^theta: expected shape"):
+        phantom.mass_matrix(np.zeros((4, 2)))
+    big = np.full((4, 3), 1e200)
+    for call in (lambda: phantom.forward_dynamics(np.zeros((4, 3)), big, np.zeros((4, 3))),
+                 lambda: phantom.inverse_dynamics_derivatives(np.zeros((4, 3)), big, np.zeros((4, 3))),
+                 lambda: phantom.inverse_dynamics(np.zeros((4, 3)), big, np.zeros((4, 3))),
+                 lambda: phantom.forward_dynamics(np.zeros(3), np.zeros(3), np.full(3, 1e307))):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with pytest.raises(InvalidInputError, match="too large, the result overflows"):
+                call()
+
+
+def test_closed_form_batches_span_chunks_and_equal_single_states(states):
+    """50000 states: they cross the chunk boundaries of closed_form.inverse_dynamics (8192)."""
+    theta, dtheta, ddtheta = (np.concatenate([s] * 50) for s in states)
+    tau = cf.inverse_dynamics(theta, dtheta, ddtheta)
+    m, c, n = cf.mass_matrix(theta), cf.coriolis_matrix(theta, dtheta), cf.gravity(theta)
+    expected = np.einsum("nij,nj->ni", m, ddtheta) + np.einsum("nij,nj->ni", c, dtheta) + n
+    assert relative_error(tau, expected) < 1e-12
+    for k in (0, 8191, 8192, 16384, 49999):
+        np.testing.assert_allclose(cf.inverse_dynamics(theta[k], dtheta[k], ddtheta[k]), tau[k],
+                                   rtol=1e-13, atol=1e-15)
+        np.testing.assert_array_equal(cf.mass_matrix(theta[k]), m[k])
+        np.testing.assert_array_equal(cf.gravity(theta[k]), n[k])
+    shaped = cf.inverse_dynamics(*(s.reshape(500, 100, 3) for s in (theta, dtheta, ddtheta)))
+    np.testing.assert_array_equal(shaped.reshape(-1, 3), tau)
+
+
+def test_solve_spd_solves_and_refuses_what_is_not_positive_definite():
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        a = rng.normal(size=(3, 3))
+        m = a @ a.T + 0.1 * np.eye(3)
+        r = rng.normal(size=3)
+        np.testing.assert_allclose(_solve_spd(m.tolist(), r.tolist()), np.linalg.solve(m, r), rtol=1e-9)
+    for m in (np.diag([1.0, -1.0, 1.0]), np.zeros((3, 3)), np.full((3, 3), np.nan), -np.eye(3)):
+        assert _solve_spd(m.tolist(), [1.0, 2.0, 3.0]) is None
+
+
+def test_forward_dynamics_still_refuses_a_mass_matrix_that_is_not_positive_definite(phantom, monkeypatch):
+    theta = np.array([0.2, 0.4, 0.5])
+    monkeypatch.setattr(pin, "crba", lambda model, data, q: -np.eye(3))
+    for values in ((theta, theta, theta), (np.tile(theta, (2, 1)),) * 3):
+        with pytest.raises(np.linalg.LinAlgError):
+            phantom.forward_dynamics(*values)
+
+
+def test_projection_by_the_kronecker_product_equals_two_products():
+    coupling = Coupling(URDF_PATH.read_text())
+    g = coupling.matrix
+    a = np.random.default_rng(6).normal(size=(7, 7))
+    np.testing.assert_allclose(coupling.project(a), g.T @ a @ g, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(coupling.project(np.asfortranarray(a)), g.T @ a @ g, rtol=1e-14, atol=1e-15)
+    q = np.array([0.1, -0.2, 0.3])
+    np.testing.assert_array_equal(coupling.configuration(q), g @ q)
+
+
+@pytest.mark.parametrize("method, count", METHODS)
+def test_fast_paths_return_fresh_arrays(phantom, method, count):
+    """A single state's result is not overwritten by the next call (no view of Pinocchio's data)."""
+    function = getattr(phantom, method)
+    first = [np.array([0.1, 0.2, 0.3])] * count
+    result = _stacked(function(*first))
+    kept = result.copy()
+    function(*[-x for x in first])
+    np.testing.assert_array_equal(result, kept)
+
+
+@pytest.mark.parametrize("method, third", [("inverse_dynamics", "ddtheta"), ("forward_dynamics", "tau"),
+                                           ("gravity", None), ("mass_matrix", None),
+                                           ("forward_kinematics", None), ("spatial_jacobian", None),
+                                           ("body_jacobian", None)])
+def test_shape_only_fast_paths_take_what_the_checked_path_takes(phantom, method, third):
+    """These fast paths check shapes and let eigenpy convert: int, bool, float32 and object
+    arrays of numbers give the numbers of the checked path; complex and (3, 1) are refused by name."""
+    function = getattr(phantom, method)
+    count = 1 if third is None else 3
+    theta = np.array([0, 1, -1])
+    for value in (theta, theta.astype(np.float32), theta.astype(object), theta.tolist(),
+                  np.array([True, False, True])):
+        expected = function(*[np.asarray(value).astype(float)] * count)
+        np.testing.assert_array_equal(function(*[value] * count), expected)
+    with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(N, 3\)"):
+        function(theta[:, None], *[theta] * (count - 1))
+    with pytest.raises(InvalidInputError, match=f"^{third or 'theta'}: expected real numbers"):
+        function(*[theta] * (count - 1), theta + 1j)
