@@ -59,7 +59,7 @@ def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray) -> np.ndarra
     return out
 
 
-def _solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:
+def solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:
     """x with m x = r for a symmetric 3x3 ``m`` (nested lists; the upper triangle is read),
     by its adjugate; None unless m is positive definite (Sylvester: leading minors > 0)."""
     (a, b, c), (_, d, e), (_, _, f) = m
@@ -271,7 +271,7 @@ class Phantom:
             for i in range(3):
                 normal[i][i] += _IK_DAMPING
             gradient = (linear.T @ error).tolist()
-            step = _solve_spd(normal, gradient)
+            step = solve_spd(normal, gradient)
             step = np.linalg.solve(np.array(normal), gradient) if step is None else np.array(step)
             theta = theta + step * min(1.0, _IK_MAX_STEP / np.abs(step).max())
         return None
@@ -364,7 +364,7 @@ class Phantom:
     def _forward(self, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray) -> np.ndarray:
         bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
         mass = pin.crba(self.model, self.data, theta)
-        acc = _solve_spd(mass.tolist(), [t - b for t, b in zip(tau.tolist(), bias)])
+        acc = solve_spd(mass.tolist(), [t - b for t, b in zip(tau.tolist(), bias)])
         if acc is None:  # M not positive definite (or not finite): Cholesky decides, as ever
             factor = np.linalg.cholesky(mass)
             return np.linalg.solve(factor.T, np.linalg.solve(factor, tau - bias))
@@ -384,7 +384,7 @@ class Phantom:
             if theta.shape == dtheta.shape == tau.shape == _ONE and _isfinite(sum(theta.tolist())):
                 bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
                 t0, t1, t2 = tau.tolist()
-                acc = _solve_spd(pin.crba(self.model, self.data, theta).tolist(),
+                acc = solve_spd(pin.crba(self.model, self.data, theta).tolist(),
                                  (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
                 if acc is not None and _isfinite(sum(acc)):  # rates can overflow
                     return np.array(acc)

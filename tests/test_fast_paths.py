@@ -10,7 +10,7 @@ import pytest
 from conftest import relative_error
 from phantom_pin import InvalidInputError, closed_form as cf
 from phantom_pin.coupling import Coupling
-from phantom_pin.model import _solve_spd
+from phantom_pin.model import solve_spd
 from phantom_pin.paths import URDF_PATH
 
 # method, number of (3,) arguments; inverse_kinematics takes positions (below)
@@ -127,15 +127,15 @@ def test_closed_form_batches_span_chunks_and_equal_single_states(states):
     np.testing.assert_array_equal(shaped.reshape(-1, 3), tau)
 
 
-def test_solve_spd_solves_and_refuses_what_is_not_positive_definite():
+def testsolve_spd_solves_and_refuses_what_is_not_positive_definite():
     rng = np.random.default_rng(5)
     for _ in range(100):
         a = rng.normal(size=(3, 3))
         m = a @ a.T + 0.1 * np.eye(3)
         r = rng.normal(size=3)
-        np.testing.assert_allclose(_solve_spd(m.tolist(), r.tolist()), np.linalg.solve(m, r), rtol=1e-9)
+        np.testing.assert_allclose(solve_spd(m.tolist(), r.tolist()), np.linalg.solve(m, r), rtol=1e-9)
     for m in (np.diag([1.0, -1.0, 1.0]), np.zeros((3, 3)), np.full((3, 3), np.nan), -np.eye(3)):
-        assert _solve_spd(m.tolist(), [1.0, 2.0, 3.0]) is None
+        assert solve_spd(m.tolist(), [1.0, 2.0, 3.0]) is None
 
 
 def test_forward_dynamics_still_refuses_a_mass_matrix_that_is_not_positive_definite(phantom, monkeypatch):

@@ -13,6 +13,7 @@ import pinocchio as pin
 
 from phantom_pin.device.device import Device
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.model import solve_spd
 from phantom_pin.validation import as_state
 
 #: Most samples one call may produce (duration * rate + 1).
@@ -161,16 +162,12 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                     total[i] -= force
                     if j is not None:
                         total[j] += force
-        m = pin.crba(model, data, q).tolist()  # the upper triangle
         bias = pin.nonLinearEffects(model, data, q, v).tolist()
-        r0, r1, r2 = total[0] - bias[0], total[1] - bias[1], total[2] - bias[2]
-        a, b, c, d, e, f = m[0][0], m[0][1], m[0][2], m[1][1], m[1][2], m[2][2]
-        c00, c01, c02 = d * f - e * e, c * e - b * f, b * e - c * d  # adjugate of the
-        c11, c12, c22 = a * f - c * c, b * c - a * e, a * d - b * b    # symmetric M
-        det = a * c00 + b * c01 + c * c02
-        return np.array([(c00 * r0 + c01 * r1 + c02 * r2) / det,
-                         (c01 * r0 + c11 * r1 + c12 * r2) / det,
-                         (c02 * r0 + c12 * r1 + c22 * r2) / det])
+        solution = solve_spd(pin.crba(model, data, q).tolist(),
+                             (total[0] - bias[0], total[1] - bias[1], total[2] - bias[2]))
+        if solution is None:  # M(theta) includes the rotors: positive definite everywhere
+            raise InvalidInputError(f"theta: the mass matrix at {q} is not positive definite")
+        return np.array(solution)
 
     def contacts(q: np.ndarray) -> list[bool]:
         """Which stops are engaged at q."""
