@@ -95,6 +95,28 @@ def test_nan_or_inf_in_any_component_raises_naming_the_argument(phantom, method,
                         getattr(phantom, method)(*values)
 
 
+@pytest.mark.parametrize("method, count", METHODS)
+def test_every_argument_of_a_wrong_shape_is_refused_by_name(phantom, method, count):
+    """The fast paths unpack x.tolist() into three (ValueError for (1, 3) and (4,), lists
+    that isfinite refuses for (3, 1)); eigenpy itself would take a (3, 1) array as a
+    3-vector. Each argument in turn, the others fine: the checked path names it, and (1, 3)
+    everywhere is a batch of one state, equal to the single state."""
+    base = np.array([0.2, 0.4, 0.5])
+    names = ("theta", "dtheta", "tau" if method == "forward_dynamics" else "ddtheta")
+    function = getattr(phantom, method)
+    for argument in range(count):
+        for wrong in (base[:, None], np.append(base, 0.1), base + 1j):
+            values = [base] * count
+            values[argument] = wrong
+            expected = "expected real numbers" if wrong.dtype.kind == "c" else r"expected shape \(3,\)"
+            with pytest.raises(InvalidInputError, match=f"^{names[argument]}: {expected}"):
+                function(*values)
+    one = _stacked(function(*[base] * count))
+    batch = function(*[base[None]] * count)
+    batch = np.stack([b[0] for b in batch]) if isinstance(batch, tuple) else batch[0]
+    assert relative_error(batch, one) < 1e-12  # a batch solves and projects otherwise: rounding
+
+
 def test_batches_still_check_shapes_and_overflow(phantom):
     with pytest.raises(InvalidInputError, match="^arguments must have the same shape"):
         phantom.forward_dynamics(np.zeros((4, 3)), np.zeros((4, 3)), np.zeros((5, 3)))
