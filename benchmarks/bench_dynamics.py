@@ -133,7 +133,7 @@ def main() -> None:
     print("|---|---:|---|---:|---:|")
     for label, call, loop in batches:
         t_ours, t_loop = (statistics.median(t) for t in zip(*[
-            (per_state(call, small, 1), per_state(loops[loop], small, 1)) for _ in range(3)]))
+            (per_state(call, small, 1), per_state(loops[loop], small, 1)) for _ in range(7)]))
         print(f"| {label} | {t_ours:.2f} | {loop} | {t_loop:.2f} | {t_ours / t_loop:.2f} |")
 
     # the baseline: the loop over rnea alone, not stacked
