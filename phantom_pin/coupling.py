@@ -125,8 +125,10 @@ class Coupling:
         """G^T A G for a (..., tree.nv, tree.nv) matrix A (mass, Coriolis, derivatives)."""
         if self._kron is None:
             return self._transpose @ tree_matrix @ self.matrix
+        # one 2-D product for any leading axes: BLAS, and the same rounding for a matrix
+        # alone as inside a batch
         shape = tree_matrix.shape
-        flat = tree_matrix.reshape(shape[:-2] + (shape[-2] * shape[-1],))
+        flat = tree_matrix.reshape(-1, shape[-2] * shape[-1])
         size = self.matrix.shape[1]
         return flat.dot(self._kron).reshape(shape[:-2] + (size, size))
 

@@ -47,8 +47,9 @@ def _finite(array: np.ndarray) -> bool:
 # (3,): a batch fails to unpack () without being listed (ValueError), as tolist() of a
 # (1, 3) array does; that of a (3, 1) array unpacks into lists whose sum isfinite refuses
 # (TypeError), as it refuses complex numbers and strings; lists have no size
-# (AttributeError). A sum that overflows only sends a finite input to the checked path. Functions of theta alone stay finite on a finite theta; where rates enter,
-# whose products can overflow, the result is checked instead or as well.
+# (AttributeError). A sum that overflows only sends a finite input to the checked path.
+# Functions of theta alone stay finite on a finite theta; where rates enter, whose products
+# can overflow, the result is checked instead or as well.
 
 
 def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray, before: tuple = (),
@@ -172,12 +173,14 @@ class Phantom:
     def _tree_batch(self, function: Callable[..., np.ndarray], names: tuple[str, ...],
                     theta: np.ndarray, *rates: np.ndarray, before: tuple = ()) -> np.ndarray:
         """``function(*before, q, *rates)`` of tree configurations and tangents over checked
-        batches (..., 3): the coupling maps the whole batch, Pinocchio runs per row, the
-        results (N, ..., tree.nv, tree.nv) are projected at once; checked for finiteness."""
+        states, (3,) or (..., 3): the coupling maps the whole batch, Pinocchio runs per row,
+        the results (N, ..., tree.nv, tree.nv) are projected at once; checked for
+        finiteness (an overflow is reported by finite_result, not by NumPy's warnings)."""
         coupling = self.coupling
-        tree = _rows(function, coupling.configuration(theta.reshape(-1, 3)),
-                     *(coupling.tangent(r.reshape(-1, 3)) for r in rates), before=before)
-        out = coupling.project(tree)
+        with np.errstate(invalid="ignore", over="ignore"):
+            tree = _rows(function, coupling.configuration(theta.reshape(-1, 3)),
+                         *(coupling.tangent(r.reshape(-1, 3)) for r in rates), before=before)
+            out = coupling.project(tree)
         return finite_result(out.reshape(theta.shape[:-1] + out.shape[1:]), ", ".join(names))
 
     def within_limits(self, theta: object) -> bool | np.ndarray:
@@ -328,10 +331,7 @@ class Phantom:
         except (AttributeError, TypeError, ValueError):
             pass
         names = ("theta", "dtheta")
-        q, v = self._states(names, theta, dtheta)
-        if q.ndim == 1:
-            return finite_result(self._coriolis(q, v), ", ".join(names))
-        return self._tree_batch(pin.computeCoriolisMatrix, names, q, v,
+        return self._tree_batch(pin.computeCoriolisMatrix, names, *self._states(names, theta, dtheta),
                                 before=(self.coupling.tree, self._tree_data))
 
     def gravity(self, theta: object) -> np.ndarray:
@@ -450,10 +450,5 @@ class Phantom:
         except (AttributeError, TypeError, ValueError):
             pass
         names = ("theta", "dtheta", "ddtheta")
-        q, v, a = self._states(names, theta, dtheta, ddtheta)
-        if q.ndim == 1:
-            both = finite_result(coupling.project(self._tree_derivatives(
-                coupling.configuration(q), coupling.tangent(v), coupling.tangent(a))), ", ".join(names))
-        else:
-            both = self._tree_batch(self._tree_derivatives, names, q, v, a)
+        both = self._tree_batch(self._tree_derivatives, names, *self._states(names, theta, dtheta, ddtheta))
         return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()

@@ -126,9 +126,10 @@ def test_batches_still_check_shapes_and_overflow(phantom):
     for call in (lambda: phantom.forward_dynamics(np.zeros((4, 3)), big, np.zeros((4, 3))),
                  lambda: phantom.inverse_dynamics_derivatives(np.zeros((4, 3)), big, np.zeros((4, 3))),
                  lambda: phantom.inverse_dynamics(np.zeros((4, 3)), big, np.zeros((4, 3))),
+                 lambda: phantom.inverse_dynamics_derivatives(np.array([0.2, 0.4, 0.5]), np.full(3, 1e308), np.zeros(3)),
                  lambda: phantom.forward_dynamics(np.zeros(3), np.zeros(3), np.full(3, 1e307))):
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+            warnings.simplefilter("error")  # the error says it; no RuntimeWarning on the way
             with pytest.raises(InvalidInputError, match="too large, the result overflows"):
                 call()
 
