@@ -7,6 +7,7 @@ import math
 import os
 import re
 from pathlib import Path
+from typing import Sequence
 
 import numpy as np
 import yaml
@@ -272,8 +273,35 @@ def parameters_from(config: Config) -> Parameters:
         ratios=tuple(act("transmission_ratio", j) for j in joints),
         lower=lower,
         upper=upper,
-        coupled=(lim("stops", "theta2_minus_theta3_max"), lim("stops", "theta3_minus_theta2_max")),
+        coupled=coupled_stops(config, lower, upper),
     )
+
+
+def coupled_stops(config: Config, lower: Sequence[float], upper: Sequence[float]) -> tuple[float, float]:
+    """The parallelogram's coupled stops of joint_limits.yaml ``stops``: (max of theta2 -
+    theta3, max of theta3 - theta2) (rad), read and checked once for Parameters and the
+    device. ParameterFileError unless -backward <= theta2 - theta3 <= forward is an open
+    interval that overlaps the range of theta2 - theta3 over the box ``lower``..``upper``
+    (rad, theta1..theta3): outside it no posture satisfies both."""
+    path = config.paths["joint_limits_file"]
+    prefix = "after the overrides, " if config.overridden else ""
+    forward = config.number("joint_limits_file", "stops", "theta2_minus_theta3_max")
+    backward = config.number("joint_limits_file", "stops", "theta3_minus_theta2_max")
+    if forward + backward <= 0:
+        raise ParameterFileError(f"{prefix}{path}: stops.theta2_minus_theta3_max + "
+                                 f"stops.theta3_minus_theta2_max must be positive (an open interval), "
+                                 f"got {forward!r} + {backward!r}")
+    low, high = lower[1] - upper[2], upper[1] - lower[2]
+    if forward <= low or -backward >= high:
+        raise ParameterFileError(
+            f"{prefix}{path}: the coupled stops {-backward:.4f} <= theta2 - theta3 <= {forward:.4f} rad "
+            f"leave no posture in the box, where theta2 - theta3 spans {low:.4f} .. {high:.4f} rad")
+    return forward, backward
+
+
+#: Rounds of rejection sampling before random_states gives up: enough when the coupled
+#: stops keep more than about 1/2000 of the box.
+_SAMPLING_ROUNDS = 1000
 
 
 def random_states(params: Parameters, n: int,
@@ -285,11 +313,16 @@ def random_states(params: Parameters, n: int,
     rng = np.random.default_rng(seed)
     forward, backward = params.coupled
     theta = np.empty((0, 3))
-    while len(theta) < n:  # rejection: about half of the box is inside the coupled stops
+    for _ in range(_SAMPLING_ROUNDS):  # rejection: the shipped stops keep 55 % of the box
         draw = rng.uniform(params.lower, params.upper, (2 * n + 16, 3))
         keep = (draw[:, 1] - draw[:, 2] <= forward) & (draw[:, 2] - draw[:, 1] <= backward)
         theta = np.concatenate([theta, draw[keep]])
-    return theta[:n], rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+        if len(theta) >= n:
+            return theta[:n], rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+    raise ParameterFileError(
+        f"joint_limits.yaml: the coupled stops (stops.theta2_minus_theta3_max "
+        f"{forward!r}, stops.theta3_minus_theta2_max {backward!r}) keep too little of the joint "
+        f"box to draw {n} postures ({len(theta)} in {_SAMPLING_ROUNDS} rounds)")
 
 
 def read_overrides(path: Path | str) -> dict[str, float]:

@@ -76,6 +76,22 @@ def test_bad_arguments_give_one_line_and_exit_code_2(capsys, argv, message):
     assert code == 2 and message in err and err.count("\n") == 1
 
 
+def test_coupled_stops_without_a_posture_exit_2_and_write_nothing(tmp_path, capsys):
+    """`check` looped for ever on them; the MJCF was written with an inverted tendon range."""
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    limits = config / "joint_limits.yaml"
+    limits.write_text(limits.read_text().replace("theta2_minus_theta3_max: 1.1344640137963142",
+                                                 "theta2_minus_theta3_max: -1.0"))
+    for argv in (["check", "-n", "10"], ["mjcf", "-o", str(tmp_path / "phantom.xml")]):
+        code, _, err = run(capsys, "--config", str(config), *argv)
+        assert code == 2 and "stops.theta2_minus_theta3_max" in err and err.count("\n") == 1
+    code, _, err = run(capsys, "mjcf", "-o", str(tmp_path / "phantom.xml"),
+                       "--set", "stops.theta3_minus_theta2_max=-1.2")
+    assert code == 2 and "after the overrides" in err and err.count("\n") == 1
+    assert not (tmp_path / "phantom.xml").exists()
+
+
 def test_urdf_refuses_to_overwrite_without_force(tmp_path, capsys):
     target = tmp_path / "phantom.urdf"
     assert run(capsys, "urdf", "--output", str(target))[0] == 0

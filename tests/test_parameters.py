@@ -8,7 +8,8 @@ import pytest
 
 from phantom_pin import InvalidInputError, ParameterFileError, Phantom, load_parameters
 from phantom_pin.description import generate_urdf
-from phantom_pin.parameters import read_overrides, write_overridden
+from phantom_pin.device.parameters import load_device_parameters
+from phantom_pin.parameters import parameters_from, random_states, read_config, read_overrides, write_overridden
 from phantom_pin.paths import CONFIG_DIR
 
 
@@ -72,6 +73,38 @@ def test_joint_limits_beyond_one_turn_are_refused(config):
                                                  "joint1: {lower: -1.0, upper: 1.0e308}"))
     with pytest.raises(ParameterFileError, match="joint1.upper must be within one turn"):
         load_parameters(config)
+
+
+@pytest.mark.parametrize("forward, backward, message", [
+    (-1.0, -1.0, "must be positive"),  # an empty interval
+    (-6.0, 6.5, "leave no posture in the box"),  # -6.5 <= theta2 - theta3 <= -6 rad
+    (3.0, -2.7, "leave no posture in the box"),  # 2.7 <= theta2 - theta3 <= 3 rad
+])
+def test_coupled_stops_that_leave_no_posture_are_refused(config, forward, backward, message):
+    """Before: random_states looped for ever (phantom-pin check hung) and the MJCF's tendon
+    range was written inverted. theta2 - theta3 spans -1.466 - 3.037 .. 2.077 + 0.506 rad
+    over the URDF's box and -2.164 - 3.735 .. 2.583 rad over the device's stops."""
+    limits = config / "joint_limits.yaml"
+    text = limits.read_text()
+    for key, value in (("theta2_minus_theta3_max", forward), ("theta3_minus_theta2_max", backward)):
+        line = next(line for line in text.splitlines() if line.strip().startswith(key + ":"))
+        text = text.replace(line, f"  {key}: {value}")
+    limits.write_text(text)
+    for call in (load_parameters, Phantom, load_device_parameters, lambda c: generate_urdf(config_dir=c)):
+        with pytest.raises(ParameterFileError, match=f"joint_limits.yaml: .*{message}"):
+            call(config)
+    with pytest.raises(ParameterFileError, match=f"after the overrides, .*{message}"):  # as overrides
+        parameters_from(read_config(CONFIG_DIR, {"stops.theta2_minus_theta3_max": forward,
+                                                 "stops.theta3_minus_theta2_max": backward}))
+
+
+def test_random_states_refuses_a_sliver_instead_of_looping():
+    """Stops that keep about 4e-7 of the box (a corner triangle 3 mrad wide): one line, no hang."""
+    params = dataclasses.replace(load_parameters(), coupled=(-4.5, 5.0))
+    with pytest.raises(ParameterFileError, match="coupled stops .* keep too little of the joint box"):
+        random_states(params, 100, seed=0)
+    theta = random_states(load_parameters(), 2000, seed=0)[0]  # the shipped stops: inside
+    assert np.all(theta[:, 1] - theta[:, 2] <= load_parameters().coupled[0])
 
 
 @pytest.mark.parametrize("call", [Phantom, load_parameters, lambda c: generate_urdf(config_dir=c)])

@@ -7,7 +7,7 @@ import dataclasses
 from pathlib import Path
 
 from phantom_pin.exceptions import ParameterFileError
-from phantom_pin.parameters import Config, read_config
+from phantom_pin.parameters import Config, coupled_stops, read_config
 from phantom_pin.paths import CONFIG_DIR
 
 _JOINTS = ("joint1", "joint2", "joint3")
@@ -89,10 +89,7 @@ def device_parameters_from(config: Config) -> DeviceParameters:
     for joint, lo, hi in zip(_JOINTS, lower, upper):
         if lo >= hi:
             raise ParameterFileError(f"{lim_path}: stops.{joint}.lower must be below stops.{joint}.upper")
-    forward, backward = lim("stops", "theta2_minus_theta3_max"), lim("stops", "theta3_minus_theta2_max")
-    if forward + backward <= 0:
-        raise ParameterFileError(f"{lim_path}: stops.theta2_minus_theta3_max + "
-                                 f"stops.theta3_minus_theta2_max must be positive (an open interval)")
+    forward, backward = coupled_stops(config, lower, upper)
     return DeviceParameters(
         max_continuous_torque=act("motor", "max_continuous_torque"),
         max_continuous_current=act("motor", "max_continuous_current"),
