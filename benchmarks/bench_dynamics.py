@@ -57,7 +57,7 @@ def main() -> None:
         pin.forwardKinematics(model, data, x)
         return pin.updateFramePlacement(model, data, tip)
 
-    def one_frame():
+    def one_frame():  # one_frame_at(q) inline: the bare call pays no extra Python frame
         pin.forwardKinematics(model, data, q)
         return pin.updateFramePlacement(model, data, tip)
 

@@ -7,7 +7,7 @@ import math
 import os
 import re
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 import yaml
@@ -299,9 +299,24 @@ def coupled_stops(config: Config, lower: Sequence[float], upper: Sequence[float]
     return forward, backward
 
 
-#: Rounds of rejection sampling before random_states gives up: enough when the coupled
-#: stops keep more than about 1/2000 of the box.
+#: Rounds of rejection sampling before sample_inside gives up: enough when the limits keep
+#: more than about 1/2000 of the box.
 _SAMPLING_ROUNDS = 1000
+
+
+def sample_inside(rng: np.random.Generator, lower: Sequence[float], upper: Sequence[float],
+                  inside: Callable[[np.ndarray], np.ndarray], n: int, draws: int, limits: str) -> np.ndarray:
+    """``n`` postures (rad), (n, 3), uniform in the box ``lower``..``upper`` where ``inside``
+    (a bool per row of an (m, 3) array) holds: rejection sampling, ``draws`` per round.
+    ParameterFileError naming ``limits`` if they keep too little of the box."""
+    theta = np.empty((0, 3))
+    for _ in range(_SAMPLING_ROUNDS):
+        draw = rng.uniform(lower, upper, (draws, 3))
+        theta = np.concatenate([theta, draw[inside(draw)]])
+        if len(theta) >= n:
+            return theta[:n]
+    raise ParameterFileError(f"{limits} keep too little of the joint box to draw {n} postures "
+                             f"({len(theta)} in {_SAMPLING_ROUNDS} rounds)")
 
 
 def random_states(params: Parameters, n: int,
@@ -312,17 +327,12 @@ def random_states(params: Parameters, n: int,
     a Generator, to draw a long sequence in chunks."""
     rng = np.random.default_rng(seed)
     forward, backward = params.coupled
-    theta = np.empty((0, 3))
-    for _ in range(_SAMPLING_ROUNDS):  # rejection: the shipped stops keep 55 % of the box
-        draw = rng.uniform(params.lower, params.upper, (2 * n + 16, 3))
-        keep = (draw[:, 1] - draw[:, 2] <= forward) & (draw[:, 2] - draw[:, 1] <= backward)
-        theta = np.concatenate([theta, draw[keep]])
-        if len(theta) >= n:
-            return theta[:n], rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
-    raise ParameterFileError(
-        f"joint_limits.yaml: the coupled stops (stops.theta2_minus_theta3_max "
-        f"{forward!r}, stops.theta3_minus_theta2_max {backward!r}) keep too little of the joint "
-        f"box to draw {n} postures ({len(theta)} in {_SAMPLING_ROUNDS} rounds)")
+    theta = sample_inside(  # the shipped stops keep 55 % of the box
+        rng, params.lower, params.upper,
+        lambda t: (t[:, 1] - t[:, 2] <= forward) & (t[:, 2] - t[:, 1] <= backward), n, 2 * n + 16,
+        f"joint_limits.yaml: the coupled stops (stops.theta2_minus_theta3_max {forward!r}, "
+        f"stops.theta3_minus_theta2_max {backward!r})")
+    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
 
 
 def read_overrides(path: Path | str) -> dict[str, float]:

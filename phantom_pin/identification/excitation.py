@@ -16,7 +16,7 @@ import scipy.optimize
 
 from phantom_pin.identification import constants
 from phantom_pin.device.parameters import device_parameters_from
-from phantom_pin.parameters import parameters_from, read_config
+from phantom_pin.parameters import parameters_from, read_config, sample_inside
 from phantom_pin.paths import CONFIG_DIR
 
 
@@ -50,12 +50,9 @@ class Limits:
 
     def sample(self, n: int, seed: int, margin: float = 0.0) -> np.ndarray:
         """``n`` seeded postures (rad), uniform inside the box and the coupled stops."""
-        rng = np.random.default_rng(seed)
-        out = np.empty((0, 3))
-        while len(out) < n:
-            theta = rng.uniform(self.lower, self.upper, (4 * n, 3))
-            out = np.vstack([out, theta[(self.slack(theta) >= margin).all(axis=1)]])
-        return out[:n]
+        return sample_inside(np.random.default_rng(seed), self.lower, self.upper,
+                             lambda theta: (self.slack(theta) >= margin).all(axis=1), n, 4 * n,
+                             f"the stops and the coupled stops, {margin} rad inside,")
 
 
 @dataclasses.dataclass(frozen=True)
