@@ -1,14 +1,16 @@
-"""phantom_pin: the PHANToM Premium 1.5 as a URDF, a Pinocchio model and the report's equations."""
+"""phantom_pin: the PHANToM haptic arms as URDF/MJCF descriptions, Pinocchio models and the
+report's equations, from one typed configuration per device (phantom_pin.models())."""
 
-from phantom_pin import closed_form
-from phantom_pin.description import Description, describe
+from phantom_pin.config import Config, models
+from phantom_pin.description.build import Description, describe
 from phantom_pin.device import Device, SimulationResult, simulate
+from phantom_pin.dynamics.loader import PhantomLoader, load
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import (InvalidInputError, ParameterFileError, PhantomPinError,
                                     UnreachableTargetError)
-from phantom_pin.loader import PhantomLoader, load
-from phantom_pin.model import Phantom
-from phantom_pin.parameters import Parameters, load_parameters
+from phantom_pin.report import closed_form
+from phantom_pin.report.parameters import ReportParameters
 
 __all__ = ["Phantom", "Device", "simulate", "SimulationResult", "load", "PhantomLoader", "Description",
-           "describe", "Parameters", "load_parameters", "closed_form", "PhantomPinError", "InvalidInputError",
-           "ParameterFileError", "UnreachableTargetError"]
+           "describe", "models", "Config", "ReportParameters", "closed_form", "PhantomPinError",
+           "InvalidInputError", "ParameterFileError", "UnreachableTargetError"]

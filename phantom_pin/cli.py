@@ -15,14 +15,15 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin import appendix, closed_form
-from phantom_pin.description import Description, describe, shipped
+from phantom_pin.report import appendix, closed_form
+from phantom_pin.config import DEFAULT, FILES, models, read_overrides
+from phantom_pin.config.sampling import random_states
+from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.device import cli as device_cli
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import commands as identification
-from phantom_pin.loader import load
-from phantom_pin.model import Phantom
-from phantom_pin.parameters import CONFIG_DIR, PARAMETER_FILES, random_states, read_overrides
+from phantom_pin.dynamics.loader import load
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.validation import output_path, within_box
 
 #: States evaluated at a time by check: memory stays bounded (tens of MB) whatever -n is.
@@ -68,11 +69,11 @@ def _vector(values: list[float], spec: str) -> str:
 
 
 def _info(args: argparse.Namespace, phantom: Phantom) -> int:
-    model, p = phantom.model, phantom.parameters
+    model, actuation = phantom.model, phantom.config.actuation
     joints = [{"name": model.names[i], "lower": float(model.lowerPositionLimit[i - 1]),
                "upper": float(model.upperPositionLimit[i - 1]),
                "velocity": float(model.velocityLimit[i - 1]), "effort": float(model.effortLimit[i - 1]),
-               "armature": float(model.armature[i - 1]), "ratio": p.ratios[i - 1]} for i in (1, 2, 3)]
+               "armature": float(model.armature[i - 1]), "ratio": actuation.ratios[i - 1]} for i in (1, 2, 3)]
     tree = phantom.coupling.tree
     body: dict[int, str] = {}
     for frame in tree.frames:  # the first body frame of a joint is its link
@@ -80,16 +81,18 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
             body.setdefault(frame.parentJoint, frame.name)
     links = [{"name": body[i], "mass": tree.inertias[i].mass,
               "com": tree.inertias[i].lever.tolist(),
-              "inertia": np.diag(tree.inertias[i].inertia).tolist()}
+              "inertia": [tree.inertias[i].inertia[j, k] for j, k in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))]}
              for i in range(1, tree.njoints) if tree.inertias[i].mass > 0]
-    data = {"joints": joints, "links": links, "rotor_inertia": p.rotor_inertia}
+    data = {"model": phantom.config.name, "joints": joints, "links": links,
+            "rotor_inertia": actuation.motor.rotor_inertia}
     lines = ["joint    lower[rad] upper[rad] vel[rad/s] effort[Nm] armature[kg m2] ratio"]
     lines += [f"{j['name']:8} {j['lower']:10.3f} {j['upper']:10.3f} {j['velocity']:10.2f} "
               f"{j['effort']:10.3f} {j['armature']:15.4e} {j['ratio']:5.1f}" for j in joints]
-    lines += ["", "link            mass[kg]  com[m] (link frame)       inertia diagonal at the COM [kg m2]"]
+    lines += ["", "link            mass[kg]  com[m] (link frame)       inertia xx xy xz yy yz zz at the COM [kg m2]"]
     lines += [f"{lk['name']:15} {lk['mass']:8.4f}  {_vector(lk['com'], '{:7.4f}'):26}"
               f"{_vector(lk['inertia'], '{:.3e}')}" for lk in links]
-    lines += ["", f"rotor inertia {p.rotor_inertia:.3e} kg m2 (each motor)"]
+    lines += ["", f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
+    lines.insert(0, f"model {phantom.config.name}")
     data["device"], device_lines = device_cli.info(phantom)  # stops, friction, motor, encoder
     lines += ["", *device_lines]
     _print(args, data, "\n".join(lines))
@@ -99,7 +102,11 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
 def _check(args: argparse.Namespace, phantom: Phantom) -> int:
     """Phantom vs closed_form with Phantom's own parameters, in chunks of CHECK_CHUNK
     states; the appendix's printed torques only when the parameters are the report's."""
-    p = phantom.parameters
+    p = phantom.config.report
+    if p is None:
+        raise PhantomPinError(f"check: the model {phantom.config.name} is not written in the report's terms, so "
+                              f"the closed form does not apply (tests/test_cad_model.py checks it against an "
+                              f"independent derivation)")
     methods = {"forward_kinematics": 1, "spatial_jacobian": 1, "body_jacobian": 1, "mass_matrix": 1,
                "coriolis_matrix": 2, "gravity": 1, "inverse_dynamics": 3}  # name: number of arguments
     worst = {name: [0.0, 0.0] for name in methods}  # max |ours - reference|, max |reference|
@@ -108,7 +115,7 @@ def _check(args: argparse.Namespace, phantom: Phantom) -> int:
     excess = 0.0
     generator = np.random.default_rng(args.seed)
     for start in range(0, args.n, CHECK_CHUNK):
-        states = random_states(p, min(CHECK_CHUNK, args.n - start), generator)
+        states = random_states(phantom.config.limits, min(CHECK_CHUNK, args.n - start), generator)
         for name, count in methods.items():
             ours = getattr(phantom, name)(*states[:count])
             reference = getattr(closed_form, name)(*states[:count], p)
@@ -160,6 +167,16 @@ def _dynamics(args: argparse.Namespace, phantom: Phantom) -> int:
     return 0
 
 
+def _source(args: argparse.Namespace) -> str | Path:
+    """The model name or the configuration folder the command works on."""
+    if args.config is not None and args.model != DEFAULT:
+        raise PhantomPinError("--config: give --model or --config, not both")
+    if args.config is None and args.model not in models():
+        raise PhantomPinError(f"--model: {args.model!r} is not a model ({', '.join(models())}); "
+                              "use --config for a folder")
+    return args.config if args.config is not None else args.model
+
+
 def _parse_set(items: list[str]) -> dict[str, float]:
     out = {}
     for item in items:
@@ -172,7 +189,7 @@ def _parse_set(items: list[str]) -> dict[str, float]:
 
 
 def _write(args: argparse.Namespace) -> int:
-    """urdf, srdf, mjcf: the files of describe(--config, --prefix, --params and --set)."""
+    """urdf, srdf, mjcf: the files of describe(--model or --config, --prefix, --params and --set)."""
     output = output_path(args.output, args.force, "--output", "--force")
     scene = output_path(args.scene, args.force, "--scene", "--force") if getattr(args, "scene", None) else None
     try:
@@ -180,7 +197,7 @@ def _write(args: argparse.Namespace) -> int:
     except PhantomPinError as error:
         raise PhantomPinError(f"--params: {error}") from None
     overrides.update(_parse_set(args.set))
-    description = describe(args.config, prefix=args.prefix, overrides=overrides, robot_file=output.name)
+    description = describe(_source(args), prefix=args.prefix, overrides=overrides, robot_file=output.name)
     output.write_text({"urdf": description.urdf, "srdf": description.srdf, "mjcf": description.mjcf}[args.kind])
     print(f"wrote {output}")
     if scene is not None:
@@ -213,8 +230,10 @@ def _show(args: argparse.Namespace, description: Description) -> int:
 
 def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="phantom-pin", description=__doc__)
-    parser.add_argument("--config", type=Path, default=CONFIG_DIR,
-                        help=f"folder with the parameter files {sorted(PARAMETER_FILES.values())}")
+    parser.add_argument("--model", default=DEFAULT,
+                        help=f"a named configuration: {', '.join(models())} (default {DEFAULT})")
+    parser.add_argument("--config", type=Path,
+                        help=f"instead of --model, a folder with the parameter files {sorted(FILES.values())}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     three = {"nargs": 3, "type": float}
     info = sub.add_parser("info", help="joints, limits, links with mass, COM and inertia, rotor data, "
@@ -234,7 +253,7 @@ def _parser() -> argparse.ArgumentParser:
     dyn.add_argument("--dtheta", default=[0.0, 0.0, 0.0], **three)
     dyn.add_argument("--ddtheta", default=[0.0, 0.0, 0.0], **three)
     for kind in ("urdf", "srdf", "mjcf"):
-        gen = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --config")
+        gen = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config")
         gen.add_argument("--output", "-o", required=True)
         gen.add_argument("--prefix", default="")
         gen.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
@@ -271,9 +290,8 @@ def main(argv: list[str] | None = None) -> int:
         args = _parser().parse_args(argv)
         if args.command in ("urdf", "srdf", "mjcf"):
             code = _write(args)
-        else:  # one Description of --config for every other command
-            shipped_config = Path(args.config).resolve() == CONFIG_DIR.resolve()
-            description = shipped() if shipped_config else describe(args.config)
+        else:  # one Description of --model or --config for every other command
+            description = description_of(_source(args), "--config" if args.config else "--model")
             code = (_show(args, description) if args.command == "show"
                     else handlers[args.command](args, Phantom(description)))
         sys.stdout.flush()  # a closed pipe raises here, not at exit

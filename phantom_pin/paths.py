@@ -1,4 +1,5 @@
-"""Where the shipped description package lives (source checkout or installed wheel)."""
+"""Where the description package lives (source checkout or installed wheel); the files of
+each model are declared in phantom_pin.config.models."""
 
 from pathlib import Path
 
@@ -8,10 +9,3 @@ DESCRIPTION_DIR = next(
     (p for p in (_PACKAGE / "robots" / "phantom_description",
                  _PACKAGE.parent / "robots" / "phantom_description") if p.is_dir()),
     _PACKAGE.parent / "robots" / "phantom_description")
-CONFIG_DIR = DESCRIPTION_DIR / "config"
-URDF_XACRO = DESCRIPTION_DIR / "urdf" / "phantom_1_5.urdf.xacro"
-SRDF_XACRO = DESCRIPTION_DIR / "srdf" / "phantom_1_5.srdf.xacro"
-URDF_PATH = DESCRIPTION_DIR / "urdf" / "phantom_1_5.urdf"
-SRDF_PATH = DESCRIPTION_DIR / "srdf" / "phantom_1_5.srdf"
-MJCF_PATH = DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml"
-SCENE_PATH = DESCRIPTION_DIR / "mjcf" / "scene.xml"

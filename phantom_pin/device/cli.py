@@ -16,7 +16,7 @@ import numpy as np
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.model import Phantom
+from phantom_pin.dynamics.model import Phantom
 
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
@@ -94,38 +94,36 @@ def _csv(result: SimulationResult) -> str:
 def info(phantom: Phantom) -> tuple[dict, list[str]]:
     """The device data of ``phantom-pin info``, as (JSON data, text lines), with sources."""
     device = Device(phantom)
-    p = device.parameters
-    numbers = dataclasses.asdict(p)
+    config = device.config
+    stops, friction, motor, encoder = (config.limits.stops, config.actuation.friction, config.actuation.motor,
+                                       config.actuation.encoder)
     sections = {
-        "stops": {key: numbers[key] for key in ("stop_lower", "stop_upper", "theta2_minus_theta3_max",
-                                                "theta3_minus_theta2_max", "stop_stiffness", "stop_damping")},
-        "friction": {key: numbers[key] for key in ("viscous", "coulomb", "smoothing_speed")},
-        "motor": {key: numbers[key] for key in ("max_continuous_torque", "max_continuous_current", "stall_torque",
-                                                "stall_current", "torque_constant", "terminal_resistance",
-                                                "max_speed")}
-        | {"continuous_joint_torque": device.continuous_torque.tolist(),
-           "peak_joint_torque": device.peak_torque.tolist()},
-        "encoder": {"cycles_per_revolution": p.cycles_per_revolution, "counts_per_cycle": p.counts_per_cycle,
-                    "resolution": device.encoder_resolution.tolist()},
+        "stops": dataclasses.asdict(stops),
+        "friction": dataclasses.asdict(friction),
+        "motor": dataclasses.asdict(motor) | {"continuous_joint_torque": device.continuous_torque.tolist(),
+                                              "peak_joint_torque": device.peak_torque.tolist()},
+        "encoder": dataclasses.asdict(encoder) | {"resolution": device.encoder_resolution.tolist()},
         "transmission_ratio": {"ratios": device.ratios.tolist()},
     }
     for name, section in sections.items():
-        section["source"] = p.sources[name]
+        section["source"] = config.sources[name]
     deg = 180 / math.pi
     vector = " ".join
     text = {
         "stops": "stops [deg]: " + ", ".join(f"joint{i + 1} {lo * deg:.1f}..{hi * deg:.1f}"
-                                             for i, (lo, hi) in enumerate(zip(p.stop_lower, p.stop_upper)))
-        + f"; theta2 - theta3 <= {p.theta2_minus_theta3_max * deg:.1f}, theta3 - theta2 <= "
-          f"{p.theta3_minus_theta2_max * deg:.1f}; K {p.stop_stiffness:g} N m/rad, B {p.stop_damping:g} N m s/rad",
-        "friction": f"friction: viscous {p.viscous:g} N m s/rad + coulomb {p.coulomb:g} N m * tanh(dtheta / "
-                    f"{p.smoothing_speed:g} rad/s)",
-        "motor": f"motor: continuous {p.max_continuous_torque * 1e3:g} mN m / {p.max_continuous_current:g} A, "
-                 f"stall {p.stall_torque * 1e3:g} mN m / {p.stall_current:g} A, Kt {p.torque_constant * 1e3:g} "
-                 f"mN m/A, R {p.terminal_resistance:g} Ohm, no-load {p.max_speed:.1f} rad/s; at the joints: "
+                                             for i, (lo, hi) in enumerate(zip(stops.lower, stops.upper)))
+        + f"; theta2 - theta3 <= {stops.coupled.theta2_minus_theta3_max * deg:.1f}, theta3 - theta2 <= "
+          f"{stops.coupled.theta3_minus_theta2_max * deg:.1f}; K {stops.stiffness:g} N m/rad, "
+          f"B {stops.damping:g} N m s/rad",
+        "friction": f"friction: viscous {friction.viscous:g} N m s/rad + coulomb {friction.coulomb:g} N m * "
+                    f"tanh(dtheta / {friction.smoothing_speed:g} rad/s)",
+        "motor": f"motor: continuous {motor.max_continuous_torque * 1e3:g} mN m / {motor.max_continuous_current:g} A, "
+                 f"stall {motor.stall_torque * 1e3:g} mN m / {motor.stall_current:g} A, Kt "
+                 f"{motor.torque_constant * 1e3:g} mN m/A, R {motor.terminal_resistance:g} Ohm, no-load "
+                 f"{motor.max_speed:.1f} rad/s; at the joints: "
                  f"continuous [{vector(f'{x:.4f}' for x in device.continuous_torque)}] N m, peak "
                  f"[{vector(f'{x:.4f}' for x in device.peak_torque)}] N m",
-        "encoder": f"encoder: {p.cycles_per_revolution:g} cycles/rev x {p.counts_per_cycle:g} counts/cycle on "
+        "encoder": f"encoder: {encoder.cycles_per_revolution:g} cycles/rev x {encoder.counts_per_cycle:g} counts/cycle on "
                    f"the motor; resolution [{vector(f'{x:.3e}' for x in device.encoder_resolution)}] rad at the joints",
         "transmission_ratio": f"transmission ratios: [{vector(f'{x:g}' for x in device.ratios)}]",
     }

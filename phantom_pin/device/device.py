@@ -1,17 +1,18 @@
-"""Device: the physical PHANToM Premium 1.5 around the report's rigid body (stops, friction,
-motors, encoders). Phantom stays the report's rigid body; this class holds the rest."""
+"""Device: the physical PHANToM around its rigid body (stops, friction, motors, encoders).
+Phantom stays the rigid body; this class holds the rest, from the same Config."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
 
+from phantom_pin.config import Config
+from phantom_pin.description.build import Description
 import numpy as np
 
-from phantom_pin import closed_form
-from phantom_pin.device.parameters import DeviceParameters, device_parameters_from
+from phantom_pin.report import closed_form
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.model import Phantom
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.validation import as_states, same_batch
 
 #: Rows: the stop coordinates as linear maps of theta: theta1, theta2, theta3, theta2 - theta3.
@@ -19,13 +20,13 @@ STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 
 
 
 class Device:
-    """The PHANToM Premium 1.5 as a device: a Phantom plus its stops, friction, motors, encoders.
+    """The PHANToM as a device: a Phantom plus its stops, friction, motors, encoders.
 
     ``Device()`` wraps ``Phantom()``; ``Device(phantom)`` wraps a Phantom you built;
-    ``Device(config_dir=DIR)`` wraps ``Phantom(DIR)``. The device numbers (actuation.yaml
-    and joint_limits.yaml ``stops``) come from the same configuration as the Phantom
-    (``phantom.description.config``), so the transmission ratios, and hence the currents
-    and the armature, agree.
+    ``Device(source)`` wraps ``Phantom(source)`` for a model name, a configuration folder
+    or a Description. The device numbers (``config.actuation`` and ``config.limits.stops``)
+    come from the Phantom's own configuration, so the transmission ratios, and hence the
+    currents and the armature, agree.
 
     Joint vectors are the report's theta1..theta3 (rad), rates rad/s, torques N m at the
     joint, currents A in the motor windings; tip positions and forces are in the report's
@@ -35,26 +36,25 @@ class Device:
     positive direction, tau_i = ratio_i * torque_constant * i_i. A real amplifier may flip
     directions (mahilab/Phantom uses +1, -1, -1); that belongs to the driver, not here.
 
-    Attributes: ``phantom`` (the rigid body), ``parameters`` (DeviceParameters, with the
-    sources), ``ratios`` (3,).
+    Attributes: ``phantom`` (the rigid body), ``config`` (its Config: ``actuation`` and
+    ``limits.stops`` hold the device's numbers, ``sources`` where they come from),
+    ``ratios`` (3,).
     """
 
-    def __init__(self, phantom: Phantom | None = None, config_dir: Path | str | None = None) -> None:
-        if phantom is not None and config_dir is not None:
-            raise InvalidInputError("config_dir: give a phantom or a config_dir, not both "
-                                    "(a Phantom carries its configuration)")
-        if phantom is None:
-            phantom = Phantom() if config_dir is None else Phantom(config_dir)
+    def __init__(self, phantom: Phantom | Description | str | Path | None = None) -> None:
         if not isinstance(phantom, Phantom):
-            raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom or None, got {phantom!r}")
+            if phantom is not None and not isinstance(phantom, (Description, str, Path)):
+                raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, a Description, a model "
+                                        f"name, a configuration folder or None, got {phantom!r}")
+            phantom = Phantom(phantom)
         self.phantom = phantom
-        self.parameters: DeviceParameters = device_parameters_from(phantom.description.config)
-        p = self.parameters
+        self.config: Config = phantom.config
+        stops, encoder = self.config.limits.stops, self.config.actuation.encoder
         #: joint angle = motor angle / ratio (the Phantom's actuation.yaml)
-        self.ratios = np.array(phantom.parameters.ratios, dtype=float)
-        self._stop_lower = np.array([*p.stop_lower, -p.theta3_minus_theta2_max])
-        self._stop_upper = np.array([*p.stop_upper, p.theta2_minus_theta3_max])
-        self._counts_per_radian = self.ratios * p.cycles_per_revolution * p.counts_per_cycle / (2 * math.pi)
+        self.ratios = np.array(self.config.actuation.ratios, dtype=float)
+        self._stop_lower = np.array([*stops.lower, -stops.coupled.theta3_minus_theta2_max])
+        self._stop_upper = np.array([*stops.upper, stops.coupled.theta2_minus_theta3_max])
+        self._counts_per_radian = self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
 
     # -- stops -----------------------------------------------------------------------
     def within_limits(self, theta: object) -> bool | np.ndarray:
@@ -78,7 +78,7 @@ class Device:
         """
         target, batch = as_states(position, "position")
         target = target.reshape(-1, 3)
-        p = self.phantom.parameters
+        p = self.config.kinematics
         shoulder = np.array([0.0, p.l2, -p.l1])  # in frame s (eqs 4-5)
         distance = np.linalg.norm(target - shoulder, axis=-1)
         shell = (distance > abs(p.l1 - p.l2)) & (distance < p.l1 + p.l2)
@@ -86,7 +86,7 @@ class Device:
         if shell.any():
             wraps = 2 * np.pi * np.array([[0, k2, k3] for k2 in (-1, 0, 1) for k3 in (-1, 0, 1)])
             for branch in ("report", "other"):
-                front = closed_form.inverse_kinematics(target[shell], branch, p)
+                front = closed_form.inverse_kinematics(target[shell], p, branch)
                 back = np.stack([front[:, 0] - np.sign(front[:, 0]) * np.pi,
                                  np.pi - front[:, 1], -front[:, 2]], axis=-1)
                 for theta in (front, back):
@@ -103,7 +103,7 @@ class Device:
         """Potential energy of the stop springs (J): K/2 * sum of squared penetrations of
         theta1, theta2, theta3 and theta2 - theta3 beyond their stops; zero inside."""
         q, _ = as_states(theta, "theta")
-        return 0.5 * self.parameters.stop_stiffness * np.sum(self._penetration(q) ** 2, axis=-1)
+        return 0.5 * self.config.limits.stops.stiffness * np.sum(self._penetration(q) ** 2, axis=-1)
 
     def stop_torque(self, theta: object, dtheta: object) -> np.ndarray:
         """Torque of the hard stops on the joints (N m): (..., 3).
@@ -122,9 +122,9 @@ class Device:
         return self._stop_torque(q, v)
 
     def _stop_torque(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
-        p = self.parameters
+        stops = self.config.limits.stops
         depth = self._penetration(theta)
-        force = p.stop_stiffness * depth + p.stop_damping * (dtheta @ STOP_COORDINATES.T) * (depth != 0)
+        force = stops.stiffness * depth + stops.damping * (dtheta @ STOP_COORDINATES.T) * (depth != 0)
         return -force @ STOP_COORDINATES
 
     # -- friction --------------------------------------------------------------------
@@ -140,20 +140,19 @@ class Device:
         return self._friction(v)
 
     def _friction(self, dtheta: np.ndarray) -> np.ndarray:
-        p = self.parameters
-        return p.viscous * dtheta + p.coulomb * np.tanh(dtheta / p.smoothing_speed)
+        return self.config.actuation.friction.torque(dtheta)
 
     # -- motors ----------------------------------------------------------------------
     @property
     def continuous_torque(self) -> np.ndarray:
         """Joint torque (N m) of each motor's max. continuous torque: max_continuous_torque * ratio."""
-        return self.parameters.max_continuous_torque * self.ratios
+        return self.config.actuation.motor.max_continuous_torque * self.ratios
 
     @property
     def peak_torque(self) -> np.ndarray:
         """Joint torque (N m) of each motor's stall torque, the most it gives: stall_torque * ratio.
         simulate() clips commanded torques here."""
-        return self.parameters.stall_torque * self.ratios
+        return self.config.actuation.motor.stall_torque * self.ratios
 
     def _limit(self, continuous: bool) -> np.ndarray:
         return self.continuous_torque if continuous else self.peak_torque
@@ -161,12 +160,12 @@ class Device:
     def motor_currents(self, tau: object) -> np.ndarray:
         """Winding currents (A) that give joint torques tau (N m): tau / (ratio * torque_constant)."""
         t, _ = as_states(tau, "tau")
-        return t / (self.ratios * self.parameters.torque_constant)
+        return t / (self.ratios * self.config.actuation.motor.torque_constant)
 
     def joint_torques(self, currents: object) -> np.ndarray:
         """Joint torques (N m) of winding currents (A): ratio * torque_constant * currents."""
         i, _ = as_states(currents, "currents")
-        return i * self.ratios * self.parameters.torque_constant
+        return i * self.ratios * self.config.actuation.motor.torque_constant
 
     def available_torque(self, theta: object, continuous: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Joint torques (N m) left for rendering forces at theta after holding gravity.

@@ -13,7 +13,7 @@ import pinocchio as pin
 
 from phantom_pin.device.device import Device
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.model import solve_spd
+from phantom_pin.dynamics.model import solve_spd
 from phantom_pin.validation import as_state
 
 #: Most samples one call may produce (duration * rate + 1).
@@ -78,11 +78,11 @@ def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool,
     stop and the coupled one, stiffness matrix eigenvalue up to 3 K) and the damping rate
     (3 B + viscous + coulomb / smoothing_speed) / m (the tanh friction's slope at rest).
     """
-    p = device.parameters
+    stops, law = device.config.limits.stops, device.config.actuation.friction
     inertia = 0.5 * float(np.linalg.eigvalsh(device.phantom.mass_matrix(theta0)).min())
-    stiffness = 3 * p.stop_stiffness if hard_stops else 0.0
-    damping = (3 * p.stop_damping if hard_stops else 0.0) + \
-        (p.viscous + p.coulomb / p.smoothing_speed if friction else 0.0)
+    stiffness = 3 * stops.stiffness if hard_stops else 0.0
+    damping = (3 * stops.damping if hard_stops else 0.0) + \
+        (law.viscous + law.coulomb / law.smoothing_speed if friction else 0.0)
     fastest = max(math.sqrt(stiffness / inertia), damping / inertia)
     return max(1, math.ceil(period * fastest / STEP_SCALE), math.ceil(period / MAX_STEP * (1 - 1e-12)))
 
@@ -134,13 +134,12 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         raise InvalidInputError(f"substeps: expected an integer >= 1, got {substeps!r}")
     substeps = int(substeps)
 
-    p = device.parameters
     model = device.phantom.model
     data = model.createData()
     peak = device.peak_torque
     bounds = list(zip(device._stop_lower.tolist(), device._stop_upper.tolist()))
-    stop_k, stop_b = p.stop_stiffness, p.stop_damping
-    viscous, coulomb, smoothing = p.viscous, p.coulomb, p.smoothing_speed
+    stop_k, stop_b = device.config.limits.stops.stiffness, device.config.limits.stops.damping
+    friction_torque = device.config.actuation.friction.torque
 
     # Stop coordinates c = theta1, theta2, theta3, theta2 - theta3 with their gradients
     # dc/dtheta (the rows of STOP_COORDINATES): Device.stop_torque, in scalars for speed.
@@ -151,8 +150,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         Device.friction and Device.stop_torque, without their per-call checks."""
         qs, vs, total = q.tolist(), v.tolist(), list(tau)
         if friction:
-            for i in range(3):
-                total[i] -= viscous * vs[i] + coulomb * math.tanh(vs[i] / smoothing)
+            losses = friction_torque(v).tolist()
+            total = [total[0] - losses[0], total[1] - losses[1], total[2] - losses[2]]
         if hard_stops:
             for i, j, lo, hi in stops:
                 c, rate = (qs[i], vs[i]) if j is None else (qs[i] - qs[j], vs[i] - vs[j])

@@ -17,15 +17,14 @@ eight constants K1, K2, K3, L, M22, M33 and the gravity coefficients of eqs 81-9
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import scipy.linalg
 
+from phantom_pin.config.sampling import sample_postures
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.identification import constants, parameterization
-from phantom_pin.identification.excitation import Limits
 from phantom_pin.identification.regressor import Regressor
-from phantom_pin.paths import CONFIG_DIR
 
 #: Relative size of |R_kk| below which a column counts as dependent.
 RANK_TOLERANCE = 1e-9
@@ -89,13 +88,14 @@ class Structured:
 
     Phi = [Y_rigid A, Y_friction] with pi = A x + b (parameterization.affine_map); tau_0 =
     Y_rigid b is the part fixed by the known parameters (zero here: the pins' compensation
-    cancels and the base's fixed parameters do not enter).
+    cancels and the base's fixed parameters do not enter). The configuration is the
+    regressor's Phantom's (``description``).
     """
 
-    def __init__(self, regressor: Regressor | None = None, config_dir: Path | str = CONFIG_DIR) -> None:
-        self.regressor = regressor or Regressor()
-        self.config_dir = config_dir
-        self.affine, self.offset = parameterization.affine_map(config_dir)
+    def __init__(self, regressor: Regressor) -> None:
+        self.regressor = regressor
+        self.description = regressor.phantom.description
+        self.affine, self.offset = parameterization.affine_map(self.description)
         self.names = tuple(parameterization.SYMBOLS) + tuple(
             f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
 
@@ -108,14 +108,15 @@ class Structured:
 
 
 def sample(regressor: Regressor, n: int = 300, seed: int = 0) -> tuple[np.ndarray, ...]:
-    """``n`` seeded states inside the joint box and the coupled stops (rad, rad/s, rad/s^2)."""
-    theta = Limits.read().sample(n, seed)
+    """``n`` seeded states inside the limits of the regressor's configuration (the box, the
+    stops and the coupled stops; rad, rad/s, rad/s^2)."""
+    theta = sample_postures(regressor.phantom.config.limits, n, np.random.default_rng(seed), draws=4 * n)
     rng = np.random.default_rng(seed + 1)
     return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
 
 
 def main() -> None:
-    regressor = Regressor()
+    regressor = Regressor(Phantom())
     states = sample(regressor)
     full = base_parameters(regressor.stacked(*states), regressor.names,
                            np.maximum(np.abs(regressor.parameters(5e-4, 0.01)), 1e-6))
@@ -124,11 +125,11 @@ def main() -> None:
     print("\n".join(full.describe()))
     structured = Structured(regressor)
     phi = structured(*states)[0].reshape(-1, len(structured.names))
-    x0 = parameterization.report_vector()
+    x0 = parameterization.report_vector(structured.description.config)
     report = base_parameters(phi, structured.names, np.concatenate([np.abs(x0), [5e-4] * 3 + [0.01] * 3]))
     print(f"\nThe report's structure: {len(structured.names)} parameters (report parameters and "
           f"friction), {report.rank} base parameters: the friction and the report's constants")
-    for name, row in zip(constants.NAMES, constants.constants_matrix()):
+    for name, row in zip(constants.NAMES, constants.constants_matrix(structured.description)):
         print(f"{name:4} = {words(row, parameterization.SYMBOLS)}")
 
 

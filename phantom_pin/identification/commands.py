@@ -36,9 +36,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
 
 
-def excite(args: argparse.Namespace, phantom: object = None) -> int:
+def excite(args: argparse.Namespace, phantom) -> int:
+    """phantom-pin excite, for the configuration of ``phantom`` (--model or --config)."""
     from phantom_pin.identification import constants, excitation, io
 
+    description = phantom.description
     _refuse(args.output, args.force)
     for name in ("duration", "rate", "period"):
         if not getattr(args, name) > 0:
@@ -46,42 +48,43 @@ def excite(args: argparse.Namespace, phantom: object = None) -> int:
     if args.harmonics < 2 or args.iterations < 1 or args.restarts < 1:
         raise PhantomPinError("--harmonics must be at least 2, --iterations and --restarts at least 1")
     try:
-        result = excitation.optimise(args.config, args.period, args.harmonics,
+        result = excitation.optimise(description, args.period, args.harmonics,
                                      iterations=args.iterations, restarts=args.restarts, seed=args.seed)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
     periods = int(np.ceil(args.duration / args.period - 1e-9))
     t = np.arange(int(round(periods * args.period * args.rate)) + 1) / args.rate
     theta, dtheta, ddtheta = result.trajectory(t)
-    beta = constants.nominal(args.config)
-    tau = constants.regressor(theta, dtheta, ddtheta, args.config) @ beta
+    beta = constants.nominal(description)
+    tau = constants.regressor(theta, dtheta, ddtheta, description) @ beta
     io.write_csv(args.output, io.TRAJECTORY_COLUMNS, np.column_stack([t, theta, dtheta, ddtheta, tau]))
-    limits = excitation.Limits.read(args.config)
+    effort = excitation.continuous_effort(description)
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
           f"{args.harmonics} harmonics per joint")
     print(f"condition number of the base regressor (14 columns scaled to unit norm): {result.condition:.3g}")
-    print("peak torque [N m] (report model + shipped friction) / motor continuous limit: "
-          + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(np.abs(tau).max(axis=0), limits.effort)))
+    print("peak torque [N m] (report model + the configuration's friction) / motor continuous limit: "
+          + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(np.abs(tau).max(axis=0), effort)))
     print(f"nearest approach to a stop: {result.min_slack:.3f} rad; the file starts and ends at rest")
     return 0
 
 
-def identify(args: argparse.Namespace, phantom: object = None) -> int:
-    from phantom_pin.description import describe
+def identify(args: argparse.Namespace, phantom) -> int:
+    """phantom-pin identify, for the configuration of ``phantom`` (--model or --config)."""
+    from phantom_pin.description.build import describe
     from phantom_pin.identification import constants, estimation, io, parameterization
 
     _refuse(args.output, args.force)
     log = io.read_log(args.log)
     try:
-        fit = estimation.estimate(log, args.config, args.cutoff)
+        fit = estimation.estimate(log, phantom, args.cutoff)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
     keys, notes = io.overlay(fit)
-    try:  # the overlay must give a physical URDF (phantom_pin.physical.check_urdf)
-        describe(args.config, overrides=keys)
+    try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
+        describe(phantom.config.folder, overrides=keys)
     except PhantomPinError as error:
         raise PhantomPinError(f"identified parameters not physically valid: {error}") from None
-    report = constants.report_constants(parameterization.report_vector(args.config), args.config)
+    report = constants.report_constants(parameterization.report_vector(phantom.config), phantom.description)
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
           f"condition number {fit.condition:.3g}")
     print("residual RMS per joint [N m]: " + ", ".join(

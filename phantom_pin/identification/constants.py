@@ -12,16 +12,13 @@ The friction columns are dtheta_i and tanh(dtheta_i / smoothing_speed).
 from __future__ import annotations
 
 import dataclasses
-import functools
-from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import closed_form
+from phantom_pin.description.build import Description
 from phantom_pin.identification import parameterization
-from phantom_pin.identification.regressor import smoothing_speed
-from phantom_pin.parameters import Parameters, load_parameters, read_config
-from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.report import closed_form
+from phantom_pin.report.parameters import ReportParameters
 
 #: The report's lumped constants (eqs 81-94), then the friction, in beta's order.
 NAMES = ("K1", "K2", "K3", "L", "M22", "M33", "N2", "N3")
@@ -30,11 +27,11 @@ FRICTION_NAMES = tuple(f"{kind}{j}" for kind in ("viscous", "coulomb") for j in 
 UNITS = ("kg m^2",) * 6 + ("N m",) * 2 + ("N m s/rad",) * 3 + ("N m",) * 3
 
 
-def report_constants(x: np.ndarray, config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+def report_constants(x: np.ndarray, description: Description) -> np.ndarray:
     """K1, K2, K3, L, M22, M33 (kg m^2), N2, N3 (N m) of the report parameters ``x``, read
     off closed_form's M and N (eqs 81-85, 93-94): M11 = K1 + K2/8 cos 2t2 + K3/8 cos 2t3 +
     L cos t2 sin t3, M23 = -L/2 sin(t2 - t3), N2 = n2 cos t2, N3 = n3 sin t3."""
-    p = _parameters(np.asarray(x, float), load_parameters(config_dir))
+    p = parameterization.report_parameters(np.asarray(x, float), description.config)
     h = np.pi / 2
     states = np.array([[0, 0, 0], [0, h, 0], [0, 0, h], [0, h / 2, h / 3]])
     m = closed_form.mass_matrix(states, p)
@@ -45,40 +42,33 @@ def report_constants(x: np.ndarray, config_dir: Path | str = CONFIG_DIR) -> np.n
     return np.array([k1, k2, k3, lam, m[0, 1, 1], m[0, 2, 2], closed_form.gravity([0.0, 0.0, 0.0], p)[1], n[2]])
 
 
-def _parameters(x: np.ndarray, known: Parameters) -> Parameters:
-    values = dict(zip(parameterization.SYMBOLS, x))
-    return dataclasses.replace(
-        known, ma=values["ma"], Iaxx=values["Iaxx"], Iayy=values["Iayy"], Iazz=values["Iazz"],
-        mc=values["mc"], Icxx=values["Icxx"], Icyy=values["Icyy"], Iczz=values["Iczz"],
-        mbe=values["mbe"], l5=values["mbe*l5"] / values["mbe"], Ibexx=values["Ibexx"],
-        Ibeyy=values["Ibeyy"], Ibezz=values["Ibezz"], mdf=values["mdf"],
-        l6=values["mdf*l6"] / values["mdf"], Idfxx=values["Idfxx"], Idfyy=values["Idfyy"],
-        Idfzz=values["Idfzz"], Ibaseyy=values["Ibaseyy"], rotor_inertia=values["J"])
-
-
-def constants_matrix(config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+def constants_matrix(description: Description) -> np.ndarray:
     """C (8, 20) with report_constants(x) = C x: the constants are linear in x (lengths fixed).
-    Unit steps (1 kg, 1 kg m, 1 kg m^2) keep the differences exact to rounding."""
-    x0 = parameterization.report_vector(config_dir)
-    c0 = report_constants(x0, config_dir)
-    columns = []
-    for k in range(len(x0)):
-        x = x0.copy()
-        x[k] += 1.0
-        columns.append(report_constants(x, config_dir) - c0)
-    return np.stack(columns, axis=1)
+    Unit steps (1 kg, 1 kg m, 1 kg m^2) keep the differences exact to rounding. Cached on
+    the Description."""
+    if "constants_matrix" not in description.cache:
+        x0 = parameterization.report_vector(description.config)
+        c0 = report_constants(x0, description)
+        columns = []
+        for k in range(len(x0)):
+            x = x0.copy()
+            x[k] += 1.0
+            columns.append(report_constants(x, description) - c0)
+        description.cache["constants_matrix"] = np.stack(columns, axis=1)
+    return description.cache["constants_matrix"].copy()
 
 
-@functools.lru_cache(maxsize=4)
-def _unit_parameters(config_dir: str) -> tuple[Parameters, ...]:
-    """One Parameters per constant whose constants are e_k (x = C^+ e_k)."""
-    known = load_parameters(config_dir)
-    c = constants_matrix(config_dir)
-    pseudo = np.linalg.pinv(c)
-    return tuple(_linear_parameters(pseudo[:, k], known) for k in range(len(NAMES)))
+def _unit_parameters(description: Description) -> tuple[ReportParameters, ...]:
+    """One ReportParameters per constant whose constants are e_k (x = C^+ e_k), cached."""
+    if "unit_parameters" not in description.cache:
+        pseudo = np.linalg.pinv(constants_matrix(description))
+        known = parameterization.report_of(description.config)
+        description.cache["unit_parameters"] = tuple(_linear_parameters(pseudo[:, k], known)
+                                                     for k in range(len(NAMES)))
+    return description.cache["unit_parameters"]
 
 
-def _linear_parameters(x: np.ndarray, known: Parameters) -> Parameters:
+def _linear_parameters(x: np.ndarray, known: ReportParameters) -> ReportParameters:
     """Parameters that closed_form reads linearly in x: mbe and mdf enter closed_form only as
     mbe * l5 and mdf * l6 (eqs 93-94), so they carry the first moments with l5 = l6 = 1 m."""
     values = dict(zip(parameterization.SYMBOLS, x))
@@ -87,27 +77,25 @@ def _linear_parameters(x: np.ndarray, known: Parameters) -> Parameters:
         mc=values["mc"], Icxx=values["Icxx"], Icyy=values["Icyy"], Iczz=values["Iczz"],
         mbe=values["mbe*l5"], l5=1.0, Ibexx=values["Ibexx"], Ibeyy=values["Ibeyy"],
         Ibezz=values["Ibezz"], mdf=values["mdf*l6"], l6=1.0, Idfxx=values["Idfxx"],
-        Idfyy=values["Idfyy"], Idfzz=values["Idfzz"], Ibaseyy=values["Ibaseyy"],
-        rotor_inertia=values["J"])
+        Idfyy=values["Idfyy"], Idfzz=values["Idfzz"], Ibaseyy=values["Ibaseyy"])
 
 
 def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
-              config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
-    """Phi (..., 3, 14) from closed_form's inverse dynamics, one constant at a time (vectorised)."""
-    units = _unit_parameters(str(Path(config_dir).resolve()))
-    columns = [closed_form.inverse_dynamics(theta, dtheta, ddtheta, p) for p in units]
+              description: Description) -> np.ndarray:
+    """Phi (..., 3, 14) from closed_form's inverse dynamics, one constant at a time (vectorised);
+    the friction columns are dtheta_i and tanh(dtheta_i / smoothing_speed) of the description's
+    friction law (Friction.torque with unit coefficients)."""
+    columns = [closed_form.inverse_dynamics(theta, dtheta, ddtheta, p) for p in _unit_parameters(description)]
     dtheta = np.asarray(dtheta, float)
-    speed = smoothing_speed(config_dir)
+    law = description.config.actuation.friction
     eye = np.eye(3)
     viscous = dtheta[..., :, None] * eye
-    coulomb = np.tanh(dtheta / speed)[..., :, None] * eye
+    coulomb = dataclasses.replace(law, viscous=0.0, coulomb=1.0).torque(dtheta)[..., :, None] * eye
     return np.concatenate([np.stack(columns, axis=-1), viscous, coulomb], axis=-1)
 
 
-def nominal(config_dir: Path | str = CONFIG_DIR) -> np.ndarray:
+def nominal(description: Description) -> np.ndarray:
     """beta of a configuration: its report constants and its friction (the same on each joint)."""
-    config = read_config(config_dir)
-    viscous = config.number("actuation_file", "friction", "viscous")
-    coulomb = config.number("actuation_file", "friction", "coulomb")
-    return np.concatenate([report_constants(parameterization.report_vector(config_dir), config_dir),
-                           [viscous] * 3, [coulomb] * 3])
+    law = description.config.actuation.friction
+    return np.concatenate([report_constants(parameterization.report_vector(description.config), description),
+                           [law.viscous] * 3, [law.coulomb] * 3])

@@ -16,17 +16,15 @@ friction, and the nearest physically consistent report parameters.
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import scipy.signal
 
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.identification import constants, parameterization, physical
 from phantom_pin.identification.base import Structured, base_parameters
 from phantom_pin.identification.io import Log, LogError
-from phantom_pin.identification.regressor import Regressor, smoothing_speed
-from phantom_pin.model import Phantom
-from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.identification.regressor import Regressor
 
 #: Largest accepted condition number of the base regressor (columns scaled to unit norm).
 MAX_CONDITION = 1e3
@@ -76,19 +74,18 @@ def base_regressor(structured: Structured, theta, dtheta, ddtheta) -> tuple[np.n
     Phi = [Phi_x C^+, Phi_friction] (Phi_x = Y A, exact because Phi_x = Phi_constants C)."""
     phi_x, tau0 = structured(theta, dtheta, ddtheta)
     n = len(parameterization.NAMES)
-    pseudo = np.linalg.pinv(constants.constants_matrix(structured.config_dir))
+    pseudo = np.linalg.pinv(constants.constants_matrix(structured.description))
     return np.concatenate([phi_x[..., :n] @ pseudo, phi_x[..., n:]], axis=-1), tau0
 
 
-def estimate(log: Log, config_dir: Path | str = CONFIG_DIR, cutoff: float = 20.0,
-             prior_weight: float = 1e-3) -> Fit:
-    """Identify beta and the nearest consistent report parameters from a device log."""
+def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: float = 1e-3) -> Fit:
+    """Identify beta and the nearest consistent report parameters from a device log, for the
+    configuration of ``phantom`` (its report numbers are the prior, its friction law the
+    friction columns). Everything it needs is computed once per Description (cached on it)."""
     theta, dtheta, ddtheta, tau = filtered(log, cutoff)
     if len(theta) < 50:
         raise LogError(f"too short: {len(theta)} samples after filtering (need 50)")
-    shipped = Path(config_dir).resolve() == CONFIG_DIR.resolve()
-    phantom = Phantom() if shipped else Phantom(config_dir)
-    structured = Structured(Regressor(phantom, smoothing_speed(config_dir)), config_dir)
+    structured = Structured(Regressor(phantom))
     phi, tau0 = base_regressor(structured, theta, dtheta, ddtheta)
     p = phi.shape[-1]
     stacked, y = phi.reshape(-1, p), (tau - tau0).reshape(-1)
@@ -107,12 +104,12 @@ def estimate(log: Log, config_dir: Path | str = CONFIG_DIR, cutoff: float = 20.0
     s2 = rw @ rw / (len(yw) - p)
     covariance = s2 * np.linalg.inv(weighted.T @ weighted)
     residual = (y - stacked @ beta).reshape(-1, 3)
-    c = constants.constants_matrix(config_dir)
+    c = constants.constants_matrix(phantom.description)
     n = len(constants.NAMES)
     info = np.linalg.inv(covariance[:n, :n])
     root = np.linalg.cholesky(info).T                       # root^T root = covariance^-1
     affine, offset = structured.affine, structured.offset
-    prior = parameterization.report_vector(config_dir)
+    prior = parameterization.report_vector(phantom.config)
     x = physical.nearest(beta[:n], root, c, prior, affine, offset, prior_weight)
     general = structured.regressor.stacked(theta, dtheta, ddtheta)
     base = base_parameters(general, structured.regressor.names)

@@ -9,50 +9,12 @@ the trajectory starts and ends each period at rest (dtheta = ddtheta = 0 at t = 
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import scipy.optimize
 
+from phantom_pin.description.build import Description
 from phantom_pin.identification import constants
-from phantom_pin.device.parameters import device_parameters_from
-from phantom_pin.parameters import parameters_from, read_config, sample_inside
-from phantom_pin.paths import CONFIG_DIR
-
-
-@dataclasses.dataclass(frozen=True)
-class Limits:
-    """Where and how hard the arm may move: the joint box (rad) intersected with the stops' box,
-    the coupled stops theta2 - theta3 <= d23, theta3 - theta2 <= d32 (rad), and each motor's
-    continuous torque at the joint (N m)."""
-
-    lower: np.ndarray
-    upper: np.ndarray
-    d23: float
-    d32: float
-    effort: np.ndarray
-
-    @classmethod
-    def read(cls, config_dir: Path | str = CONFIG_DIR) -> "Limits":
-        config = read_config(config_dir)
-        p, device = parameters_from(config), device_parameters_from(config)
-        lower = np.maximum(p.lower, device.stop_lower)
-        upper = np.minimum(p.upper, device.stop_upper)
-        effort = device.max_continuous_torque * np.array(p.ratios)
-        return cls(lower, upper, device.theta2_minus_theta3_max, device.theta3_minus_theta2_max, effort)
-
-    def slack(self, theta: np.ndarray) -> np.ndarray:
-        """Distance (rad) to every limit at each state, (..., 8): >= 0 inside."""
-        t = np.asarray(theta, float)
-        return np.concatenate([self.upper - t, t - self.lower,
-                               (self.d23 - (t[..., 1] - t[..., 2]))[..., None],
-                               (self.d32 - (t[..., 2] - t[..., 1]))[..., None]], axis=-1)
-
-    def sample(self, n: int, seed: int, margin: float = 0.0) -> np.ndarray:
-        """``n`` seeded postures (rad), uniform inside the box and the coupled stops."""
-        return sample_inside(np.random.default_rng(seed), self.lower, self.upper,
-                             lambda theta: (self.slack(theta) >= margin).all(axis=1), n, 4 * n,
-                             f"the stops and the coupled stops, {margin} rad inside,")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,6 +47,12 @@ class Fourier:
         return theta, dtheta, ddtheta
 
 
+def continuous_effort(description: Description) -> np.ndarray:
+    """Each motor's max. continuous torque at its joint (N m): the excitation's torque bound."""
+    actuation = description.config.actuation
+    return actuation.motor.max_continuous_torque * np.array(actuation.ratios)
+
+
 def condition_number(phi: np.ndarray) -> float:
     """Condition number of a stacked base regressor after scaling its columns to unit norm."""
     norms = np.linalg.norm(phi, axis=0)
@@ -95,11 +63,11 @@ def condition_number(phi: np.ndarray) -> float:
 class Excitation:
     trajectory: Fourier
     condition: float        # of the base regressor over one period (columns scaled to unit norm)
-    peak_torque: np.ndarray  # N m per joint, report model with the shipped friction
+    peak_torque: np.ndarray  # N m per joint, report model with the configuration's friction
     min_slack: float        # rad, nearest approach to a stop
 
 
-def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics: int = 5,
+def optimise(description: Description, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0,
              amplitude_weight: float = 3.0) -> Excitation:
@@ -107,17 +75,18 @@ def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics
     base regressor (columns scaled to unit norm for the first, weighted by the nominal beta
     for the second, so that the torques grow against the noise) over the Fourier
     coefficients, subject to: positions ``margin`` (rad) inside every stop, and the report model's torque (with the
-    shipped friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
+    configuration's friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
     ``restarts`` seeded random starts; the best feasible result is returned."""
-    limits = Limits.read(config_dir)
-    beta = constants.nominal(config_dir)
+    limits = description.config.limits
+    effort = continuous_effort(description)
+    beta = constants.nominal(description)
     t = np.linspace(0.0, period, samples, endpoint=False)
     rng = np.random.default_rng(seed)
 
     def evaluate(free):
         trajectory = Fourier.from_free(free, harmonics, period)
         states = trajectory(t)
-        phi = constants.regressor(*states, config_dir).reshape(-1, len(beta))
+        phi = constants.regressor(*states, description).reshape(-1, len(beta))
         return states, phi
 
     def cost(free):
@@ -131,7 +100,7 @@ def optimise(config_dir: Path | str = CONFIG_DIR, period: float = 5.0, harmonics
         states, phi = evaluate(free)
         torque = (phi @ beta).reshape(-1, 3)
         return np.concatenate([limits.slack(states[0]).ravel() - margin,
-                               (torque_share * limits.effort - np.abs(torque)).ravel() * 10])
+                               (torque_share * effort - np.abs(torque)).ravel() * 10])
 
     start_q0 = np.array([0.0, 0.35, 0.35])
     best, best_cost = None, np.inf

@@ -1,5 +1,6 @@
-"""Physical consistency: every link's mass positive, inertia at the COM positive definite and
-satisfying the triangle inequality; and the nearest consistent report parameters to an estimate.
+"""Physical consistency of identified parameters: every link passes the one physical check of a
+link (phantom_pin.inertial.problem), the rotor inertia is positive; and the nearest
+consistent report parameters to an estimate.
 """
 
 from __future__ import annotations
@@ -8,13 +9,7 @@ import numpy as np
 import scipy.optimize
 
 from phantom_pin.identification import parameterization
-
-#: Smallest accepted link mass (kg) and principal moment (kg m^2), and triangle-inequality
-#: slack lambda1 + lambda2 - lambda3 as a share of lambda3: MuJoCo refuses a link at the
-#: boundary (A + B >= C fails by rounding), and the report's thin forearm has 0.37 %.
-MIN_MASS, MIN_MOMENT, MIN_SLACK = 1e-6, 1e-10, 1e-3
-#: Smallest accepted rotor inertia (kg m^2).
-MIN_ROTOR = 1e-9
+from phantom_pin.inertial import TRIANGLE_SLACK, Inertial, problem
 
 
 def body_margins(pi_inertial: np.ndarray) -> np.ndarray:
@@ -32,14 +27,21 @@ def body_margins(pi_inertial: np.ndarray) -> np.ndarray:
 
 
 def _constraints(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """The smooth margins of the physical check (>= 0 where it holds, scaled for SLSQP)."""
     pi = affine @ x + offset
     margins = body_margins(pi[:-3])
-    return np.concatenate([margins[:, 0] - MIN_MASS, (margins[:, 1] - MIN_MOMENT) * 1e4,
-                           (margins[:, 2] - MIN_SLACK * margins[:, 3]) * 1e4, [(x[parameterization.ROTOR] - MIN_ROTOR) * 1e6]])
+    return np.concatenate([margins[:, 0], margins[:, 1] * 1e4, (margins[:, 2] - TRIANGLE_SLACK * margins[:, 3]) * 1e4,
+                           [x[parameterization.ROTOR] * 1e6]])
 
 
 def consistent(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> bool:
-    return bool(_constraints(x, affine, offset).min() >= -1e-12)
+    """True if every tree body of pi = affine x + offset passes phantom_pin.inertial.problem
+    and the rotor inertia x[ROTOR] is positive."""
+    pi = affine @ x + offset
+    if not x[parameterization.ROTOR] > 0:
+        return False
+    bodies = np.asarray(pi[:-3]).reshape(-1, 10)
+    return all(body[0] > 0 and problem(Inertial.from_dynamic_parameters(body)) is None for body in bodies)
 
 
 def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarray,

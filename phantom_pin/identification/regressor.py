@@ -17,21 +17,17 @@ and is projected: Y = G^T Y_tree. Gravity is the model's (base_link -z).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin.model import Phantom
-from phantom_pin.parameters import read_config
-from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.validation import as_states, same_batch
 
 #: Pinocchio's order of the standard parameters of one body (pin.Inertia.toDynamicParameters).
 INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
-
-
-def smoothing_speed(config_dir=CONFIG_DIR) -> float:
-    """actuation.yaml friction.smoothing_speed (rad/s) of the Coulomb term's tanh."""
-    return read_config(config_dir).number("actuation_file", "friction", "smoothing_speed", positive=True)
 
 
 def body_names(tree: pin.Model) -> list[str]:
@@ -44,14 +40,18 @@ def body_names(tree: pin.Model) -> list[str]:
 
 
 class Regressor:
-    """Y(theta, dtheta, ddtheta) of a Phantom: (..., 3, n_parameters), see the module doc."""
+    """Y(theta, dtheta, ddtheta) of a Phantom: (..., 3, n_parameters), see the module doc.
+    The friction columns follow the Phantom's own friction law (its config's smoothing speed)."""
 
-    def __init__(self, phantom: Phantom | None = None, speed: float | None = None) -> None:
-        self.phantom = phantom or Phantom()
+    def __init__(self, phantom: Phantom) -> None:
+        if not isinstance(phantom, Phantom):
+            raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, got {phantom!r}")
+        self.phantom = phantom
         self.coupling = self.phantom.coupling
         self.tree = self.coupling.tree
         self._data = self.tree.createData()
-        self.smoothing_speed = smoothing_speed() if speed is None else float(speed)
+        #: the Coulomb column: the friction law with unit Coulomb and no viscous term
+        self._coulomb = dataclasses.replace(phantom.config.actuation.friction, viscous=0.0, coulomb=1.0).torque
         self.bodies = body_names(self.tree)
         self.n_inertial = 10 * len(self.bodies)
         self.names = ([f"{b}.{p}" for b in self.bodies for p in INERTIAL_NAMES]
@@ -79,7 +79,7 @@ class Regressor:
         tree_y = pin.computeJointTorqueRegressor(self.tree, self._data, c.configuration(q),
                                                  c.tangent(v), c.tangent(a))
         return np.hstack([c.matrix.T @ tree_y, np.diag(a), np.diag(v),
-                          np.diag(np.tanh(v / self.smoothing_speed))])
+                          np.diag(self._coulomb(v))])
 
     def __call__(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
         """Y at one state (3, P) or a batch (N, 3, P); rad, rad/s, rad/s^2 -> N m per unit."""

@@ -2,7 +2,7 @@
 any parameters, friction, torque noise and encoder quantization, tracking a trajectory.
 
 Integration: classical RK4 at the log's rate with the commanded torque held over each step
-(zero-order hold). Controller: the shipped report model's inverse dynamics along the
+(zero-order hold). Controller: the inverse dynamics of the parameters model along the
 reference plus PD feedback (on the quantized position and the true velocity). Logged: time,
 the quantized positions and the *commanded* torques, as a real device's log.
 """
@@ -13,18 +13,19 @@ from typing import Callable
 
 import numpy as np
 
-from phantom_pin import closed_form
+from phantom_pin.report import closed_form
 from phantom_pin.identification.io import Log
-from phantom_pin.parameters import Parameters
+from phantom_pin.report.parameters import ReportParameters
 
 
 def simulate(reference: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-             duration: float, truth: Parameters, viscous: np.ndarray, coulomb: np.ndarray,
+             duration: float, truth: ReportParameters, model: ReportParameters, viscous: np.ndarray, coulomb: np.ndarray,
              smoothing_speed: float, rate: float = 1000.0, torque_noise: float = 0.0,
              resolution: np.ndarray | float = 0.0, kp: float = 5.0, kd: float = 0.05,
              seed: int = 0) -> Log:
     """Track ``reference(t) -> (theta, dtheta, ddtheta)`` (rad, rad/s, rad/s^2 at (N,) times)
-    for ``duration`` s on the device ``truth`` with friction viscous * dtheta + coulomb *
+    for ``duration`` s on the device ``truth``, fed forward with the inverse dynamics of
+    ``model`` (the parameters the controller believes), with friction viscous * dtheta + coulomb *
     tanh(dtheta / smoothing_speed) (N m s/rad, N m, rad/s). ``torque_noise``: standard
     deviation (N m) of white noise added to the applied torque; ``resolution``: encoder step
     at the joint (rad); kp (N m/rad), kd (N m s/rad): feedback gains."""
@@ -33,7 +34,7 @@ def simulate(reference: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.
     t = np.arange(n) / rate
     dt = 1.0 / rate
     ref_q, ref_v, ref_a = reference(t)
-    feedforward = closed_form.inverse_dynamics(ref_q, ref_v, ref_a)
+    feedforward = closed_form.inverse_dynamics(ref_q, ref_v, ref_a, model)
     resolution = np.broadcast_to(np.asarray(resolution, float), 3)
 
     def quantize(q):

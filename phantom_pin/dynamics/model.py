@@ -11,12 +11,11 @@ from typing import Callable, Sequence
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin.coupling import Coupling
-from phantom_pin.description import Description, describe, shipped
+from phantom_pin.dynamics.coupling import Coupling
+from phantom_pin.config import Config
+from phantom_pin.description.build import Description, description_of
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
-from phantom_pin.loader import load_rotor_parameters
-from phantom_pin.parameters import Parameters
-from phantom_pin.paths import CONFIG_DIR
+from phantom_pin.dynamics.loader import load_rotor_parameters
 from phantom_pin.validation import as_states, finite_result, same_batch, within_box, wrap_angle
 
 #: Newton iterations and position tolerance (m) of inverse_kinematics.
@@ -94,13 +93,13 @@ def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Calla
 
 
 class Phantom:
-    """The PHANToM 1.5 in the report's coordinates, computed by Pinocchio.
+    """The PHANToM in the report's coordinates, computed by Pinocchio.
 
-    ``Phantom()`` loads the shipped URDF and SRDF. ``Phantom(config_dir=...)``, or
-    any of the xacro file arguments of ``parameters.PARAMETER_FILES`` (for example
-    ``Phantom(physical_parameters_file="mine.yaml")``), generates them through xacro
-    from modified parameter files; ``Phantom(description)`` takes a Description
-    (phantom_pin.describe), the one result of reading a configuration.
+    ``Phantom()`` loads the default model's committed URDF and SRDF (premium_1_5);
+    ``Phantom(name)`` another named model (phantom_pin.models()), with its committed files;
+    ``Phantom(folder)`` generates them from a configuration folder of one's own
+    (phantom_pin.describe); ``Phantom(description)`` takes a Description, the one result
+    of reading a configuration (phantom_pin.describe(..., overrides=...)).
 
     Joint vectors are the report's theta1..theta3 (rad), which are the URDF's
     joint1..joint3; rates in rad/s, accelerations in rad/s^2, torques in N m. Poses
@@ -108,21 +107,17 @@ class Phantom:
     z forward); the tool frame t is ``tip``. Every method takes one state, shape (3,),
     or a batch, shape (N, 3), and returns fresh arrays.
 
-    Attributes: ``description`` (the Description it was built from), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's rotor
-    inertias times ratio^2), ``data``, ``coupling`` (the mimic-free tree model and the
-    coupling matrix read from the URDF's mimic tags), ``parameters`` (the report's
-    numbers), ``threads`` (OpenMP threads of batched inverse dynamics).
+    Attributes: ``description`` (the Description it was built from), ``config`` (its
+    typed configuration), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's
+    rotor inertias times ratio^2), ``data``, ``coupling`` (the mimic-free tree model and
+    the coupling matrix read from the URDF's mimic tags), ``threads`` (OpenMP threads of
+    batched inverse dynamics).
     """
 
-    def __init__(self, config_dir: Description | Path | str | None = None, **files: Path | str) -> None:
-        if isinstance(config_dir, Description):
-            description = config_dir
-        elif config_dir is None and not files:
-            description = shipped()
-        else:
-            description = describe(CONFIG_DIR if config_dir is None else config_dir, **files)
+    def __init__(self, source: Description | str | Path | None = None) -> None:
+        description = description_of(source, "source")
         self.description = description
-        self.parameters: Parameters = description.parameters
+        self.config: Config = description.config
         self.coupling = Coupling(description.urdf)
         self.model: pin.Model = self.coupling.reduced
         load_rotor_parameters(self.model, description.srdf)
@@ -239,7 +234,7 @@ class Phantom:
         return self._each(lambda p: self._solve_ik(p, branch), ("position",), position)
 
     def _solve_ik(self, target: np.ndarray, branch: str) -> np.ndarray:
-        p = self.parameters
+        p = self.config.kinematics
         x, y, z = target.tolist()
         distance = math.hypot(x, y - p.l2, z + p.l1)  # from the shoulder (0, l2, -l1) in s
         if not abs(p.l1 - p.l2) * (1 - 1e-12) <= distance <= (p.l1 + p.l2) * (1 + 1e-12):

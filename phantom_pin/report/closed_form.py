@@ -1,6 +1,7 @@
 """The report's closed-form kinematics and dynamics (eqs 10-24, 80-94), corrected, in NumPy.
 
-Every function takes one state (shape (3,)) or a batch (shape (..., 3)) and returns
+Every function takes one state (shape (3,)) or a batch (shape (..., 3)) and the report's
+numbers (``params``: a ReportParameters, e.g. phantom_pin.config.read().report), and returns
 fresh arrays with the same leading axes. Angles are the report's theta1..theta3 (rad);
 positions are in metres in the report's kinematic frame s (x left, y up, z forward,
 origin at the tip of the zero configuration); torques in N m. The printed equations
@@ -9,12 +10,11 @@ contain typos; the corrections, and their evidence, are listed in docs/errata.md
 
 from __future__ import annotations
 
-import functools
 
 import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
-from phantom_pin.parameters import Parameters, load_parameters
+from phantom_pin.report.parameters import ReportParameters
 from phantom_pin.validation import as_states, finite_result, same_batch, wrap_angle
 
 #: Relative slack on the law-of-cosines arguments before a target counts as unreachable.
@@ -23,20 +23,14 @@ _ACOS_SLACK = 1e-12
 _CHUNK = 8192
 
 
-@functools.lru_cache(maxsize=1)
-def shipped_parameters() -> Parameters:
-    """The parameters of the shipped description (robots/phantom_description/config)."""
-    return load_parameters()
-
-
 def _state(theta: object, name: str = "theta") -> tuple[np.ndarray, ...]:
     array, _ = as_states(theta, name)
     return array[..., 0], array[..., 1], array[..., 2]
 
 
-def forward_kinematics(theta: object, params: Parameters | None = None) -> np.ndarray:
+def forward_kinematics(theta: object, params: ReportParameters) -> np.ndarray:
     """Pose g_st of the tool frame t in frame s, eq. 10: shape (..., 4, 4), metres."""
-    p = params or shipped_parameters()
+    p = params
     t1, t2, t3 = _state(theta)
     s1, c1, s2, c2, s3, c3 = np.sin(t1), np.cos(t1), np.sin(t2), np.cos(t2), np.sin(t3), np.cos(t3)
     reach = p.l1 * c2 + p.l2 * s3
@@ -48,8 +42,7 @@ def forward_kinematics(theta: object, params: Parameters | None = None) -> np.nd
     return g
 
 
-def inverse_kinematics(position: object, branch: str = "report",
-                       params: Parameters | None = None) -> np.ndarray:
+def inverse_kinematics(position: object, params: ReportParameters, branch: str = "report") -> np.ndarray:
     """Joint angles (rad) that put the tip at ``position`` (m, frame s), eqs 11-20.
 
     ``branch="report"`` is the report's elbow branch (gamma > 0, alpha > 0:
@@ -60,7 +53,7 @@ def inverse_kinematics(position: object, branch: str = "report",
     or nearer than |l1 - l2|. Angles are wrapped into (-pi, pi] (theta1 = +pi behind
     the shoulder); they may lie outside the joint limits.
     """
-    p = params or shipped_parameters()
+    p = params
     if branch not in ("report", "other"):
         raise InvalidInputError(f"branch: expected 'report' or 'other', got {branch!r}")
     target, _ = as_states(position, "position")
@@ -89,13 +82,13 @@ def inverse_kinematics(position: object, branch: str = "report",
     return wrap_angle(np.stack([theta1, theta2, theta3], axis=-1))
 
 
-def spatial_jacobian(theta: object, params: Parameters | None = None) -> np.ndarray:
+def spatial_jacobian(theta: object, params: ReportParameters) -> np.ndarray:
     """Spatial manipulator Jacobian J^s, eq. 22: shape (..., 6, 3), twist order (v, omega).
 
     Columns map joint rates (rad/s) to the spatial twist of the tool in frame s
     (v in m/s: the velocity of the body point at the origin of s; omega in rad/s).
     """
-    p = params or shipped_parameters()
+    p = params
     t1, t2, t3 = _state(theta)
     s1, c1, s2, c2 = np.sin(t1), np.cos(t1), np.sin(t2), np.cos(t2)
     zero, one = 0 * t1, 0 * t1 + 1
@@ -110,12 +103,12 @@ def spatial_jacobian(theta: object, params: Parameters | None = None) -> np.ndar
     return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
 
 
-def body_jacobian(theta: object, params: Parameters | None = None) -> np.ndarray:
+def body_jacobian(theta: object, params: ReportParameters) -> np.ndarray:
     """Body manipulator Jacobian J^b, eq. 24: shape (..., 6, 3), twist order (v, omega).
 
     Columns map joint rates (rad/s) to the tool's body twist in frame t (m/s, rad/s).
     """
-    p = params or shipped_parameters()
+    p = params
     t1, t2, t3 = _state(theta)
     zero = 0 * t1
     rows = [
@@ -129,7 +122,7 @@ def body_jacobian(theta: object, params: Parameters | None = None) -> np.ndarray
     return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
 
 
-def _coefficients(p: Parameters) -> tuple[float, float, float, float]:
+def _coefficients(p: ReportParameters) -> tuple[float, float, float, float]:
     """K1, K2, K3, L of eqs 81-92 with the zz corrections of docs/errata.md (E5-E7)."""
     k1 = (4 * p.Iayy + 4 * p.Iazz + 8 * p.Ibaseyy + 4 * p.Ibeyy + 4 * p.Ibezz + 4 * p.Icyy
           + 4 * p.Iczz + 4 * p.Idfyy + 4 * p.Idfzz + 4 * p.l1**2 * p.ma + p.l2**2 * p.ma
@@ -169,7 +162,7 @@ class _Trig:
 # functions below assemble matrices from them, and inverse_dynamics sums them per component
 # (no (N, 3, 3) intermediates: a batch runs at NumPy's speed on (N,) arrays).
 
-def _mass_entries(trig: _Trig, p: Parameters) -> dict[tuple[int, int], np.ndarray | float]:
+def _mass_entries(trig: _Trig, p: ReportParameters) -> dict[tuple[int, int], np.ndarray | float]:
     k1, k2, k3, lam = _coefficients(p)
     m12 = -lam / 2 * trig.sin_23()                                                  # eqs 83-84
     return {
@@ -181,7 +174,7 @@ def _mass_entries(trig: _Trig, p: Parameters) -> dict[tuple[int, int], np.ndarra
 
 
 def _coriolis_entries(trig: _Trig, d1: np.ndarray, d2: np.ndarray, d3: np.ndarray,
-                      p: Parameters) -> dict[tuple[int, int], np.ndarray]:
+                      p: ReportParameters) -> dict[tuple[int, int], np.ndarray]:
     _, k2, k3, lam = _coefficients(p)
     # a = (k2 sin 2theta2 + 4 L sin theta2 sin theta3) / 8, b = (4 L cos theta2 cos theta3
     # - k3 sin 2theta3) / 8, with sin 2x = 2 sin x cos x, factored
@@ -200,7 +193,7 @@ def _coriolis_entries(trig: _Trig, d1: np.ndarray, d2: np.ndarray, d3: np.ndarra
     }
 
 
-def _gravity_entries(trig: _Trig, p: Parameters) -> dict[int, np.ndarray]:
+def _gravity_entries(trig: _Trig, p: ReportParameters) -> dict[int, np.ndarray]:
     return {1: p.g / 2 * (2 * p.l1 * p.ma + 2 * p.l5 * p.mbe + p.l1 * p.mc) * trig.c2,  # eq 93
             2: p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf) * trig.s3}  # eq 94
 
@@ -212,33 +205,33 @@ def _matrix(entries: dict[tuple[int, int], np.ndarray | float], shape: tuple[int
     return out
 
 
-def mass_matrix(theta: object, params: Parameters | None = None) -> np.ndarray:
+def mass_matrix(theta: object, params: ReportParameters) -> np.ndarray:
     """Joint-space inertia matrix M(theta), eqs 81-85 (corrected): (..., 3, 3), kg m^2.
 
     Includes the motors' reflected rotor inertia, lumped by the report into Ibexx,
     Idfxx and Ibaseyy.
     """
-    p = params or shipped_parameters()
+    p = params
     _, t2, t3 = _state(theta)
     return _matrix(_mass_entries(_Trig(t2, t3), p), t2.shape)
 
 
-def coriolis_matrix(theta: object, dtheta: object, params: Parameters | None = None) -> np.ndarray:
+def coriolis_matrix(theta: object, dtheta: object, params: ReportParameters) -> np.ndarray:
     """Coriolis/centrifugal matrix C(theta, dtheta), eqs 86-92 (corrected): (..., 3, 3).
 
     In N m s/rad; C(theta, dtheta) @ dtheta is the velocity-product torque, and
     dM/dt - 2C is skew-symmetric (C is built from the Christoffel symbols of M).
     """
-    p = params or shipped_parameters()
+    p = params
     _, t2, t3 = _state(theta)
     d1, d2, d3 = _state(dtheta, "dtheta")
     same_batch(("theta", "dtheta"), t2, d1)
     return _matrix(_coriolis_entries(_Trig(t2, t3), d1, d2, d3, p), t2.shape)
 
 
-def gravity(theta: object, params: Parameters | None = None) -> np.ndarray:
+def gravity(theta: object, params: ReportParameters) -> np.ndarray:
     """Gravity torque N(theta), eqs 93-94: shape (..., 3), N m (N1 = 0)."""
-    p = params or shipped_parameters()
+    p = params
     _, t2, t3 = _state(theta)
     n = np.zeros(t2.shape + (3,))
     for i, value in _gravity_entries(_Trig(t2, t3), p).items():
@@ -246,9 +239,9 @@ def gravity(theta: object, params: Parameters | None = None) -> np.ndarray:
     return n
 
 
-def potential_energy(theta: object, params: Parameters | None = None) -> np.ndarray:
+def potential_energy(theta: object, params: ReportParameters) -> np.ndarray:
     """Potential energy V = V_a + V_c + V_be + V_df (eqs 34, 45, 55, 65), J; zero at the shoulder."""
-    p = params or shipped_parameters()
+    p = params
     _, t2, t3 = _state(theta)
     s2, c3 = np.sin(t2), np.cos(t3)
     return p.g * (p.ma * (p.l1 * s2 - p.l2 / 2 * c3) + p.mc * (p.l1 / 2 * s2 - p.l3 * c3)
@@ -256,12 +249,12 @@ def potential_energy(theta: object, params: Parameters | None = None) -> np.ndar
 
 
 def inverse_dynamics(theta: object, dtheta: object, ddtheta: object,
-                     params: Parameters | None = None) -> np.ndarray:
+                     params: ReportParameters) -> np.ndarray:
     """Joint torques tau = M ddtheta + C dtheta + N, eq. 80: shape (..., 3), N m.
 
     theta in rad, dtheta in rad/s, ddtheta in rad/s^2.
     """
-    p = params or shipped_parameters()
+    p = params
     acc, _ = as_states(ddtheta, "ddtheta")
     vel, _ = as_states(dtheta, "dtheta")
     pos, _ = as_states(theta, "theta")

@@ -1,4 +1,4 @@
-"""load(): the shipped description as a pinocchio RobotWrapper, in example-robot-data's style."""
+"""load(): a description as a pinocchio RobotWrapper, in example-robot-data's style."""
 
 from __future__ import annotations
 
@@ -7,10 +7,11 @@ from pathlib import Path
 
 import pinocchio as pin
 
-from phantom_pin.description import Description
+from phantom_pin.description.build import Description, description_of
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
-from phantom_pin.paths import DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
-from phantom_pin.physical import check_urdf
+from phantom_pin.config import DEFAULT, MODELS
+from phantom_pin.paths import DESCRIPTION_DIR
+from phantom_pin.description.physical import check_urdf
 
 
 class PhantomLoader:
@@ -21,9 +22,9 @@ class PhantomLoader:
     """
 
     #: The URDF with the parallelogram as mimic joints (joint1..3 = theta1..3).
-    urdf_path: Path = URDF_PATH
+    urdf_path: Path = MODELS[DEFAULT].urdf
     #: The SRDF with the named postures, rotor parameters and disabled collision pairs.
-    srdf_path: Path = SRDF_PATH
+    srdf_path: Path = MODELS[DEFAULT].srdf
     #: Folders that resolve package:// URIs (the parent of phantom_description).
     package_dirs: tuple[Path, ...] = (DESCRIPTION_DIR.parent,)
     #: The SRDF posture that becomes ``robot.q0``.
@@ -46,21 +47,24 @@ def load_rotor_parameters(model: pin.Model, srdf_xml: str) -> None:
         pin.loadRotorParameters(model, str(path), False)
 
 
-def load(source: type[PhantomLoader] | Description = PhantomLoader) -> pin.RobotWrapper:
-    """The PHANToM 1.5 as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
+def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader) -> pin.RobotWrapper:
+    """The PHANToM as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
     joint1..3 = the report's theta1..3 in rad), with ``visual_model``,
     ``collision_model`` (every pair but the SRDF's disabled ones), the SRDF postures in
     ``model.referenceConfigurations``, ``q0`` = the ``ref_posture`` (rad) and
     ``model.armature`` = the reflected rotor inertias (kg m^2). World = ``base_link``
     (REP-103: x forward, z up, origin at the shoulder).
 
-    ``source`` is a PhantomLoader (sub)class, whose files are read, or a Description
-    (phantom_pin.describe), whose texts are used with PhantomLoader's other attributes.
+    ``source`` is a PhantomLoader (sub)class, whose files are read (the default: the
+    premium_1_5 model's committed files), a model name (phantom_pin.models(): its committed
+    files), a configuration folder, or a Description (phantom_pin.describe), whose texts are
+    used with PhantomLoader's other attributes.
     The URDF must pass physical.check_urdf. Raises ParameterFileError naming
     ``urdf_path`` or ``srdf_path`` for a missing, malformed or non-physical file.
     """
-    if isinstance(source, Description):
-        loader, urdf, srdf = PhantomLoader, source.urdf, source.srdf  # checked by describe()
+    if isinstance(source, (Description, str, Path)):
+        description = description_of(source, "source")
+        loader, urdf, srdf = PhantomLoader, description.urdf, description.srdf  # checked by describe()
         urdf_name, srdf_name = "source: the description's URDF", "source: the description's SRDF"
     elif isinstance(source, type) and issubclass(source, PhantomLoader):
         loader = source
@@ -77,7 +81,8 @@ def load(source: type[PhantomLoader] | Description = PhantomLoader) -> pin.Robot
         urdf_name, srdf_name = f"urdf_path: {loader.urdf_path}", f"srdf_path: {loader.srdf_path}"
         check_urdf(urdf, urdf_name)
     else:
-        raise InvalidInputError(f"source: expected a PhantomLoader class or a Description, got {source!r}")
+        raise InvalidInputError(f"source: expected a PhantomLoader class, a model name, a configuration "
+                                f"folder or a Description, got {source!r}")
     package_dirs = [str(p) for p in loader.package_dirs]
     try:
         model = pin.buildModelFromXML(urdf, mimic=True)

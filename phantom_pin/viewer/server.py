@@ -34,7 +34,7 @@ class MeshcatServer:
 
     def __init__(self) -> None:
         self.process = subprocess.Popen(
-            [sys.executable, "-u", "-m", "phantom_pin.meshcat_server"],
+            [sys.executable, "-u", "-m", "phantom_pin.viewer.server"],
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
             start_new_session=True,
             preexec_fn=_die_with_parent if sys.platform == "linux" else None)

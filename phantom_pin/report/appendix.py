@@ -15,7 +15,7 @@ from decimal import Decimal
 
 import numpy as np
 
-#: The appendix's "Numerical Values", as printed (h = 0 omitted), by Parameters field name.
+#: The appendix's "Numerical Values", as printed (h = 0 omitted), by ReportParameters field name.
 NUMERICAL_VALUES = {
     "l1": "0.215", "l2": "0.170", "l3": "0.0325", "l5": "-0.0368", "l6": "0.0527",
     "ma": "0.0202", "Iaxx": "0.4864e-4", "Iayy": "0.0018e-4", "Iazz": "0.4864e-4",
@@ -30,7 +30,7 @@ EQ41_IAYY = 0.001843e-4
 
 
 def applies(params: object) -> bool:
-    """True if ``params`` (a Parameters) hold the report's numbers: every appendix value,
+    """True if ``params`` (a ReportParameters) hold the report's numbers: every appendix value,
     with Iayy either the appendix's or eq. 41's. Only then do the printed torques apply."""
     return all(getattr(params, name) == float(text) for name, text in NUMERICAL_VALUES.items()
                if name != "Iayy") and params.Iayy in (APPENDIX_IAYY, EQ41_IAYY)

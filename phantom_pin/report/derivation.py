@@ -15,11 +15,11 @@ from typing import Callable
 import numpy as np
 import sympy as sp
 
-from phantom_pin.parameters import Parameters
+from phantom_pin.report.parameters import ReportParameters
 
 theta = sp.symbols("theta1:4", real=True)
 dtheta = sp.symbols("dtheta1:4", real=True)
-#: Symbols of every Parameters field that enters the dynamics.
+#: Symbols of every ReportParameters field that enters the dynamics.
 SYMBOLS = {name: sp.Symbol(name, real=True) for name in (
     "l1", "l2", "l3", "l5", "l6", "g", "ma", "Iaxx", "Iayy", "Iazz", "mc", "Icxx", "Icyy",
     "Iczz", "mbe", "Ibexx", "Ibeyy", "Ibezz", "mdf", "Idfxx", "Idfyy", "Idfzz", "Ibaseyy")}
@@ -84,7 +84,7 @@ def derive() -> tuple[sp.Matrix, sp.Matrix, sp.Matrix, sp.Expr]:
 
 
 @functools.lru_cache(maxsize=4)
-def numeric(params: Parameters) -> dict[str, Callable[..., np.ndarray]]:
+def numeric(params: ReportParameters) -> dict[str, Callable[..., np.ndarray]]:
     """NumPy functions mass_matrix(theta), coriolis_matrix(theta, dtheta), gravity(theta)
     of the derived dynamics for one set of parameters (one state each)."""
     mass_matrix, coriolis, gravity, _ = derive()

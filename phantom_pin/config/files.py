@@ -1,0 +1,139 @@
+"""The parameter files of a configuration folder: YAML read once each, overrides applied.
+
+This is the only module that opens a parameter file. Everything it returns is plain data
+(mappings of mappings); phantom_pin.config.schema turns it into the typed Config.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from pathlib import Path
+
+import yaml
+
+from phantom_pin.exceptions import ParameterFileError
+
+#: The parameter files of a configuration folder, by the xacro argument that names them.
+FILES = {
+    "kinematics_file": "kinematics.yaml",
+    "physical_parameters_file": "physical_parameters.yaml",
+    "actuation_file": "actuation.yaml",
+    "joint_limits_file": "joint_limits.yaml",
+    "visual_parameters_file": "visual_parameters.yaml",
+    "mjcf_file": "mjcf.yaml",
+}
+
+
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader, which also reads 1e-6 and 1.0e6 as numbers.
+
+    PyYAML follows YAML 1.1, whose floats need a dot and a signed exponent: it reads
+    ``1e-6`` and ``1.0e6`` as strings (``1.0e-6`` and ``1.0e+6`` as numbers). YAML 1.2
+    reads all four as numbers, and so does this loader.
+    """
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"),
+    list("-+0123456789"))
+
+
+def read_yaml(path: Path) -> dict:
+    """The mapping in the YAML file ``path``; ParameterFileError naming it (one line) if it
+    cannot be read, is not UTF-8 text, is not valid YAML or is not a mapping."""
+    try:
+        with open(path, encoding="utf-8") as stream:
+            data = yaml.load(stream, Loader=_Loader)
+    except OSError as error:
+        raise ParameterFileError(f"{path}: cannot read ({error.strerror})") from error
+    except UnicodeDecodeError as error:
+        raise ParameterFileError(f"{path}: not a text file (not UTF-8 at byte {error.start})") from error
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(error, "problem", None) or " ".join(str(error).split())
+        raise ParameterFileError(f"{path}: not valid YAML{where}: {problem}") from error
+    if not isinstance(data, dict):
+        raise ParameterFileError(f"{path}: expected a mapping at the top level")
+    return data
+
+
+def is_number(value: object) -> bool:
+    """True for an int or float that is not a bool (YAML's true/false)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def read_documents(folder: Path) -> dict[str, dict]:
+    """Each parameter file of ``folder`` read once: its mapping by xacro argument name."""
+    return {arg: read_yaml(folder / name) for arg, name in FILES.items()}
+
+
+def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) -> dict[str, dict]:
+    """A copy of ``documents`` with ``overrides`` applied.
+
+    Override keys are dotted paths into the files ("l1", "segment_a.mass", "joint2.upper"),
+    optionally qualified by the file's stem ("actuation.motor.rotor_inertia"); an
+    unqualified key must exist in exactly one file. Each must name a number, and each
+    value must be a finite number in the units of that file (SI, radians); an item of a
+    list is named by its index ("links.forearm_link.com.2"). ParameterFileError naming
+    the key otherwise.
+    """
+    documents = copy.deepcopy(documents)
+    stems = {Path(name).stem: arg for arg, name in FILES.items()}
+    for key, value in overrides.items():
+        parts = str(key).split(".")
+        if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
+            holders, parts = [stems[parts[0]]], parts[1:]
+        else:
+            holders = [arg for arg, document in documents.items() if parts[0] in document]
+        if not holders:
+            raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
+        if len(holders) > 1:
+            names = [FILES[arg] for arg in holders]
+            raise ParameterFileError(f"{key}: {' and '.join(names)} both have {parts[0]!r}; "
+                                     f"qualify it, e.g. {Path(names[0]).stem}.{key}")
+        name = FILES[holders[0]]
+        node: object = documents[holders[0]]
+        for part in parts[:-1]:
+            node = _child(node, part)
+        if _child(node, parts[-1]) is None and parts[0] not in documents[holders[0]]:
+            raise ParameterFileError(f"{key}: {name} has no key {parts[0]!r}")
+        if not is_number(_child(node, parts[-1])):
+            raise ParameterFileError(f"{key}: not a number in {name}, cannot override it")
+        if not is_number(value) or not math.isfinite(value):
+            raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
+        if isinstance(node, list):
+            node[int(parts[-1])] = float(value)
+        else:
+            node[parts[-1]] = float(value)
+    return documents
+
+
+def _child(node: object, part: str) -> object:
+    if isinstance(node, dict):
+        return node.get(part)
+    if isinstance(node, list) and part.isdigit() and int(part) < len(node):
+        return node[int(part)]
+    return None
+
+
+def read_overrides(path: Path | str) -> dict[str, float]:
+    """Read a YAML file of parameter overrides into dotted keys.
+
+    Nested mappings and dotted keys are equivalent: ``segment_a: {mass: 0.03}`` and
+    ``segment_a.mass: 0.03`` both give ``{"segment_a.mass": 0.03}``.
+    """
+    flat: dict[str, float] = {}
+
+    def walk(node: dict, prefix: str) -> None:
+        for key, value in node.items():
+            dotted = f"{prefix}{key}"
+            if isinstance(value, dict):
+                walk(value, f"{dotted}.")
+            else:
+                flat[dotted] = value
+
+    walk(read_yaml(Path(path)), "")
+    return flat

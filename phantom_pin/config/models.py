@@ -1,0 +1,76 @@
+"""The named configurations: a model is a few declared attributes (robot_descriptions.py's
+style), and ``resolve`` turns a name or a folder into one."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+
+from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.paths import DESCRIPTION_DIR
+
+
+@dataclasses.dataclass(frozen=True)
+class Model:
+    """A configuration of the description package: its ``name``, a one-line ``title``, its
+    ``config`` folder (config/NAME), the top-level xacros that generate its URDF and SRDF,
+    and the committed generated files (URDF, SRDF, MJCF and its scene). ``links_file``: the
+    generated YAML of the links in full, committed where the configuration is written in
+    the report's terms (for plain xacro), else None (its physical_parameters.yaml has them)."""
+
+    name: str
+    title: str
+    robot_name: str
+    urdf_xacro: Path
+    srdf_xacro: Path
+    urdf: Path
+    srdf: Path
+    mjcf: Path
+    scene: Path
+    links_file: Path | None
+
+    @property
+    def config(self) -> Path:
+        return DESCRIPTION_DIR / "config" / self.name
+
+
+def _model(name: str, title: str, robot: str, generated_links: bool, scene: str) -> Model:
+    d = DESCRIPTION_DIR
+    return Model(name, title, robot, d / "urdf" / f"{robot}.urdf.xacro", d / "srdf" / "phantom_1_5.srdf.xacro",
+                 d / "urdf" / f"{robot}.urdf", d / "srdf" / f"{robot}.srdf", d / "mjcf" / f"{robot}.xml",
+                 d / "mjcf" / scene, d / "config" / name / "links.yaml" if generated_links else None)
+
+
+#: The shipped configurations, by name; the first is the default everywhere.
+MODELS = {model.name: model for model in (
+    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5", True, "scene.xml"),
+    _model("premium_1_5_cad", "PHANToM Premium 1.5, mahilab/Phantom's CAD mass properties and lengths",
+           "phantom_1_5_cad", False, "scene_phantom_1_5_cad.xml"),
+)}
+DEFAULT = "premium_1_5"
+
+
+def models() -> list[str]:
+    """The names of the shipped configurations (phantom_pin.describe(name) and --model NAME)."""
+    return list(MODELS)
+
+
+def resolve(source: object, argument: str = "model") -> tuple[str, Path, Model | None]:
+    """(name, config folder, Model or None) of a model name or a configuration folder.
+
+    A string without a path separator that names no folder must be a model's name;
+    InvalidInputError naming ``argument`` otherwise."""
+    if not isinstance(source, (str, os.PathLike)):
+        raise InvalidInputError(f"{argument}: expected a model name ({', '.join(MODELS)}) or a "
+                                f"configuration folder, got {source!r}")
+    if isinstance(source, str) and source in MODELS:
+        model = MODELS[source]
+        return model.name, model.config, model
+    folder = Path(source)
+    if not folder.is_dir():
+        if isinstance(source, str) and os.sep not in source and "/" not in source:
+            raise InvalidInputError(f"{argument}: {source!r} is neither a model ({', '.join(MODELS)}) nor a folder")
+        raise InvalidInputError(f"{argument}: {folder} is not a folder")
+    shipped = next((m for m in MODELS.values() if m.config.resolve() == folder.resolve()), None)
+    return (shipped.name if shipped else str(folder)), folder, shipped

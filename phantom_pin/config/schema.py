@@ -1,0 +1,402 @@
+"""The typed, immutable configuration of one device: every number of its parameter files,
+checked once, with one name per quantity (SI units, radians).
+
+``Config`` is built by phantom_pin.config.read from the YAML files of a folder (files.py);
+every consumer (the description, the rigid body, the device, the simulator, the
+identification) takes it, through a Description, and reads nothing again.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+from pathlib import Path
+from typing import Mapping
+
+import numpy as np
+
+from phantom_pin.config.files import FILES, is_number
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem
+from phantom_pin.exceptions import ParameterFileError
+from phantom_pin.report.parameters import ReportParameters, Unprinted, links as report_links
+
+JOINTS = ("joint1", "joint2", "joint3")
+#: The links of the URDF that carry mass, in the order of the kinematic tree.
+LINKS = ("turret_link", "upper_arm_link", "crank_link", "crank_pin_link", "lower_bar_link",
+         "forearm_pin_link", "forearm_link")
+#: Largest |joint limit| (rad): a revolute joint's range beyond one turn each way repeats
+#: postures and describes no stop of this arm (mahilab's widest stop is 3.74 rad).
+JOINT_LIMIT_BOUND = 2 * math.pi
+#: MuJoCo's integrators, as config/mjcf.yaml may name them.
+INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+#: The ``sources`` entries each file must have (a non-empty text per section).
+SOURCES = {"actuation_file": ("transmission_ratio", "motor", "encoder", "friction"),
+           "joint_limits_file": ("stops",)}
+
+
+@dataclasses.dataclass(frozen=True)
+class Kinematics:
+    """l1: shoulder to elbow along the upper arm; l2: elbow to tip along the forearm; l3:
+    the parallelogram's crank radius (m; the report's eqs 29-31)."""
+
+    l1: float
+    l2: float
+    l3: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Motor:
+    """At the motor shaft: rotor inertia (kg m^2), max. continuous and stall torque (N m)
+    and current (A), torque constant (N m/A), terminal resistance (Ohm), no-load speed (rad/s)."""
+
+    rotor_inertia: float
+    max_continuous_torque: float
+    max_continuous_current: float
+    stall_torque: float
+    stall_current: float
+    torque_constant: float
+    terminal_resistance: float
+    max_speed: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Encoder:
+    """Optical cycles per motor revolution and counts per cycle (quadrature decoding)."""
+
+    cycles_per_revolution: float
+    counts_per_cycle: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Friction:
+    """Joint friction, the same on each joint: viscous (N m s/rad), Coulomb (N m), and the
+    speed (rad/s) of the tanh that smooths the Coulomb term."""
+
+    viscous: float
+    coulomb: float
+    smoothing_speed: float
+
+    def torque(self, dtheta: np.ndarray) -> np.ndarray:
+        """The friction law: tau_f = viscous * dtheta + coulomb * tanh(dtheta / smoothing_speed)
+        (N m) at rates dtheta (rad/s), opposing motion. Smooth at rest, so it holds nothing
+        still (no stiction); below smoothing_speed it acts as a damper of coulomb /
+        smoothing_speed N m s/rad."""
+        return self.viscous * dtheta + self.coulomb * np.tanh(dtheta / self.smoothing_speed)
+
+
+@dataclasses.dataclass(frozen=True)
+class Actuation:
+    """Transmission ratios (joint angle = motor angle / ratio), motor, encoder, friction."""
+
+    ratios: tuple[float, float, float]
+    motor: Motor
+    encoder: Encoder
+    friction: Friction
+
+    @property
+    def armature(self) -> tuple[float, float, float]:
+        """Reflected rotor inertia of each joint, rotor_inertia * ratio^2 (kg m^2)."""
+        return tuple(self.motor.rotor_inertia * r**2 for r in self.ratios)
+
+
+@dataclasses.dataclass(frozen=True)
+class CoupledStops:
+    """The parallelogram's stops: theta2 - theta3 <= theta2_minus_theta3_max and
+    theta3 - theta2 <= theta3_minus_theta2_max (rad), which no URDF box can express."""
+
+    theta2_minus_theta3_max: float
+    theta3_minus_theta2_max: float
+
+    def slack(self, theta: np.ndarray) -> np.ndarray:
+        """(..., 2) distances (rad) of each posture ``theta`` (..., 3) to the two coupled
+        stops: >= 0 inside."""
+        d = np.asarray(theta, float)[..., 1] - np.asarray(theta, float)[..., 2]
+        return np.stack([self.theta2_minus_theta3_max - d, self.theta3_minus_theta2_max + d], axis=-1)
+
+
+@dataclasses.dataclass(frozen=True)
+class Stops:
+    """The real device's mechanical stops: per joint ``lower``/``upper`` (rad), the coupled
+    stops, and the hard-stop model tau = K (limit - theta) - B dtheta: ``stiffness`` K
+    (N m/rad) and ``damping`` B (N m s/rad)."""
+
+    lower: tuple[float, float, float]
+    upper: tuple[float, float, float]
+    coupled: CoupledStops
+    stiffness: float
+    damping: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Limits:
+    """The URDF's joint box ``lower``..``upper`` (rad, theta1..theta3) and the device's stops."""
+
+    lower: tuple[float, float, float]
+    upper: tuple[float, float, float]
+    stops: Stops
+
+    def slack(self, theta: np.ndarray) -> np.ndarray:
+        """(..., 8) distances (rad) of postures (..., 3) to the box intersected with the
+        stops' box (upper, then lower) and to the coupled stops: >= 0 inside every limit."""
+        t = np.asarray(theta, float)
+        lower = np.maximum(self.lower, self.stops.lower)
+        upper = np.minimum(self.upper, self.stops.upper)
+        return np.concatenate([upper - t, t - lower, self.stops.coupled.slack(t)], axis=-1)
+
+
+@dataclasses.dataclass(frozen=True)
+class Scene:
+    """scene.xml's picture (m): the shoulder above the table top, the stand's radius, the
+    table's size (x, y, z) and centre ahead of the shoulder, the floor below the table top."""
+
+    shoulder_height: float
+    stand_radius: float
+    table_size: tuple[float, float, float]
+    table_offset_x: float
+    floor_below_table: float
+
+
+@dataclasses.dataclass(frozen=True)
+class MujocoSettings:
+    """The MJCF's timestep (s) and integrator, the mimic equalities' solref (time constant
+    in timesteps, damping ratio) and solimp (dmin, dmax, width), and the scene."""
+
+    timestep: float
+    integrator: str
+    equality_solref_timesteps: float
+    equality_solref_damping_ratio: float
+    equality_solimp: tuple[float, float, float]
+    scene: Scene
+
+
+def _freeze(node: object) -> object:
+    """A read-only copy of nested YAML data (mappings become MappingProxyType, lists tuples)."""
+    if isinstance(node, dict):
+        return types.MappingProxyType({k: _freeze(v) for k, v in node.items()})
+    if isinstance(node, list):
+        return tuple(_freeze(v) for v in node)
+    return node
+
+
+def thaw(node: object) -> object:
+    """Plain dicts and lists of _freeze's output, for writing YAML."""
+    if isinstance(node, Mapping):
+        return {k: thaw(v) for k, v in node.items()}
+    if isinstance(node, tuple):
+        return [thaw(v) for v in node]
+    return node
+
+
+@dataclasses.dataclass(frozen=True)
+class Config:
+    """One device's configuration, read once, immutable.
+
+    ``name``: the model's name (phantom_pin.models()) or the folder's path; ``folder``;
+    ``overridden``: whether overrides were applied; ``kinematics`` (m); ``gravity`` (m/s^2,
+    along base_link's -z); ``links``: the seven URDF links in full (Inertial by link name,
+    without prefix); ``report``: the report's numbers where the configuration is written
+    in the report's terms (else None: closed_form does not apply), and ``unprinted``, what
+    its links need beyond them (report.parameters.Unprinted, or None); ``actuation``,
+    ``limits`` (box and stops), ``mujoco``, ``visual`` (the primitive geometry, read-only
+    YAML data), ``sources`` (section -> where its numbers come from).
+    """
+
+    name: str
+    folder: Path
+    overridden: bool
+    kinematics: Kinematics
+    gravity: float
+    links: Mapping[str, Inertial]
+    report: ReportParameters | None
+    unprinted: Unprinted | None
+    actuation: Actuation
+    limits: Limits
+    mujoco: MujocoSettings
+    visual: Mapping[str, object]
+    sources: Mapping[str, str]
+
+
+class _Reader:
+    """Typed, checked access to the documents; every error names the file and the key."""
+
+    def __init__(self, documents: dict[str, dict], folder: Path, overridden: bool) -> None:
+        self.documents, self.folder, self.overridden = documents, folder, overridden
+
+    def error(self, arg: str, message: str) -> ParameterFileError:
+        prefix = "after the overrides, " if self.overridden else ""
+        return ParameterFileError(f"{prefix}{self.folder / FILES[arg]}: {message}")
+
+    def node(self, arg: str, *keys: str) -> object:
+        node: object = self.documents[arg]
+        for depth, key in enumerate(keys):
+            if not isinstance(node, dict) or key not in node:
+                raise self.error(arg, f"missing key {'.'.join(keys[:depth + 1])}")
+            node = node[key]
+        return node
+
+    def number(self, arg: str, *keys: str, positive: bool = False, non_negative: bool = False) -> float:
+        value = self.node(arg, *keys)
+        name = ".".join(keys)
+        if not is_number(value) or not math.isfinite(value):
+            raise self.error(arg, f"{name} must be a finite number, got {value!r}")
+        if positive and value <= 0:
+            raise self.error(arg, f"{name} must be positive, got {value!r}")
+        if non_negative and value < 0:
+            raise self.error(arg, f"{name} must not be negative, got {value!r}")
+        return value
+
+    def vector(self, arg: str, *keys: str, length: int) -> tuple:
+        value = self.node(arg, *keys)
+        if not (isinstance(value, list) and len(value) == length
+                and all(is_number(v) and math.isfinite(v) for v in value)):
+            raise self.error(arg, f"{'.'.join(keys)} must be a list of {length} finite numbers, got {value!r}")
+        return tuple(value)
+
+    def text(self, arg: str, *keys: str) -> str:
+        value = self.node(arg, *keys)
+        if not isinstance(value, str) or not value.strip():
+            raise self.error(arg, f"{'.'.join(keys)} must be a non-empty text, got {value!r}")
+        return value
+
+    def interval(self, arg: str, prefix: tuple[str, ...], joint: str) -> tuple[float, float]:
+        lo = self.number(arg, *prefix, joint, "lower")
+        hi = self.number(arg, *prefix, joint, "upper")
+        name = ".".join((*prefix, joint))
+        for side, value in (("lower", lo), ("upper", hi)):
+            if abs(value) > JOINT_LIMIT_BOUND:
+                raise self.error(arg, f"{name}.{side} must be within one turn (|limit| <= 2 pi rad), got {value!r}")
+        if lo >= hi:
+            raise self.error(arg, f"{name}.lower must be below {name}.upper")
+        return lo, hi
+
+
+def _kinematics(r: _Reader) -> Kinematics:
+    return Kinematics(*(r.number("kinematics_file", k, positive=True) for k in ("l1", "l2", "l3")))
+
+
+def _actuation(r: _Reader) -> Actuation:
+    def act(*keys: str, **kind: bool) -> float:
+        return r.number("actuation_file", *keys, **kind)
+
+    motor = Motor(*(act("motor", f.name, positive=True) for f in dataclasses.fields(Motor)))
+    encoder = Encoder(*(act("encoder", f.name, positive=True) for f in dataclasses.fields(Encoder)))
+    friction = Friction(act("friction", "viscous", non_negative=True), act("friction", "coulomb", non_negative=True),
+                        act("friction", "smoothing_speed", positive=True))
+    return Actuation(tuple(act("transmission_ratio", j, positive=True) for j in JOINTS), motor, encoder, friction)
+
+
+def _limits(r: _Reader) -> Limits:
+    arg = "joint_limits_file"
+    box = [r.interval(arg, (), j) for j in JOINTS]
+    stops = [r.interval(arg, ("stops",), j) for j in JOINTS]
+    lower, upper = tuple(b[0] for b in box), tuple(b[1] for b in box)
+    coupled = CoupledStops(r.number(arg, "stops", "theta2_minus_theta3_max"),
+                           r.number(arg, "stops", "theta3_minus_theta2_max"))
+    forward, backward = coupled.theta2_minus_theta3_max, coupled.theta3_minus_theta2_max
+    if forward + backward <= 0:
+        raise r.error(arg, f"stops.theta2_minus_theta3_max + stops.theta3_minus_theta2_max must be "
+                           f"positive (an open interval), got {forward!r} + {backward!r}")
+    for name, (lo, hi) in (("box", (lower, upper)), ("stops", ([s[0] for s in stops], [s[1] for s in stops]))):
+        low, high = lo[1] - hi[2], hi[1] - lo[2]
+        if forward <= low or -backward >= high:
+            raise r.error(arg, f"the coupled stops {-backward:.4f} <= theta2 - theta3 <= {forward:.4f} rad "
+                               f"leave no posture in the {name}, where theta2 - theta3 spans {low:.4f} .. {high:.4f} rad")
+    return Limits(lower, upper, Stops(tuple(s[0] for s in stops), tuple(s[1] for s in stops), coupled,
+                                      r.number(arg, "stops", "stiffness", positive=True),
+                                      r.number(arg, "stops", "damping", non_negative=True)))
+
+
+def _mujoco(r: _Reader) -> MujocoSettings:
+    arg = "mjcf_file"
+    integrator = r.node(arg, "integrator")
+    if integrator not in INTEGRATORS:
+        raise r.error(arg, f"integrator must be {', '.join(INTEGRATORS[:-1])} or {INTEGRATORS[-1]}, got {integrator!r}")
+    scene = Scene(r.number(arg, "scene", "shoulder_height", positive=True),
+                  r.number(arg, "scene", "stand_radius", positive=True),
+                  r.vector(arg, "scene", "table_size", length=3),
+                  r.number(arg, "scene", "table_offset_x"),
+                  r.number(arg, "scene", "floor_below_table", positive=True))
+    return MujocoSettings(r.number(arg, "timestep", positive=True), integrator,
+                          r.number(arg, "equality_solref_timesteps", positive=True),
+                          r.number(arg, "equality_solref_damping_ratio", positive=True),
+                          r.vector(arg, "equality_solimp", length=3), scene)
+
+
+def _sources(r: _Reader) -> dict[str, str]:
+    return {section: r.text(arg, "sources", section) for arg, sections in SOURCES.items() for section in sections}
+
+
+def _report(r: _Reader, kinematics: Kinematics,
+            actuation: Actuation) -> tuple[ReportParameters, Unprinted, dict[str, Inertial]]:
+    """The report's numbers of physical_parameters.yaml (the report's form) and their links."""
+    arg = "physical_parameters_file"
+
+    def phys(*keys: str, positive: bool = True) -> float:
+        return r.number(arg, *keys, positive=positive)
+
+    def inertia(segment: str) -> list[float]:
+        return [phys(segment, "inertia", axis) for axis in ("xx", "yy", "zz")]
+
+    report = ReportParameters(
+        kinematics.l1, kinematics.l2, kinematics.l3, phys("segment_be", "com", positive=False),
+        phys("segment_df", "com", positive=False), phys("gravity"),
+        phys("segment_a", "mass"), *inertia("segment_a"), phys("segment_c", "mass"), *inertia("segment_c"),
+        phys("segment_be", "mass"), *inertia("segment_be"), phys("segment_df", "mass"), *inertia("segment_df"),
+        phys("segment_g", "inertia_yy"))
+    unprinted = Unprinted(phys("segment_g", "mass"), phys("segment_g", "inertia_xx"), phys("segment_g", "inertia_zz"),
+                          phys("hinge_pin", "mass"), tuple(phys("hinge_pin", "inertia", a) for a in ("xx", "yy", "zz")))
+    return report, unprinted, report_links(report, unprinted, actuation.motor.rotor_inertia, actuation.ratios)
+
+
+def _links(r: _Reader) -> dict[str, Inertial]:
+    """The links in full of physical_parameters.yaml ``links`` (the URDF's form)."""
+    arg = "physical_parameters_file"
+    listed = r.node(arg, "links")
+    if not isinstance(listed, dict) or set(listed) != set(LINKS):
+        raise r.error(arg, f"links must name exactly the links {', '.join(LINKS)}, got "
+                           f"{sorted(listed) if isinstance(listed, dict) else listed!r}")
+    return {name: Inertial(r.number(arg, "links", name, "mass", positive=True),
+                           r.vector(arg, "links", name, "com", length=3),
+                           tuple(r.number(arg, "links", name, "inertia", k) for k in INERTIA_KEYS))
+            for name in LINKS}
+
+
+def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool) -> Config:
+    """The Config of the parameter files' ``documents`` (files.FILES keys); ParameterFileError
+    naming the file and the key of the first missing, malformed or non-physical number."""
+    r = _Reader(documents, folder, overridden)
+    kinematics, actuation = _kinematics(r), _actuation(r)
+    physical = documents["physical_parameters_file"]
+    report_form = "segment_a" in physical
+    if report_form == ("links" in physical):
+        raise r.error("physical_parameters_file", "needs either the report's segments (segment_a ...) or "
+                                                  "the links in full (links), not both or neither")
+    if report_form:
+        report, unprinted, links = _report(r, kinematics, actuation)
+    else:
+        report, unprinted, links = None, None, _links(r)
+    for link, inertial in links.items():
+        trouble = problem(inertial)
+        if trouble:
+            keys = f"links.{link}" if report is None else REPORT_KEYS[link]
+            raise r.error("physical_parameters_file", f"link {link}: {trouble} (from {keys})")
+    return Config(name, folder, overridden, kinematics, r.number("physical_parameters_file", "gravity", positive=True),
+                  types.MappingProxyType(links), report, unprinted, actuation, _limits(r), _mujoco(r),
+                  _freeze(documents["visual_parameters_file"]), types.MappingProxyType(_sources(r)))
+
+
+#: The keys of the report's form that feed each link, for error messages.
+REPORT_KEYS = {
+    "turret_link": "segment_g.mass, segment_g.inertia_*, actuation.motor.rotor_inertia, "
+                   "transmission_ratio.joint1, hinge_pin.inertia.zz",
+    "upper_arm_link": "segment_be.mass, segment_be.com, segment_be.inertia, "
+                      "actuation.motor.rotor_inertia, transmission_ratio.joint2",
+    "crank_link": "segment_df.mass, segment_df.com, segment_df.inertia, "
+                  "actuation.motor.rotor_inertia, transmission_ratio.joint3, hinge_pin.mass",
+    "crank_pin_link": "hinge_pin.mass, hinge_pin.inertia",
+    "lower_bar_link": "segment_c.mass, segment_c.inertia, hinge_pin.mass",
+    "forearm_pin_link": "hinge_pin.mass, hinge_pin.inertia",
+    "forearm_link": "segment_a.mass, segment_a.inertia",
+}
+

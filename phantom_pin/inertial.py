@@ -1,0 +1,91 @@
+"""A link's mass properties in the URDF's own terms, and the one physical check of a link.
+
+``Inertial``: mass (kg), centre of mass ``com`` (m, 3-vector in the link frame) and the
+inertia tensor about the centre of mass in the link frame (kg m^2, six numbers xx, xy,
+xz, yy, yz, zz, the tensor's elements: xy = -integral(x y dm), as URDF's ixy).
+
+``problem(inertial)`` is the physical law every consumer of a link relies on: a finite
+positive mass, a positive definite inertia, and principal moments a <= b <= c with
+a + b - c >= TRIANGLE_SLACK * c. MuJoCo is the strictest consumer: it refuses a body
+whose principal moments, as its own eigen-decomposition finds them, break a + b >= c;
+with products of inertia, the rounding of that decomposition refuses links up to about
+1e-14 c inside the boundary (measured, DEVELOPERS.md). TRIANGLE_SLACK keeps a margin of
+100 over that, so every link this check accepts loads in MuJoCo, Pinocchio and Drake
+(tests/test_inertial.py loads the boundary in MuJoCo).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+#: Smallest accepted (a + b - c) / c of a link's principal moments a <= b <= c.
+TRIANGLE_SLACK = 1e-12
+
+#: The six numbers of a tensor, in the order of ``Inertial.inertia`` (and of the YAML keys).
+INERTIA_KEYS = ("xx", "xy", "xz", "yy", "yz", "zz")
+
+
+@dataclasses.dataclass(frozen=True)
+class Inertial:
+    """Mass (kg), centre of mass (m, link frame) and inertia about it (kg m^2, link frame,
+    ``INERTIA_KEYS`` order). The numbers are kept as given: an exact zero written as an
+    integer stays one, so that the generated URDF prints it as the xacro did (``0``)."""
+
+    mass: float
+    com: tuple[float, float, float]
+    inertia: tuple[float, float, float, float, float, float]
+
+    @property
+    def tensor(self) -> np.ndarray:
+        """The 3x3 inertia tensor about the centre of mass (kg m^2)."""
+        xx, xy, xz, yy, yz, zz = (float(v) for v in self.inertia)
+        return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+
+    def dynamic_parameters(self) -> np.ndarray:
+        """The 10 standard parameters in Pinocchio's order [m, m c, I_origin (xx, xy, yy, xz,
+        yz, zz)]: the inertia about the link frame's origin (kg, kg m, kg m^2)."""
+        m, c = float(self.mass), np.array(self.com, dtype=float)
+        origin = self.tensor + m * (c @ c * np.eye(3) - np.outer(c, c))
+        return np.array([m, *(m * c), origin[0, 0], origin[0, 1], origin[1, 1], origin[0, 2],
+                         origin[1, 2], origin[2, 2]])
+
+    @classmethod
+    def from_dynamic_parameters(cls, pi: np.ndarray) -> "Inertial":
+        """The inverse of dynamic_parameters (the mass must be positive)."""
+        m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = (float(v) for v in pi)
+        c = np.array([hx, hy, hz]) / m
+        at_com = (np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+                  - m * (c @ c * np.eye(3) - np.outer(c, c)))
+        return cls(m, tuple(float(v) for v in c),
+                   tuple(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
+
+
+def principal_moments(tensor: np.ndarray) -> np.ndarray:
+    """The principal moments a <= b <= c (kg m^2) of a symmetric tensor."""
+    return np.linalg.eigvalsh(tensor)
+
+
+def slack(tensor: np.ndarray) -> float:
+    """(a + b - c) / c of the principal moments: the share by which the triangle inequality holds."""
+    a, b, c = principal_moments(tensor)
+    return float((a + b - c) / c) if c > 0 else -math.inf
+
+
+def problem(inertial: Inertial) -> str | None:
+    """Why a link is not physical (one line, SI units), or None if it is (module doc)."""
+    values = [inertial.mass, *inertial.com, *inertial.inertia]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values):
+        return "mass, com and inertia must be finite numbers"
+    if inertial.mass <= 0:
+        return f"mass must be positive (kg), got {inertial.mass!r}"
+    moments = principal_moments(inertial.tensor)
+    listed = ", ".join(f"{m:.6g}" for m in moments)
+    if moments[0] <= 0:
+        return f"inertia at the centre of mass is not positive definite (principal moments {listed} kg m^2)"
+    if slack(inertial.tensor) < TRIANGLE_SLACK:
+        return (f"principal moments of inertia at the centre of mass {listed} kg m^2 break the "
+                f"triangle inequality (a + b - c must be at least {TRIANGLE_SLACK:g} c)")
+    return None
