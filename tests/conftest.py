@@ -12,11 +12,14 @@ import pinocchio as pin
 import pytest
 from PIL import Image
 
-from phantom_pin import Phantom, closed_form
-from phantom_pin.parameters import random_states
+from phantom_pin import Phantom, config
+from phantom_pin.config.sampling import random_states
 from phantom_pin.viewer import CAMERA_POSITION
 
 N_STATES = 1000
+#: The default model's configuration (premium_1_5) and the report's numbers it holds.
+CONFIG = config.read()
+REPORT = CONFIG.report
 
 
 @pytest.fixture(scope="session")
@@ -26,14 +29,14 @@ def phantom() -> Phantom:
 
 @pytest.fixture(scope="session")
 def limits() -> tuple[np.ndarray, np.ndarray]:
-    p = closed_form.shipped_parameters()
+    p = CONFIG.limits
     return np.array(p.lower), np.array(p.upper)
 
 
 @pytest.fixture()
 def states():
-    """N_STATES seeded (theta, dtheta, ddtheta) inside the joint limits (parameters.random_states)."""
-    return random_states(closed_form.shipped_parameters(), N_STATES, seed=20261121)
+    """N_STATES seeded (theta, dtheta, ddtheta) inside the joint limits (config.sampling.random_states)."""
+    return random_states(CONFIG.limits, N_STATES, seed=20261121)
 
 
 def frame_pose(model: pin.Model, theta: np.ndarray, name: str) -> pin.SE3:

@@ -8,12 +8,13 @@ import pinocchio as pin
 import pytest
 import yourdfpy
 
-from phantom_pin import appendix
-from conftest import relative_error
-from phantom_pin import closed_form
-from phantom_pin import parameters
-from phantom_pin.description import describe, generate_srdf, generate_urdf, shipped
-from phantom_pin.paths import CONFIG_DIR, DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
+from conftest import CONFIG, REPORT, relative_error
+from phantom_pin.config import MODELS, files, models
+from phantom_pin.description.build import describe, links_yaml, shipped
+from phantom_pin.report import appendix, closed_form
+
+SHIPPED = MODELS["premium_1_5"]
+URDF_PATH, SRDF_PATH = SHIPPED.urdf, SHIPPED.srdf
 
 ACTUATED = ["joint1", "joint2", "joint3"]
 # (joint, primary, multiplier) of the parallelogram, as designed in urdf/phantom_1_5_macro.xacro
@@ -35,13 +36,30 @@ def mimic_model():
     return model
 
 
-def test_committed_files_match_a_fresh_xacro_run():
-    assert URDF_PATH.read_text() == generate_urdf(), "run the regeneration in robots/phantom_description/README.md"
-    assert SRDF_PATH.read_text() == generate_srdf()
-    fresh = describe()
-    assert (DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml").read_text() == fresh.mjcf
-    assert (DESCRIPTION_DIR / "mjcf" / "scene.xml").read_text() == fresh.scene
-    assert (shipped().urdf, shipped().srdf, shipped().mjcf) == (fresh.urdf, fresh.srdf, fresh.mjcf)
+@pytest.mark.parametrize("name", models())
+def test_committed_files_match_a_fresh_xacro_run(name):
+    """Every model's committed URDF, SRDF, MJCF, scene and (report-form) links.yaml equal
+    what its configuration generates now: a stale file fails here."""
+    model, fresh = MODELS[name], describe(name)
+    hint = "run the regeneration in robots/phantom_description/README.md"
+    for kind in ("urdf", "srdf", "mjcf", "scene"):
+        assert getattr(model, kind).read_text() == getattr(fresh, kind), f"{name} {kind}: {hint}"
+    if model.links_file is not None:
+        assert model.links_file.read_text() == links_yaml(fresh.config, model.robot_name), f"{name} links: {hint}"
+    committed = shipped(name)
+    assert (committed.urdf, committed.srdf, committed.mjcf) == (fresh.urdf, fresh.srdf, fresh.mjcf)
+
+
+def test_the_xacro_alone_reads_the_committed_links(tmp_path):
+    """Plain xacro on the top-level xacro with its default (committed) files gives the
+    committed URDF, banner aside: links.yaml is what a ROS user's xacro reads."""
+    import xacro
+
+    for name in models():
+        model = MODELS[name]
+        plain = xacro.process_file(str(model.urdf_xacro)).documentElement.toprettyxml(indent="  ")
+        committed = model.urdf.read_text()
+        assert committed[committed.index("<robot"):].strip() == plain.strip(), name
 
 
 def test_a_configuration_is_read_once_into_every_model(tmp_path, monkeypatch):
@@ -51,17 +69,17 @@ def test_a_configuration_is_read_once_into_every_model(tmp_path, monkeypatch):
 
     from phantom_pin import Device, Phantom, load
     config = tmp_path / "config"
-    shutil.copytree(CONFIG_DIR, config)
+    shutil.copytree(SHIPPED.config, config)
     reads = []
-    original = parameters._read
-    monkeypatch.setattr(parameters, "_read", lambda path: reads.append(path.name) or original(path))
+    original = files.read_yaml
+    monkeypatch.setattr(files, "read_yaml", lambda path: reads.append(path.name) or original(path))
     description = describe(config, overrides={"l1": 0.2096})
-    assert sorted(reads) == sorted(parameters.PARAMETER_FILES.values())
+    assert sorted(reads) == sorted(files.FILES.values())
     phantom = Phantom(description)
     robot = load(description)
     device = Device(phantom)
-    assert len(reads) == len(parameters.PARAMETER_FILES)  # nothing read again
-    assert phantom.description is description and device.phantom.parameters.l1 == 0.2096
+    assert len(reads) == len(files.FILES)  # nothing read again
+    assert phantom.description is description and device.config.kinematics.l1 == 0.2096
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, np.zeros(3))
     assert data.oMf[robot.model.getFrameId("elbow")].translation[0] == pytest.approx(0.2096, abs=1e-15)
@@ -69,16 +87,17 @@ def test_a_configuration_is_read_once_into_every_model(tmp_path, monkeypatch):
 
 
 def test_prefix_reaches_every_name():
-    root = ET.fromstring(generate_urdf(prefix="left_"))
+    left = describe(prefix="left_")
+    root = ET.fromstring(left.urdf)
     names = [e.get("name") for e in root.iter() if e.tag in ("link", "joint", "material") and e.get("name")]
     assert names and all(n.startswith("left_") for n in names)
     references = [e.get("link") for e in root.iter() if e.tag in ("parent", "child")]
     references += [e.get("joint") for e in root.iter("mimic")]
     assert all(r.startswith("left_") for r in references)
-    model = pin.buildModelFromXML(generate_urdf(prefix="left_"), mimic=True)
+    model = pin.buildModelFromXML(left.urdf, mimic=True)
     assert [model.names[i] for i in range(1, 4)] == ["left_joint1", "left_joint2", "left_joint3"]
     assert model.existFrame("left_tip") and model.existFrame("left_report_s")
-    srdf = ET.fromstring(generate_srdf(prefix="left_"))
+    srdf = ET.fromstring(left.srdf)
     srdf_names = [j.get("name") for j in srdf.iter("joint")]
     assert srdf_names and all(n.startswith("left_") for n in srdf_names)
 
@@ -96,11 +115,11 @@ def test_joints_are_the_report_thetas_and_the_parallelogram_mimics(urdf_root):
 
 
 def test_mimic_model_has_three_dofs_and_the_rotor_armature(mimic_model):
-    p = closed_form.shipped_parameters()
+    a, limits = CONFIG.actuation, CONFIG.limits
     assert (mimic_model.nq, mimic_model.nv) == (3, 3)
-    np.testing.assert_allclose(mimic_model.armature, [p.rotor_inertia * r**2 for r in p.ratios], rtol=1e-12)
-    np.testing.assert_array_equal(mimic_model.lowerPositionLimit, p.lower)
-    np.testing.assert_array_equal(mimic_model.upperPositionLimit, p.upper)
+    np.testing.assert_allclose(mimic_model.armature, [a.motor.rotor_inertia * r**2 for r in a.ratios], rtol=1e-12)
+    np.testing.assert_array_equal(mimic_model.lowerPositionLimit, limits.lower)
+    np.testing.assert_array_equal(mimic_model.upperPositionLimit, limits.upper)
 
 
 def _inertials(root):
@@ -132,9 +151,9 @@ def test_link_inertias_give_back_the_report_values(urdf_root):
     donor (as a point mass, by Pinocchio's spatial-inertia sum), the donor is the report's
     segment again. The pins' vertical moments add back to the turret's.
     """
-    p = closed_form.shipped_parameters()
+    p, armature = REPORT, CONFIG.actuation.armature
     to_report = np.array([[0, 1, 0], [0, 0, 1], [1, 0, 0]])  # base (x, y, z) = report (z, x, y)
-    armature2, armature3 = p.armature[1], p.armature[2]
+    armature2, armature3 = armature[1], armature[2]
     expected = {  # link: (mass, report inertia about the point below, point in report axes)
         "forearm_link": (p.ma, np.diag([p.Iaxx, p.Iayy, p.Iazz]), None),
         "lower_bar_link": (p.mc, np.diag([p.Icxx, p.Icyy, p.Iczz]), None),
@@ -152,7 +171,7 @@ def test_link_inertias_give_back_the_report_values(urdf_root):
         vertical += pin_inertia.inertia[2, 2]
         links[donor] = links[donor] + pin.Inertia(pin_inertia.mass, pivots[pin_link], np.zeros((3, 3)))
     turret = links.pop("turret_link")
-    assert turret.inertia[2, 2] + vertical + p.armature[0] == pytest.approx(p.Ibaseyy, rel=1e-12)
+    assert turret.inertia[2, 2] + vertical + armature[0] == pytest.approx(p.Ibaseyy, rel=1e-12)
     for name, inertia in links.items():
         report_mass, report_inertia, about = expected[name]
         com_report = to_report @ inertia.lever
@@ -169,7 +188,7 @@ def test_crba_equals_the_report_mass_matrix(mimic_model, states):
     theta = states[0]
     crba = np.array([pin.crba(mimic_model, data, q) for q in theta])
     crba = np.triu(crba) + np.swapaxes(np.triu(crba, 1), -1, -2)
-    assert relative_error(crba, closed_form.mass_matrix(theta)) < 1e-9
+    assert relative_error(crba, closed_form.mass_matrix(theta, REPORT)) < 1e-9
 
 
 def test_rnea_equals_the_appendix_torques_to_their_printed_precision(mimic_model, states):
@@ -179,7 +198,7 @@ def test_rnea_equals_the_appendix_torques_to_their_printed_precision(mimic_model
     printed, bound = appendix.torques(theta, dtheta, ddtheta)
     # the URDF holds eq. 41's Iayy = 0.001843e-4, the appendix used 0.0018e-4: allow for that
     # difference, 0.043e-7 kg m^2 typed here (tau is linear in Iayy), not for the code's value
-    as_appendix = dataclasses.replace(closed_form.shipped_parameters(), Iayy=0.0018e-4)
+    as_appendix = dataclasses.replace(REPORT, Iayy=0.0018e-4)
     rounded = dataclasses.replace(as_appendix, Iayy=0.0018e-4 + 0.043e-7)
     bound += np.abs(closed_form.inverse_dynamics(theta, dtheta, ddtheta, rounded)
                     - closed_form.inverse_dynamics(theta, dtheta, ddtheta, as_appendix))
@@ -196,7 +215,7 @@ def test_yourdfpy_forward_kinematics_is_eq10_and_pinocchio(mimic_model, states):
         g = np.linalg.inv(urdf.get_transform("report_s")) @ urdf.get_transform("tip")
         pin.framesForwardKinematics(mimic_model, data, theta)
         g_pin = data.oMf[s].actInv(data.oMf[tip]).homogeneous
-        worst_report = max(worst_report, np.abs(g - closed_form.forward_kinematics(theta)).max())
+        worst_report = max(worst_report, np.abs(g - closed_form.forward_kinematics(theta, REPORT)).max())
         worst_pinocchio = max(worst_pinocchio, np.abs(g - g_pin).max())
     assert worst_report < 1e-9 and worst_pinocchio < 1e-9
 
@@ -207,7 +226,7 @@ def test_parallelogram_closes_in_the_mimic_free_model(urdf_root, states):
     data = tree.createData()
     mimic = {j.get("name"): (j.find("mimic").get("joint"), float(j.find("mimic").get("multiplier")))
              for j in urdf_root.iter("joint") if j.find("mimic") is not None}
-    l3 = closed_form.shipped_parameters().l3
+    l3 = REPORT.l3
     worst = 0.0
     for theta in states[0]:
         angles = dict(zip(ACTUATED, theta))
@@ -227,7 +246,7 @@ def test_parallelogram_closes_in_the_mimic_free_model(urdf_root, states):
 def test_report_frames_sit_where_the_report_puts_them(mimic_model):
     data = mimic_model.createData()
     pin.framesForwardKinematics(mimic_model, data, np.zeros(3))
-    p = closed_form.shipped_parameters()
+    p = REPORT
     dynamics = data.oMf[mimic_model.getFrameId("report_dynamics")]
     s = data.oMf[mimic_model.getFrameId("report_s")]
     # report y is up (gravity along -y, eqs 34, 45), report z forward, x left (REP-103 base)
