@@ -215,12 +215,12 @@ def test_missing_file(tmp_path):
 
 def test_overrides_nested_dotted_and_qualified_keys_are_the_same(tmp_path):
     nested, dotted = tmp_path / "nested.yaml", tmp_path / "dotted.yaml"
-    nested.write_text("segment_a: {inertia: {xx: 5.0e-5}}\nactuation: {motor: {rotor_inertia: 1.05e-6}}\n")
-    dotted.write_text("segment_a.inertia.xx: 5.0e-5\nactuation.motor.rotor_inertia: 1.05e-6\n")
+    nested.write_text("segment_a: {inertia: {xx: 4.87e-5}}\nactuation: {motor: {rotor_inertia: 1.05e-6}}\n")
+    dotted.write_text("segment_a.inertia.xx: 4.87e-5\nactuation.motor.rotor_inertia: 1.05e-6\n")
     assert read_overrides(nested) == read_overrides(dotted) == {
-        "segment_a.inertia.xx": 5.0e-5, "actuation.motor.rotor_inertia": 1.05e-6}
+        "segment_a.inertia.xx": 4.87e-5, "actuation.motor.rotor_inertia": 1.05e-6}
     changed, shipped_config = config.read("premium_1_5", read_overrides(nested)), config.read()
-    assert (changed.report.Iaxx, changed.actuation.motor.rotor_inertia) == (5.0e-5, 1.05e-6)
+    assert (changed.report.Iaxx, changed.actuation.motor.rotor_inertia) == (4.87e-5, 1.05e-6)
     unchanged = dataclasses.replace(
         changed, overridden=False, report=dataclasses.replace(changed.report, Iaxx=shipped_config.report.Iaxx),
         actuation=dataclasses.replace(changed.actuation, motor=shipped_config.actuation.motor),
