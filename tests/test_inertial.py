@@ -1,0 +1,114 @@
+"""The one physical check of a link (phantom_pin.inertial), its tolerance against MuJoCo (the
+strictest consumer, loading the generated MJCF at the boundary), and links given in full."""
+
+import shutil
+
+import mujoco
+import numpy as np
+import pytest
+import yaml
+
+from phantom_pin import ParameterFileError, config, describe
+from phantom_pin.cli import main
+from phantom_pin.config import MODELS
+from phantom_pin.inertial import TRIANGLE_SLACK, Inertial, problem, slack
+
+SHIPPED = MODELS["premium_1_5"]
+
+
+@pytest.fixture(scope="module")
+def links_folder(tmp_path_factory):
+    """premium_1_5 with its links given in full (the committed links.yaml) instead of the report's numbers."""
+    folder = tmp_path_factory.mktemp("links") / "config"
+    shutil.copytree(SHIPPED.config, folder)
+    links = yaml.safe_load(SHIPPED.links_file.read_text())["links"]
+    (folder / "physical_parameters.yaml").write_text(yaml.safe_dump({"gravity": 9.81, "links": links}))
+    (folder / "links.yaml").unlink()
+    return folder
+
+
+def test_links_in_full_describe_the_same_urdf_as_the_report_numbers(links_folder):
+    """The report's adapter and the links in full give the same URDF, byte for byte."""
+    full, report = describe(links_folder), describe("premium_1_5")
+    assert full.config.report is None and report.config.report is not None
+    assert full.urdf == report.urdf and full.mjcf == report.mjcf
+
+
+def _loads_in_mujoco(mjcf: str) -> bool:
+    try:
+        mujoco.MjModel.from_xml_string(mjcf)
+    except ValueError:
+        return False
+    return True
+
+
+@pytest.mark.parametrize("factor, accepted", [(10.0, True), (1.5, True), (0.5, False), (0.0, False), (-1e3, False)])
+def test_the_boundary_of_the_triangle_inequality_is_the_same_for_us_and_mujoco(factor, accepted):
+    """The forearm (a thin rod: 0.38 % slack) moved to slack = factor * TRIANGLE_SLACK through
+    segment_a.inertia.xx (its URDF iyy): describe() accepts exactly what loads in MuJoCo."""
+    a, b = config.read().report.Iayy, config.read().report.Iazz  # URDF izz and ixx of the forearm
+    largest = (a + b) / (1 + factor * TRIANGLE_SLACK)
+    if accepted:
+        description = describe(overrides={"segment_a.inertia.xx": largest})
+        assert _loads_in_mujoco(description.mjcf)
+    else:
+        with pytest.raises(ParameterFileError, match="link forearm_link: .*triangle inequality"):
+            describe(overrides={"segment_a.inertia.xx": largest})
+
+
+def test_rotated_links_at_the_boundary_load_in_mujoco(links_folder):
+    """With products of inertia MuJoCo's own eigen-decomposition decides, and rounds: every
+    link the check accepts (slack 2 TRIANGLE_SLACK, 100 random orientations) loads from the
+    generated MJCF; links 1e-12 c past the boundary are refused by the check."""
+    rng = np.random.default_rng(7)
+    a, b = 1.843e-7, 4.864e-5
+    for _ in range(100):
+        q = rng.normal(size=4)
+        w, x, y, z = q / np.linalg.norm(q)
+        rotation = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                             [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+        for share, physical in ((2 * TRIANGLE_SLACK, True), (-TRIANGLE_SLACK, False)):
+            tensor = rotation @ np.diag([a, b, (a + b) / (1 + share)]) @ rotation.T
+            keys = dict(zip(("xx", "xy", "xz", "yy", "yz", "zz"), (tensor[0, 0], tensor[0, 1], tensor[0, 2],
+                                                                   tensor[1, 1], tensor[1, 2], tensor[2, 2])))
+            overrides = {f"links.forearm_link.inertia.{k}": float(v) for k, v in keys.items()}
+            if physical:
+                assert _loads_in_mujoco(describe(links_folder, overrides=overrides).mjcf)
+            else:
+                with pytest.raises(ParameterFileError, match="link forearm_link"):
+                    describe(links_folder, overrides=overrides)
+
+
+def test_the_issue_example_is_refused_with_one_line_and_nothing_written(tmp_path, capsys):
+    """Before: `mjcf --set segment_a.inertia.xx=4.8824300001e-05` exited 0 and MuJoCo refused
+    the file ("inertia must satisfy A + B >= C")."""
+    output = tmp_path / "x.xml"
+    assert main(["mjcf", "-o", str(output), "--set", "segment_a.inertia.xx=4.8824300001e-05"]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "forearm_link" in error and "triangle inequality" in error
+    assert not output.exists()
+
+
+@pytest.mark.parametrize("inertial, message", [
+    (Inertial(0.0, (0, 0, 0), (1e-4, 0, 0, 1e-4, 0, 1e-4)), "mass must be positive"),
+    (Inertial(1.0, (0, 0, float("nan")), (1e-4, 0, 0, 1e-4, 0, 1e-4)), "finite"),
+    (Inertial(1.0, (0, 0, 0), (1e-4, 2e-4, 0, 1e-4, 0, 1e-4)), "not positive definite"),
+    (Inertial(1.0, (0, 0, 0), (1e-4, 0, 0, 1e-4, 0, 3e-4)), "triangle inequality"),
+])
+def test_the_check_names_the_problem(inertial, message):
+    assert message in problem(inertial)
+
+
+def test_dynamic_parameters_are_pinocchios():
+    """Inertial.dynamic_parameters (about the link origin) equals Pinocchio's
+    Inertia.toDynamicParameters of the same body, and from_dynamic_parameters inverts it."""
+    import pinocchio as pin
+
+    link = Inertial(0.3, (0.01, -0.02, 0.05), (2e-4, 1e-5, -2e-5, 3e-4, 3e-5, 2.5e-4))
+    body = pin.Inertia(link.mass, np.array(link.com), link.tensor)
+    np.testing.assert_allclose(link.dynamic_parameters(), body.toDynamicParameters(), rtol=1e-13, atol=1e-19)
+    back = Inertial.from_dynamic_parameters(link.dynamic_parameters())
+    np.testing.assert_allclose([back.mass, *back.com, *back.inertia], [link.mass, *link.com, *link.inertia],
+                               rtol=1e-10, atol=1e-18)
+    assert slack(link.tensor) > 0
