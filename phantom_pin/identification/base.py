@@ -95,7 +95,7 @@ class Structured:
     def __init__(self, regressor: Regressor) -> None:
         self.regressor = regressor
         self.description = regressor.phantom.description
-        self.affine, self.offset = parameterization.affine_map(self.description)
+        self.affine, self.offset = parameterization.affine_map(self.description, regressor.bodies)
         self.names = tuple(parameterization.SYMBOLS) + tuple(
             f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
 

@@ -24,7 +24,6 @@ import numpy as np
 from phantom_pin.config import Config
 from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification.regressor import body_names
 from phantom_pin.report.parameters import ReportParameters, links
 
 #: The report parameters, named by their --params key (first moments: mass * com).
@@ -90,13 +89,12 @@ def tree_parameters(x: np.ndarray, description: Description, bodies: list[str]) 
     return np.concatenate(inertial + [float(x[ROTOR]) * ratios**2])
 
 
-def affine_map(description: Description) -> tuple[np.ndarray, np.ndarray]:
-    """(A, b) with pi_without_friction = A x + b; A is (73, 20), for the tree bodies of the
-    description's URDF in Pinocchio's order. Built once per Description (cached on it)."""
-    if "affine" not in description.cache:
-        from phantom_pin.dynamics.coupling import Coupling  # the tree's body order
-
-        bodies = body_names(Coupling(description.urdf).tree)
+def affine_map(description: Description, bodies: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """(A, b) with pi_without_friction = A x + b; A is (73, 20), for the tree bodies
+    ``bodies`` (link names in Pinocchio's order: Regressor.bodies). Built once per
+    Description (cached on it), from the Config alone."""
+    key = ("affine", tuple(bodies))
+    if key not in description.cache:
         x0 = report_vector(description.config)
         base = tree_parameters(x0, description, bodies)
         columns = []
@@ -106,6 +104,6 @@ def affine_map(description: Description) -> tuple[np.ndarray, np.ndarray]:
             x[k] += step
             columns.append((tree_parameters(x, description, bodies) - base) / step)
         a = np.stack(columns, axis=1)
-        description.cache["affine"] = (a, base - a @ x0)
-    a, b = description.cache["affine"]
+        description.cache[key] = (a, base - a @ x0)
+    a, b = description.cache[key]
     return a.copy(), b.copy()
