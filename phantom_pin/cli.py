@@ -1,5 +1,5 @@
-"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, mjcf, show, simulate,
-excite, identify."""
+"""The phantom-pin command line: info, check, fk, ik, dynamics, urdf, srdf, mjcf, links, show,
+simulate, excite, identify; --model NAME or --config DIR chooses the configuration."""
 
 from __future__ import annotations
 
@@ -16,9 +16,9 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.report import appendix, closed_form
-from phantom_pin.config import DEFAULT, FILES, models, read_overrides
+from phantom_pin.config import DEFAULT, FILES, MODELS, models, read_overrides
 from phantom_pin.config.sampling import random_states
-from phantom_pin.description.build import Description, describe, description_of
+from phantom_pin.description.build import Description, describe, description_of, links_yaml
 from phantom_pin.device import cli as device_cli
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import commands as identification
@@ -189,7 +189,7 @@ def _parse_set(items: list[str]) -> dict[str, float]:
 
 
 def _write(args: argparse.Namespace) -> int:
-    """urdf, srdf, mjcf: the files of describe(--model or --config, --prefix, --params and --set)."""
+    """urdf, srdf, mjcf, links: the files of describe(--model or --config, --prefix, --params and --set)."""
     output = output_path(args.output, args.force, "--output", "--force")
     scene = output_path(args.scene, args.force, "--scene", "--force") if getattr(args, "scene", None) else None
     try:
@@ -198,7 +198,10 @@ def _write(args: argparse.Namespace) -> int:
         raise PhantomPinError(f"--params: {error}") from None
     overrides.update(_parse_set(args.set))
     description = describe(_source(args), prefix=args.prefix, overrides=overrides, robot_file=output.name)
-    output.write_text({"urdf": description.urdf, "srdf": description.srdf, "mjcf": description.mjcf}[args.kind])
+    robot = (description.model or MODELS[DEFAULT]).robot_name
+    texts = {"urdf": description.urdf, "srdf": description.srdf, "mjcf": description.mjcf,
+             "links": links_yaml(description.config, robot)}
+    output.write_text(texts[args.kind])
     print(f"wrote {output}")
     if scene is not None:
         scene.write_text(description.scene)
@@ -252,8 +255,10 @@ def _parser() -> argparse.ArgumentParser:
     dyn.add_argument("--theta", required=True, **three)
     dyn.add_argument("--dtheta", default=[0.0, 0.0, 0.0], **three)
     dyn.add_argument("--ddtheta", default=[0.0, 0.0, 0.0], **three)
-    for kind in ("urdf", "srdf", "mjcf"):
-        gen = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config")
+    for kind in ("urdf", "srdf", "mjcf", "links"):
+        gen = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config"
+                             if kind != "links" else "write the links in full (mass, COM, inertia; the "
+                             "xacro's links_file) of --model or --config")
         gen.add_argument("--output", "-o", required=True)
         gen.add_argument("--prefix", default="")
         gen.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
@@ -288,7 +293,7 @@ def main(argv: list[str] | None = None) -> int:
                 "identify": identification.identify}
     try:
         args = _parser().parse_args(argv)
-        if args.command in ("urdf", "srdf", "mjcf"):
+        if args.command in ("urdf", "srdf", "mjcf", "links"):
             code = _write(args)
         else:  # one Description of --model or --config for every other command
             description = description_of(_source(args), "--config" if args.config else "--model")

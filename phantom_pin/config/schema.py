@@ -28,6 +28,9 @@ LINKS = ("turret_link", "upper_arm_link", "crank_link", "crank_pin_link", "lower
 #: Largest |joint limit| (rad): a revolute joint's range beyond one turn each way repeats
 #: postures and describes no stop of this arm (mahilab's widest stop is 3.74 rad).
 JOINT_LIMIT_BOUND = 2 * math.pi
+#: The stop coordinates as linear maps of theta (rows): theta1, theta2, theta3, theta2 - theta3.
+STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, -1.0]])
+STOP_COORDINATES.flags.writeable = False
 #: MuJoCo's integrators, as config/mjcf.yaml may name them.
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
 #: The ``sources`` entries each file must have (a non-empty text per section).
@@ -108,12 +111,6 @@ class CoupledStops:
     theta2_minus_theta3_max: float
     theta3_minus_theta2_max: float
 
-    def slack(self, theta: np.ndarray) -> np.ndarray:
-        """(..., 2) distances (rad) of each posture ``theta`` (..., 3) to the two coupled
-        stops: >= 0 inside."""
-        d = np.asarray(theta, float)[..., 1] - np.asarray(theta, float)[..., 2]
-        return np.stack([self.theta2_minus_theta3_max - d, self.theta3_minus_theta2_max + d], axis=-1)
-
 
 @dataclasses.dataclass(frozen=True)
 class Stops:
@@ -127,6 +124,19 @@ class Stops:
     stiffness: float
     damping: float
 
+    def bounds(self, lower: tuple | None = None, upper: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper), each (4,) rad, of the stop coordinates (STOP_COORDINATES): the
+        joints' stops (or the given per-joint ``lower``/``upper``) and the coupled stops."""
+        lo, hi = self.lower if lower is None else lower, self.upper if upper is None else upper
+        return (np.array([*lo, -self.coupled.theta3_minus_theta2_max]),
+                np.array([*hi, self.coupled.theta2_minus_theta3_max]))
+
+    def penetration(self, theta: np.ndarray) -> np.ndarray:
+        """Signed depth (rad) of each stop coordinate of postures (..., 3) beyond its stop:
+        (..., 4), zero inside. The one stop geometry (Device's stops, the samplers' limits)."""
+        c = np.asarray(theta, float) @ STOP_COORDINATES.T
+        return c - np.clip(c, *self.bounds())
+
 
 @dataclasses.dataclass(frozen=True)
 class Limits:
@@ -137,12 +147,13 @@ class Limits:
     stops: Stops
 
     def slack(self, theta: np.ndarray) -> np.ndarray:
-        """(..., 8) distances (rad) of postures (..., 3) to the box intersected with the
-        stops' box (upper, then lower) and to the coupled stops: >= 0 inside every limit."""
-        t = np.asarray(theta, float)
-        lower = np.maximum(self.lower, self.stops.lower)
-        upper = np.minimum(self.upper, self.stops.upper)
-        return np.concatenate([upper - t, t - lower, self.stops.coupled.slack(t)], axis=-1)
+        """(..., 8) distances (rad) of postures (..., 3) to every limit: the upper, then the
+        lower bounds of the stop coordinates (STOP_COORDINATES) over the box intersected with
+        the stops' box and the coupled stops: >= 0 inside every limit."""
+        c = np.asarray(theta, float) @ STOP_COORDINATES.T
+        lower, upper = self.stops.bounds(np.maximum(self.lower, self.stops.lower),
+                                         np.minimum(self.upper, self.stops.upper))
+        return np.concatenate([upper - c, c - lower], axis=-1)
 
 
 @dataclasses.dataclass(frozen=True)

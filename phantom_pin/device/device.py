@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 from phantom_pin.config import Config
+from phantom_pin.config.schema import STOP_COORDINATES
 from phantom_pin.description.build import Description
 import numpy as np
 
@@ -15,8 +16,6 @@ from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.validation import as_states, same_batch
 
-#: Rows: the stop coordinates as linear maps of theta: theta1, theta2, theta3, theta2 - theta3.
-STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, -1.0]])
 
 
 class Device:
@@ -52,8 +51,7 @@ class Device:
         stops, encoder = self.config.limits.stops, self.config.actuation.encoder
         #: joint angle = motor angle / ratio (the Phantom's actuation.yaml)
         self.ratios = np.array(self.config.actuation.ratios, dtype=float)
-        self._stop_lower = np.array([*stops.lower, -stops.coupled.theta3_minus_theta2_max])
-        self._stop_upper = np.array([*stops.upper, stops.coupled.theta2_minus_theta3_max])
+        self._stop_lower, self._stop_upper = stops.bounds()
         self._counts_per_radian = self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
 
     # -- stops -----------------------------------------------------------------------
@@ -63,8 +61,7 @@ class Device:
         theta3 - theta2 <= theta3_minus_theta2_max. A bool for one state (3,), an (N,) bool
         array for a batch (N, 3)."""
         q, batch = as_states(theta, "theta")
-        c = q @ STOP_COORDINATES.T
-        inside = np.all((c >= self._stop_lower) & (c <= self._stop_upper), axis=-1)
+        inside = np.all(self.config.limits.stops.penetration(q) == 0, axis=-1)
         return inside if batch else bool(inside)
 
     def reachable(self, position: object) -> bool | np.ndarray:
@@ -94,16 +91,11 @@ class Device:
                     found[shell] |= self.within_limits(candidates.reshape(-1, 3)).reshape(-1, 9).any(axis=1)
         return found if batch else bool(found[0])
 
-    def _penetration(self, theta: np.ndarray) -> np.ndarray:
-        """Signed depth (rad) of each stop coordinate beyond its stop: (..., 4)."""
-        c = theta @ STOP_COORDINATES.T
-        return c - np.clip(c, self._stop_lower, self._stop_upper)
-
     def stop_energy(self, theta: object) -> np.ndarray:
         """Potential energy of the stop springs (J): K/2 * sum of squared penetrations of
         theta1, theta2, theta3 and theta2 - theta3 beyond their stops; zero inside."""
         q, _ = as_states(theta, "theta")
-        return 0.5 * self.config.limits.stops.stiffness * np.sum(self._penetration(q) ** 2, axis=-1)
+        return 0.5 * self.config.limits.stops.stiffness * np.sum(self.config.limits.stops.penetration(q) ** 2, axis=-1)
 
     def stop_torque(self, theta: object, dtheta: object) -> np.ndarray:
         """Torque of the hard stops on the joints (N m): (..., 3).
@@ -123,7 +115,7 @@ class Device:
 
     def _stop_torque(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
         stops = self.config.limits.stops
-        depth = self._penetration(theta)
+        depth = self.config.limits.stops.penetration(theta)
         force = stops.stiffness * depth + stops.damping * (dtheta @ STOP_COORDINATES.T) * (depth != 0)
         return -force @ STOP_COORDINATES
 
