@@ -13,6 +13,7 @@ import pinocchio as pin
 
 from phantom_pin.device.device import Device
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.integration import rk4_step
 from phantom_pin.dynamics.model import solve_spd
 from phantom_pin.validation import as_state
 
@@ -175,14 +176,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
 
     def advance(q: np.ndarray, v: np.ndarray, tau: np.ndarray, h: float, depth: int) -> tuple:
         """One RK4 step of h; a step across a stop's boundary is bisected (event location)."""
-        a1 = acceleration(q, v, tau)
-        q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
-        a2 = acceleration(q2, v2, tau)
-        q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
-        a3 = acceleration(q3, v3, tau)
-        q4, v4 = q + h * v3, v + h * a3
-        a4 = acceleration(q4, v4, tau)
-        q_end, v_end = q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+        q_end, v_end = rk4_step(lambda q_, v_: acceleration(q_, v_, tau), q, v, h)
         if hard_stops and depth < EVENT_BISECTIONS and contacts(q) != contacts(q_end):
             q_mid, v_mid = advance(q, v, tau, 0.5 * h, depth + 1)
             return advance(q_mid, v_mid, tau, 0.5 * h, depth + 1)

@@ -1,7 +1,7 @@
 """A simulated PHANToM for testing identification: the report's closed-form dynamics with
 any parameters, friction, torque noise and encoder quantization, tracking a trajectory.
 
-Integration: classical RK4 at the log's rate with the commanded torque held over each step
+Integration: classical RK4 (phantom_pin.integration) at the log's rate with the commanded torque held over each step
 (zero-order hold). Controller: the inverse dynamics of the parameters model along the
 reference plus PD feedback (on the quantized position and the true velocity). Logged: time,
 the quantized positions and the *commanded* torques, as a real device's log.
@@ -15,6 +15,7 @@ import numpy as np
 
 from phantom_pin.report import closed_form
 from phantom_pin.identification.io import Log
+from phantom_pin.integration import rk4_step
 from phantom_pin.report.parameters import ReportParameters
 
 
@@ -51,13 +52,5 @@ def simulate(reference: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.
         measured[i] = quantize(q)
         commanded[i] = feedforward[i] + kp * (ref_q[i] - measured[i]) + kd * (ref_v[i] - v)
         applied = commanded[i] + torque_noise * rng.standard_normal(3)
-        k1v = acceleration(q, v, applied)
-        k2v = acceleration(q + dt / 2 * v, v + dt / 2 * k1v, applied)
-        k2q = v + dt / 2 * k1v
-        k3q = v + dt / 2 * k2v
-        k3v = acceleration(q + dt / 2 * k2q, k3q, applied)
-        k4q = v + dt * k3v
-        k4v = acceleration(q + dt * k3q, k4q, applied)
-        q = q + dt / 6 * (v + 2 * k2q + 2 * k3q + k4q)
-        v = v + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        q, v = rk4_step(lambda q_, v_: acceleration(q_, v_, applied), q, v, dt)
     return Log(t, measured, commanded)
