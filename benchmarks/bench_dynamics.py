@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin import Phantom, closed_form as cf
-from phantom_pin.parameters import random_states
+from phantom_pin.config.sampling import random_states
 
 
 def interleaved(calls: list, rounds: int, number: int) -> list[float]:
@@ -46,6 +46,7 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=1_000_000, help="states in closed_form's batch runs")
     args = parser.parse_args()
     phantom = Phantom()
+    report = phantom.config.report  # the closed form's numbers (the report's)
     model, data = phantom.model, phantom.model.createData()
     tree, tree_data, coupling = phantom.coupling.tree, phantom.coupling.tree.createData(), phantom.coupling
     q, v, a = np.array([0.2, 0.4, 0.5]), np.array([0.5, -1.0, 1.5]), np.array([2.0, 1.0, -3.0])
@@ -84,7 +85,7 @@ def main() -> None:
         ("inverse_dynamics_derivatives", lambda: phantom.inverse_dynamics_derivatives(q, v, a),
          lambda: pin.computeRNEADerivatives(tree, tree_data, qt, vt, at), "computeRNEADerivatives (tree)", 3.0),
         ("inverse_kinematics", lambda: phantom.inverse_kinematics(target),
-         lambda: cf.inverse_kinematics(target), "closed_form.inverse_kinematics", 2.0),
+         lambda: cf.inverse_kinematics(target, report), "closed_form.inverse_kinematics", 2.0),
     ]
     missed = []
     print(f"{os.cpu_count()} cores, {platform.machine()}, "
@@ -102,7 +103,7 @@ def main() -> None:
               f"{'met' if met else 'MISSED'} |")
 
     n = args.batch
-    theta, dtheta, ddtheta = random_states(phantom.parameters, n, seed=0)
+    theta, dtheta, ddtheta = random_states(phantom.config.limits, n, seed=0)
     small = min(n, 20_000)  # the Python loops and the per-state Pinocchio methods
     q_, v_, a_ = theta[:small], dtheta[:small], ddtheta[:small]
     # a Python loop over the bare call, stacked by np.array into the (N, ...) array a batch
@@ -142,9 +143,9 @@ def main() -> None:
           f"({loop_rnea:.2f} µs per state, {1 / loop_rnea:.2f} M states/s)\n")
     print("| batched call | µs per state | M states/s | x loop over rnea | target | |")
     print("|---|---:|---:|---:|---:|---|")
-    for label, call in (("closed_form.inverse_dynamics", lambda: cf.inverse_dynamics(theta, dtheta, ddtheta)),
-                        ("closed_form.mass_matrix", lambda: cf.mass_matrix(theta)),
-                        ("closed_form.gravity", lambda: cf.gravity(theta)),
+    for label, call in (("closed_form.inverse_dynamics", lambda: cf.inverse_dynamics(theta, dtheta, ddtheta, report)),
+                        ("closed_form.mass_matrix", lambda: cf.mass_matrix(theta, report)),
+                        ("closed_form.gravity", lambda: cf.gravity(theta, report)),
                         ("Phantom.inverse_dynamics (rneaInParallel)",
                          lambda: phantom.inverse_dynamics(theta, dtheta, ddtheta))):
         t = per_state(call, n, 5)

@@ -19,13 +19,13 @@ def main(argv: list[str] | None = None) -> None:
     args = common.parser(__doc__.splitlines()[0]).parse_args(argv)
     figure_path = common.output(args, "gravity_compensation.png")
     phantom = Phantom()
-    p = phantom.parameters
-    theta2 = np.linspace(p.lower[1], p.upper[1], 61)
-    theta3 = np.linspace(p.lower[2], p.upper[2], 61)
+    limits = phantom.config.limits                                   # the URDF's joint box
+    theta2 = np.linspace(limits.lower[1], limits.upper[1], 61)
+    theta3 = np.linspace(limits.lower[2], limits.upper[2], 61)
     grid = np.stack(np.meshgrid(theta2, theta3, indexing="ij"), axis=-1)
     theta = np.concatenate([np.zeros(grid.shape[:2] + (1,)), grid], axis=-1)
     tau = phantom.gravity(theta)                                     # (61, 61, 3) N m
-    difference = np.abs(tau - closed_form.gravity(theta)).max()
+    difference = np.abs(tau - closed_form.gravity(theta, phantom.config.report)).max()
     figure, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
     for axis, joint in zip(axes, (1, 2)):
         image = axis.pcolormesh(theta3, theta2, tau[..., joint], shading="auto", cmap="coolwarm")

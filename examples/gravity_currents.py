@@ -25,15 +25,16 @@ def main(argv: list[str] | None = None) -> None:
     args = cli.parse_args(argv)
     figure_path = common.output(args, "gravity_currents.png")
     device = Device()
-    p = device.parameters
-    theta2 = np.linspace(p.stop_lower[1], p.stop_upper[1], args.samples)
-    theta3 = np.linspace(p.stop_lower[2], p.stop_upper[2], args.samples)
+    stops, motor = device.config.limits.stops, device.config.actuation.motor
+    theta2 = np.linspace(stops.lower[1], stops.upper[1], args.samples)
+    theta3 = np.linspace(stops.lower[2], stops.upper[2], args.samples)
     grid = np.stack(np.meshgrid(theta2, theta3, indexing="ij"), axis=-1)
     theta = np.concatenate([np.zeros(grid.shape[:2] + (1,)), grid], axis=-1).reshape(-1, 3)
     inside = device.within_limits(theta)
     theta = theta[inside]
     currents = device.motor_currents(device.phantom.gravity(theta))           # (N, 3) A
-    check = np.abs(currents * device.ratios * p.torque_constant - closed_form.gravity(theta)).max()
+    check = np.abs(currents * device.ratios * motor.torque_constant
+                   - closed_form.gravity(theta, device.config.report)).max()
     down = device.tip_force_capacity(theta, [0.0, -1.0, 0.0])                 # N
 
     figure, axes = plt.subplots(1, 3, figsize=(15, 4.5), constrained_layout=True)
@@ -50,7 +51,7 @@ def main(argv: list[str] | None = None) -> None:
                  xlim=np.degrees([theta[:, 2].min(), theta[:, 2].max()]),
                  ylim=np.degrees([theta[:, 1].min(), theta[:, 1].max()]))
         figure.colorbar(mesh, ax=axis)
-    figure.suptitle(f"gravity compensation inside the real stops; continuous rating {p.max_continuous_current:g} A")
+    figure.suptitle(f"gravity compensation inside the real stops; continuous rating {motor.max_continuous_current:g} A")
     figure.savefig(figure_path, dpi=120)
     print(f"wrote {figure_path}")
     print(f"{len(theta)} of {inside.size} grid postures inside the stops")
@@ -59,7 +60,8 @@ def main(argv: list[str] | None = None) -> None:
     for joint in (1, 2):
         where = np.degrees(theta[np.argmax(np.abs(currents[:, joint]))])
         print(f"motor {joint + 1}: worst holding current {worst[joint]:.4f} A = "
-              f"{100 * worst[joint] / p.max_continuous_current:.1f}% of the continuous {p.max_continuous_current:g} A "
+              f"{100 * worst[joint] / motor.max_continuous_current:.1f}% of the continuous "
+              f"{motor.max_continuous_current:g} A "
               f"(at theta2 {where[1]:.0f} deg, theta3 {where[2]:.0f} deg)")
     print(f"downward tip force left at the continuous rating: min {down.min():.3f} N, max {down.max():.3f} N")
 

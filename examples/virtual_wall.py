@@ -79,7 +79,7 @@ def main(argv: list[str] | None = None) -> None:
     posture = np.array(args.posture)
     if not device.within_limits(posture):
         raise PhantomPinError(f"--posture: {args.posture} rad is outside the device's stops")
-    p = device.parameters
+    p = device.config.actuation.friction
     jacobian = device.tip_jacobian(posture)
     mobility = NORMAL @ np.linalg.inv(jacobian @ jacobian.T) @ NORMAL     # 1/m^2
     damping = {"viscous": p.viscous * mobility,                          # N s/m at the tip

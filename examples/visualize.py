@@ -5,10 +5,12 @@ live on 127.0.0.1 with --serve until Ctrl-C.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 import common
-from phantom_pin import closed_form, load
+from phantom_pin import config, load
 from phantom_pin.viewer import Viewer
 
 
@@ -35,7 +37,7 @@ def main(argv: list[str] | None = None) -> None:
     with Viewer(robot) as viewer:
         viewer.set_force([0.0, -1.0, 0.0])          # N, frame s: y is up
         viewer.animate(*sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
-                              closed_form.shipped_parameters().coupled),
+                              dataclasses.astuple(config.read().limits.stops.coupled)),
                        repetitions=1000)
         if html_path is not None:
             print(f"wrote {viewer.export_html(html_path, force=args.force)}")

@@ -48,8 +48,8 @@ def main(argv: list[str] | None = None) -> None:
         raise PhantomPinError("--placements: expected at least 1")
     figure_path = common.output(args, "workspace.png")
     device = Device()
-    p = device.phantom.parameters
-    axes_ = [np.linspace(lo, hi, args.samples) for lo, hi in zip(p.lower, p.upper)]
+    limits, p = device.config.limits, device.config.kinematics     # the URDF's joint box; l1, l2
+    axes_ = [np.linspace(lo, hi, args.samples) for lo, hi in zip(limits.lower, limits.upper)]
     box = np.stack(np.meshgrid(*axes_, indexing="ij"), axis=-1).reshape(-1, 3)
     theta = box[device.within_limits(box)]
     tip = device.phantom.forward_kinematics(theta)[:, :3, 3]                # (N, 3) m in frame s

@@ -16,12 +16,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import RAISED, dark, frame_pose, patch, render
-from phantom_pin import closed_form as cf
+from conftest import CONFIG, RAISED, REPORT, dark, frame_pose, patch, render
+from phantom_pin import closed_form as cf, describe
 from phantom_pin.cli import main
-from phantom_pin.description import generate_urdf
-from phantom_pin.parameters import random_states
-from phantom_pin.paths import CONFIG_DIR, URDF_PATH
+from phantom_pin.config import MODELS
+from phantom_pin.config.sampling import random_states
+
+CONFIG_DIR, URDF_PATH = MODELS["premium_1_5"].config, MODELS["premium_1_5"].urdf
 
 
 def run(capsys, *argv):
@@ -40,8 +41,8 @@ def test_fk_and_ik_agree_with_the_closed_form(capsys):
     theta = [0.2, 0.3, 0.4]
     code, out, _ = run(capsys, "fk", *map(str, theta), "--json")
     assert code == 0
-    np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics(theta), atol=1e-12)
-    position = cf.forward_kinematics(theta)[:3, 3]
+    np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics(theta, REPORT), atol=1e-12)
+    position = cf.forward_kinematics(theta, REPORT)[:3, 3]
     code, out, _ = run(capsys, "ik", *(str(float(x)) for x in position), "--json")
     np.testing.assert_allclose(json.loads(out)["theta"], theta, atol=1e-9)
 
@@ -50,8 +51,9 @@ def test_dynamics_agrees_with_the_closed_form(capsys):
     code, out, _ = run(capsys, "dynamics", "--theta", "0.1", "0.2", "0.3", "--dtheta", "1", "2", "3",
                        "--ddtheta", "0", "1", "0", "--json")
     data = json.loads(out)
-    np.testing.assert_allclose(data["tau"], cf.inverse_dynamics([0.1, 0.2, 0.3], [1, 2, 3], [0, 1, 0]), rtol=1e-9)
-    np.testing.assert_allclose(data["M"], cf.mass_matrix([0.1, 0.2, 0.3]), rtol=1e-9)
+    np.testing.assert_allclose(data["tau"], cf.inverse_dynamics([0.1, 0.2, 0.3], [1, 2, 3], [0, 1, 0], REPORT),
+                               rtol=1e-9)
+    np.testing.assert_allclose(data["M"], cf.mass_matrix([0.1, 0.2, 0.3], REPORT), rtol=1e-9)
 
 
 def test_info_lists_the_report_masses(capsys):
@@ -110,11 +112,11 @@ def test_urdf_overrides_reach_kinematics_dynamics_and_mimic_tags(tmp_path, capsy
     code, _, _ = run(capsys, "urdf", "-o", str(target), "--params", str(params), "--set", "l1=0.2096")
     assert code == 0
     model = pin.buildModelFromUrdf(str(target), mimic=True)
-    expected = dataclasses.replace(cf.shipped_parameters(), l1=0.2096, ma=0.03, Ibexx=12.0e-4)
-    rotors = np.diag(expected.armature)  # the report's inertias include them; the URDF leaves
-                                         # them to the SRDF, which is not loaded here
+    expected = dataclasses.replace(REPORT, l1=0.2096, ma=0.03, Ibexx=12.0e-4)
+    rotors = np.diag(CONFIG.actuation.armature)  # the report's inertias include them; the URDF
+                                                 # leaves them to the SRDF, not loaded here
     data = model.createData()
-    for theta in np.random.default_rng(7).uniform(expected.lower, expected.upper, (50, 3)):
+    for theta in np.random.default_rng(7).uniform(CONFIG.limits.lower, CONFIG.limits.upper, (50, 3)):
         pin.framesForwardKinematics(model, data, theta)
         g = data.oMf[model.getFrameId("report_s")].actInv(data.oMf[model.getFrameId("tip")])
         np.testing.assert_allclose(g.homogeneous, cf.forward_kinematics(theta, expected), atol=1e-12)
@@ -131,7 +133,7 @@ def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, capsy
     assert run(capsys, "srdf", "-o", str(target), "--set", "actuation.motor.rotor_inertia=1.1e-6")[0] == 0
     model = pin.buildModelFromUrdf(str(URDF_PATH), mimic=True)
     pin.loadRotorParameters(model, str(target), False)
-    np.testing.assert_allclose(model.armature, [1.1e-6 * r**2 for r in cf.shipped_parameters().ratios],
+    np.testing.assert_allclose(model.armature, [1.1e-6 * r**2 for r in CONFIG.actuation.ratios],
                                rtol=1e-12)
     code, _, err = run(capsys, "srdf", "-o", str(tmp_path / "bad.srdf"), "--set", "actuation.motor.rotor_inertia=2e-6")
     assert code == 2 and "upper_arm_link" in err and not (tmp_path / "bad.srdf").exists()
@@ -164,7 +166,7 @@ def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, ca
     assert run(capsys, *argv)[0] == 0
     image = render(html, tmp_path / "scene.png")
     tips = [frame_pose(pin.buildModelFromXML(urdf, mimic=True), RAISED, "tip").translation
-            for urdf in (generate_urdf("", config), URDF_PATH.read_text())]
+            for urdf in (describe(config).urdf, URDF_PATH.read_text())]
     assert np.linalg.norm(tips[0] - tips[1]) > 0.03
     assert dark(patch(image, tips[0])) and not dark(patch(image, tips[1]))
     code, _, err = run(capsys, *argv)
@@ -213,9 +215,9 @@ def test_check_draws_and_evaluates_in_chunks(monkeypatch, capsys):
     """250 states in chunks of 7: 35 chunks of 7 and one of 5, every check passes."""
     sizes = []
 
-    def spy(params, n, seed):
+    def spy(limits, n, seed):
         sizes.append(n)
-        return random_states(params, n, seed)
+        return random_states(limits, n, seed)
     monkeypatch.setattr("phantom_pin.cli.CHECK_CHUNK", 7)
     monkeypatch.setattr("phantom_pin.cli.random_states", spy)
     report = json.loads(run(capsys, "check", "-n", "250", "--json")[1])
@@ -260,12 +262,12 @@ def test_binary_params_file_is_named(tmp_path, capsys):
 def test_negative_numbers_in_scientific_notation_are_values(capsys):
     code, out, _ = run(capsys, "fk", "-1e-3", "0", "0", "--json")
     assert code == 0
-    np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics([-1e-3, 0, 0]), atol=1e-12)
+    np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics([-1e-3, 0, 0], REPORT), atol=1e-12)
     code, out, _ = run(capsys, "dynamics", "--theta", "-1e-3", "0.1", "0.2", "--dtheta", "-2E+0", "0", "-.5",
                        "--json")
     assert code == 0
     np.testing.assert_allclose(json.loads(out)["tau"], cf.inverse_dynamics([-1e-3, 0.1, 0.2], [-2, 0, -0.5],
-                                                                           [0, 0, 0]), rtol=1e-9)
+                                                                           [0, 0, 0], REPORT), rtol=1e-9)
 
 
 @pytest.mark.parametrize("argv, warned", [

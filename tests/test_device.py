@@ -8,9 +8,11 @@ import shutil
 import numpy as np
 import pytest
 
-from phantom_pin import Device, InvalidInputError, ParameterFileError, Phantom, closed_form
-from phantom_pin.device import load_device_parameters
-from phantom_pin.paths import CONFIG_DIR
+from conftest import REPORT
+from phantom_pin import Device, InvalidInputError, ParameterFileError, Phantom, closed_form, config
+from phantom_pin.config import MODELS
+
+CONFIG_DIR = MODELS["premium_1_5"].config
 
 DEG = math.pi / 180
 #: mahilab/Phantom's stops (deg): per joint, and the parallelogram's coupled ones.
@@ -30,8 +32,11 @@ def device(phantom):
 
 def test_device_wraps_the_phantom_and_builds_one_by_default(phantom):
     assert Device(phantom).phantom is phantom
-    assert Device().phantom.parameters == phantom.parameters
+    assert Device().phantom.config == phantom.config
     with pytest.raises(InvalidInputError, match="phantom"):
+        Device(42)
+    # a text is a model name or a folder now: one that names neither is refused as such
+    with pytest.raises(InvalidInputError, match="neither a model"):
         Device("not a phantom")
 
 
@@ -131,7 +136,7 @@ def test_currents_and_torques_round_trip_against_the_data_sheet(device):
 
 def test_available_torque_is_the_limit_minus_gravity(device, states):
     theta = states[0]
-    gravity = closed_form.gravity(theta)
+    gravity = closed_form.gravity(theta, REPORT)
     for continuous, limit in ((True, TAU_NOMINAL * RATIOS), (False, TAU_STALL * RATIOS)):
         lower, upper = device.available_torque(theta, continuous=continuous)
         np.testing.assert_allclose(lower, -limit - gravity, atol=1e-12)
@@ -144,8 +149,8 @@ def _position_jacobian(theta, step=1e-6):
     for j in range(3):
         shift = np.zeros(3)
         shift[j] = step
-        columns.append((closed_form.forward_kinematics(theta + shift)[..., :3, 3]
-                        - closed_form.forward_kinematics(theta - shift)[..., :3, 3]) / (2 * step))
+        columns.append((closed_form.forward_kinematics(theta + shift, REPORT)[..., :3, 3]
+                        - closed_form.forward_kinematics(theta - shift, REPORT)[..., :3, 3]) / (2 * step))
     return np.stack(columns, axis=-1)
 
 
@@ -159,7 +164,8 @@ def test_tip_force_capacity_reaches_exactly_one_motor_limit(device, states):
     direction = np.random.default_rng(5).normal(size=(50, 3))
     force = device.tip_force_capacity(theta, direction)
     unit = direction / np.linalg.norm(direction, axis=1, keepdims=True)
-    motor = np.einsum("nji,nj->ni", _position_jacobian(theta), force[:, None] * unit) + closed_form.gravity(theta)
+    motor = (np.einsum("nji,nj->ni", _position_jacobian(theta), force[:, None] * unit)
+             + closed_form.gravity(theta, REPORT))
     margin = np.abs(motor) / (TAU_NOMINAL * RATIOS)
     assert np.all(margin <= 1 + 1e-8) and np.all(np.abs(margin.max(axis=1) - 1) < 1e-8)
     assert np.all(force > 0.5)  # N: the box is far from where gravity alone saturates a motor
@@ -183,14 +189,15 @@ def test_encoder_resolution_counts_and_tip_resolution(device, states):
 
 # -- parameters ------------------------------------------------------------------------
 def test_shipped_device_numbers_and_sources(device):
-    p = device.parameters
-    assert (p.viscous, p.coulomb, p.smoothing_speed) == (VISCOUS, COULOMB, 0.1)
-    assert (p.stop_stiffness, p.stop_damping) == (K_STOP, B_STOP)
-    np.testing.assert_allclose(p.stop_lower, np.radians([-90, -124, -29]), rtol=1e-15)
-    np.testing.assert_allclose(p.stop_upper, np.radians([90, 119, 214]), rtol=1e-15)
-    np.testing.assert_allclose([p.theta2_minus_theta3_max, p.theta3_minus_theta2_max], np.radians([65, 55]), rtol=1e-15)
-    assert set(p.sources) == {"transmission_ratio", "motor", "encoder", "friction", "stops"}
-    assert "118743" in p.sources["motor"] and "mahilab" in p.sources["stops"]
+    friction, stops, sources = device.config.actuation.friction, device.config.limits.stops, device.config.sources
+    assert (friction.viscous, friction.coulomb, friction.smoothing_speed) == (VISCOUS, COULOMB, 0.1)
+    assert (stops.stiffness, stops.damping) == (K_STOP, B_STOP)
+    np.testing.assert_allclose(stops.lower, np.radians([-90, -124, -29]), rtol=1e-15)
+    np.testing.assert_allclose(stops.upper, np.radians([90, 119, 214]), rtol=1e-15)
+    np.testing.assert_allclose([stops.coupled.theta2_minus_theta3_max, stops.coupled.theta3_minus_theta2_max],
+                               np.radians([65, 55]), rtol=1e-15)
+    assert set(sources) == {"transmission_ratio", "motor", "encoder", "friction", "stops"}
+    assert "118743" in sources["motor"] and "mahilab" in sources["stops"]
 
 
 @pytest.mark.parametrize("file, old, new, message", [
@@ -200,31 +207,35 @@ def test_shipped_device_numbers_and_sources(device):
     ("joint_limits.yaml", "  stiffness: 10.0", "  stiffness: .nan", "stops.stiffness must be a finite"),
     ("joint_limits.yaml", "  joint3: {lower: -0.5061454830783556", "  joint3: {lower: 4.0",
      "stops.joint3.lower must be below"),
-    ("joint_limits.yaml", "  stops: \"mahilab", "  stop: \"mahilab", "sources.stops must be a non-empty text"),
+    ("joint_limits.yaml", "  stops: \"mahilab", "  stop: \"mahilab", "missing key sources.stops"),
+    ("joint_limits.yaml", "  stops: \"mahilab", "  stops: \"\" # \"mahilab", "sources.stops must be a non-empty text"),
 ])
 def test_malformed_device_numbers_are_named(tmp_path, file, old, new, message):
-    config = tmp_path / "config"
-    shutil.copytree(CONFIG_DIR, config)
-    text = (config / file).read_text()
+    folder = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, folder)
+    text = (folder / file).read_text()
     assert old in text
-    (config / file).write_text(text.replace(old, new, 1))
+    (folder / file).write_text(text.replace(old, new, 1))
     with pytest.raises(ParameterFileError, match=message) as error:
-        load_device_parameters(config)
+        config.read(folder)
     assert file in str(error.value)
 
 
 def test_device_reads_its_config_folder(tmp_path, phantom):
-    """Device(config_dir=DIR) and Device(Phantom(DIR)) take the device numbers of DIR, the
-    folder the rigid body comes from; a phantom and a folder together are refused."""
-    config = tmp_path / "config"
-    shutil.copytree(CONFIG_DIR, config)
-    text = (config / "actuation.yaml").read_text()
-    (config / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
-    for device in (Device(config_dir=config), Device(Phantom(config))):
+    """Device(DIR) and Device(Phantom(DIR)) take the device numbers of DIR, the folder the
+    rigid body comes from; a phantom and a folder together are refused (Device takes one
+    source: there is no config_dir keyword any more)."""
+    folder = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, folder)
+    text = (folder / "actuation.yaml").read_text()
+    (folder / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
+    for device in (Device(folder), Device(Phantom(folder))):
         np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB * np.tanh(10), 0, 0],
                                    rtol=1e-14)
-    with pytest.raises(InvalidInputError, match="config_dir: give a phantom or a config_dir"):
-        Device(phantom, config)
+    with pytest.raises(TypeError):
+        Device(phantom, folder)
+    with pytest.raises(TypeError, match="config_dir"):
+        Device(config_dir=folder)
 
 
 def test_reachable_is_forward_kinematics_inside_the_stops(device):
@@ -232,11 +243,12 @@ def test_reachable_is_forward_kinematics_inside_the_stops(device):
     kinematics of Device.reachable); beyond l1 + l2, and straight behind the shoulder where
     only theta2 > 119 deg would reach, nothing is."""
     rng = np.random.default_rng(21)
-    p = device.phantom.parameters
-    theta = rng.uniform(device.parameters.stop_lower, device.parameters.stop_upper, (6000, 3))
+    p = device.config.kinematics
+    stops = device.config.limits.stops
+    theta = rng.uniform(stops.lower, stops.upper, (6000, 3))
     theta = theta[device.within_limits(theta)]
     assert len(theta) > 1000
-    assert device.reachable(closed_form.forward_kinematics(theta)[:, :3, 3]).all()
+    assert device.reachable(closed_form.forward_kinematics(theta, REPORT)[:, :3, 3]).all()
     shoulder = np.array([0.0, p.l2, -p.l1])  # frame s (eqs 4-5)
     assert not device.reachable(shoulder + [0.0, 0.0, p.l1 + p.l2 + 1e-3])
     assert device.reachable(shoulder + [0.0, 0.0, 0.3])        # 0.3 m in front, at shoulder height

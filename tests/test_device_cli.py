@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from conftest import REPORT
 from phantom_pin import closed_form, simulate
 from phantom_pin.cli import main
 
@@ -38,7 +39,8 @@ def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(capsys):
     assert code == 0 and rows[0][:4] == ["t [s]", "theta1 [rad]", "theta2 [rad]", "theta3 [rad]"] and len(rows) == 22
     table = np.array(rows[1:], dtype=float)
     np.testing.assert_allclose(table[:, 1:4], np.tile([0.3, 0.8, 0.4], (21, 1)), atol=1e-12)
-    np.testing.assert_allclose(table[:, 8:10], np.tile(closed_form.gravity([0.3, 0.8, 0.4])[1:], (21, 1)), rtol=1e-9)
+    np.testing.assert_allclose(table[:, 8:10], np.tile(closed_form.gravity([0.3, 0.8, 0.4], REPORT)[1:], (21, 1)),
+                               rtol=1e-9)
     assert rows[0][-3:] == ["tip_x [m]", "tip_y [m]", "tip_z [m]"]
 
 
@@ -72,6 +74,6 @@ def test_info_lists_the_device_data_with_sources(capsys):
     assert all(section["source"] for section in device.values())
     assert device["motor"]["stall_torque"] == 0.129 and device["motor"]["torque_constant"] == 0.0234
     np.testing.assert_allclose(device["encoder"]["resolution"], 2 * np.pi / (4096 * np.array([13.3, 11.6, 11.6])))
-    np.testing.assert_allclose(device["stops"]["stop_upper"], np.radians([90, 119, 214]))
+    np.testing.assert_allclose(device["stops"]["upper"], np.radians([90, 119, 214]))
     code, out, _ = run(capsys, "info")
     assert "theta3 - theta2 <= 55.0" in out and "118743" in out and "HEDM-5500" in out

@@ -6,7 +6,9 @@ from pathlib import Path
 
 import yaml
 
-from phantom_pin.paths import CONFIG_DIR, URDF_PATH
+from phantom_pin.config import MODELS
+
+CONFIG_DIR, URDF_PATH = MODELS["premium_1_5"].config, MODELS["premium_1_5"].urdf
 
 ROOT = Path(__file__).resolve().parent.parent
 

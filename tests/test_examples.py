@@ -2,6 +2,7 @@
 pass their independent checks (closed form, energy conservation, the reachable shell,
 finite differences, the page rendered in chromium)."""
 
+import dataclasses
 import importlib.util
 import re
 import subprocess
@@ -12,7 +13,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import dark, frame_pose, light_grey, patch, render
+from conftest import CONFIG, REPORT, dark, frame_pose, light_grey, patch, render
 from phantom_pin import Device, Phantom, closed_form as cf, load
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -70,11 +71,11 @@ def test_workspace_prints_the_closed_form_extent_of_the_grid(tmp_path):
     result = run("workspace.py", tmp_path, "--samples", "15", "--placements", "3")
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "workspace.png")
-    p = cf.shipped_parameters()
-    grid = np.stack(np.meshgrid(*(np.linspace(lo, hi, 15) for lo, hi in zip(p.lower, p.upper)),
+    p, limits = REPORT, CONFIG.limits
+    grid = np.stack(np.meshgrid(*(np.linspace(lo, hi, 15) for lo, hi in zip(limits.lower, limits.upper)),
                                 indexing="ij"), axis=-1).reshape(-1, 3)
     grid = grid[(grid[:, 1] - grid[:, 2] <= np.radians(65)) & (grid[:, 2] - grid[:, 1] <= np.radians(55))]
-    tip = cf.forward_kinematics(grid)[:, :3, 3]
+    tip = cf.forward_kinematics(grid, REPORT)[:, :3, 3]
     radius = np.linalg.norm(tip - [0.0, p.l2, -p.l1], axis=1)
     printed = [float(v) for v in re.findall(r"[-+]?\d+\.\d{4}", result.stdout.split("bounding box")[1])[:8]]
     expected = [tip[:, 0].min(), tip[:, 0].max(), tip[:, 1].min(), tip[:, 1].max(),
@@ -93,23 +94,23 @@ def test_trajectory_torques_follow_the_minimum_jerk_path_and_the_closed_form(tmp
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "trajectory_torques.png")
     module = example("trajectory_torques")
-    start, end = cf.forward_kinematics(module.START)[:3, 3], cf.forward_kinematics(module.END)[:3, 3]
+    start, end = cf.forward_kinematics(module.START, REPORT)[:3, 3], cf.forward_kinematics(module.END, REPORT)[:3, 3]
     duration = 0.6
     r = module.reach(Phantom(), start, end, duration)
     s = r["time"] / duration
     profile = 10 * s**3 - 15 * s**4 + 6 * s**5
     speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / duration
-    np.testing.assert_allclose(cf.forward_kinematics(r["theta"])[:, :3, 3],
+    np.testing.assert_allclose(cf.forward_kinematics(r["theta"], REPORT)[:, :3, 3],
                                start + np.outer(profile, end - start), atol=1e-12)
-    jacobian = cf.spatial_jacobian(r["theta"])
-    tip = cf.forward_kinematics(r["theta"])[:, :3, 3]
+    jacobian = cf.spatial_jacobian(r["theta"], REPORT)
+    tip = cf.forward_kinematics(r["theta"], REPORT)[:, :3, 3]
     velocity = (np.einsum("nij,nj->ni", jacobian[:, :3], r["dtheta"])
                 + np.cross(np.einsum("nij,nj->ni", jacobian[:, 3:], r["dtheta"]), tip))
     np.testing.assert_allclose(velocity, np.outer(speed, end - start), atol=1e-12)
     # 301 samples over 0.6 s: second-order differences (measured 3.6e-3 rad/s^2 of 17.6)
     numeric = np.gradient(r["dtheta"], r["time"], axis=0, edge_order=2)
     assert np.abs(numeric - r["ddtheta"]).max() < 1e-3 * np.abs(r["ddtheta"]).max()
-    expected = cf.inverse_dynamics(r["theta"], r["dtheta"], r["ddtheta"])
+    expected = cf.inverse_dynamics(r["theta"], r["dtheta"], r["ddtheta"], REPORT)
     assert np.abs(r["torque"] - expected).max() < 1e-9 * np.abs(expected).max()
 
 
@@ -125,7 +126,7 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
     assert np.count_nonzero(np.ptp(image[40:], axis=2) < 30) > 3000
     robot = load()
     _, postures = example("visualize").sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
-                                             cf.shipped_parameters().coupled)
+                                             dataclasses.astuple(CONFIG.limits.stops.coupled))
     assert Device().within_limits(postures).all()
 
     def where(theta, frame):

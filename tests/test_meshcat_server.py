@@ -9,7 +9,7 @@ import time
 import urllib.request
 from pathlib import Path
 
-from phantom_pin.meshcat_server import MeshcatServer
+from phantom_pin.viewer.server import MeshcatServer
 
 LOOPBACK_V4, LISTEN = "0100007F", "0A"
 
@@ -61,7 +61,7 @@ def test_listens_on_loopback_only_and_serves_the_viewer():
 
 def _owner(ending: str) -> tuple[subprocess.Popen, int]:
     """A Python process that starts a server, prints its pid, then ``ending``."""
-    code = ("from phantom_pin.meshcat_server import MeshcatServer\n"
+    code = ("from phantom_pin.viewer.server import MeshcatServer\n"
             "import sys, time\n"
             "server = MeshcatServer()\n"
             "print(server.process.pid, flush=True)\n" + ending)

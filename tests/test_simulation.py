@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from conftest import REPORT
 from phantom_pin import InvalidInputError, closed_form, simulate
 from phantom_pin.device.simulation import default_device
 
@@ -24,8 +25,8 @@ def closed_form_rk4(theta0, dtheta0, torque, duration, h):
     """RK4 with step h of M(q) q'' + C(q, q') q' + N(q) = torque(t), the report's closed form."""
     def rate(x, t):
         q, v = x[:3], x[3:]
-        a = np.linalg.solve(closed_form.mass_matrix(q),
-                            torque(t) - closed_form.coriolis_matrix(q, v) @ v - closed_form.gravity(q))
+        a = np.linalg.solve(closed_form.mass_matrix(q, REPORT),
+                            torque(t) - closed_form.coriolis_matrix(q, v, REPORT) @ v - closed_form.gravity(q, REPORT))
         return np.concatenate([v, a])
 
     x, out = np.concatenate([theta0, dtheta0]), []
@@ -47,7 +48,7 @@ def test_without_friction_stops_and_saturation_it_is_the_closed_form():
     assert np.abs(result.theta - reference[:, :3]).max() < 1e-6          # measured 3e-11 rad
     assert np.abs(result.dtheta - reference[:, 3:]).max() < 1e-5         # rad/s
     assert np.abs(result.theta[-1] - START).max() > 0.05                 # it did move
-    np.testing.assert_allclose(result.tip, closed_form.forward_kinematics(result.theta)[:, :3, 3], atol=1e-12)
+    np.testing.assert_allclose(result.tip, closed_form.forward_kinematics(result.theta, REPORT)[:, :3, 3], atol=1e-12)
     slow = simulate(START, 0.15, rate=20.0, friction=False, hard_stops=False, saturation=False)
     assert slow.substeps == 50 and np.abs(slow.theta - reference[::50, :3]).max() < 1e-6  # steps <= 1 ms
 
@@ -90,8 +91,8 @@ def stop_depth(theta):
 
 def test_mechanical_energy_never_grows_without_input(fall):
     theta, dtheta = fall.theta, fall.dtheta
-    energy = (0.5 * np.einsum("ni,nij,nj->n", dtheta, closed_form.mass_matrix(theta), dtheta)
-              + closed_form.potential_energy(theta) + 0.5 * K_STOP * np.sum(stop_depth(theta) ** 2, axis=1))
+    energy = (0.5 * np.einsum("ni,nij,nj->n", dtheta, closed_form.mass_matrix(theta, REPORT), dtheta)
+              + closed_form.potential_energy(theta, REPORT) + 0.5 * K_STOP * np.sum(stop_depth(theta) ** 2, axis=1))
     assert np.diff(energy).max() < 1e-10                                # J; measured < 0 at every sample
     assert energy[-1] < energy[0] - 0.1                                 # J: it fell and lost it
     assert (np.abs(stop_depth(theta)).max(axis=1) > 0).any()            # and it hit the stops
@@ -105,13 +106,13 @@ def test_a_free_fall_comes_to_rest_against_the_parallelogram_stop(fall):
     assert np.abs(dtheta).max() < 1e-3                                  # rad/s (measured 1.7e-4)
     depth = stop_depth(theta)
     assert depth[:3].tolist() == [0, 0, 0] and -2e-3 < depth[3] < 0     # only q3 - q2 <= 55 deg
-    gravity, spring = closed_form.gravity(theta), -K_STOP * depth[3]
+    gravity, spring = closed_form.gravity(theta, REPORT), -K_STOP * depth[3]
     assert gravity[1] == pytest.approx(spring, rel=0.01) and -gravity[2] == pytest.approx(spring, rel=0.01)
     # the equilibrium, by Newton's method on N(q) = stop torque for (q2, q3)
     q = theta[1:].copy()
 
     def residual(x):
-        n = closed_form.gravity([theta[0], *x])[1:]
+        n = closed_form.gravity([theta[0], *x], REPORT)[1:]
         p = x[1] - x[0] - np.radians(55)
         return n - K_STOP * p * np.array([1.0, -1.0])
 
@@ -134,7 +135,7 @@ def test_saturation_clips_at_the_stall_torque():
 
 def test_gravity_compensation_holds_the_arm_still():
     """The sign convention: the controller's torque is eq. 80's tau."""
-    result = simulate(START, 0.2, lambda t, q, dq: closed_form.gravity(q))
+    result = simulate(START, 0.2, lambda t, q, dq: closed_form.gravity(q, REPORT))
     assert np.abs(result.theta - START).max() < 1e-12
 
 
