@@ -63,6 +63,24 @@ class Inertial:
                    tuple(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
 
 
+def _point(m: float, c: np.ndarray) -> np.ndarray:
+    """The inertia of a point mass ``m`` at ``c`` about the origin: m (|c|^2 1 - c c^T)."""
+    return m * (c @ c * np.eye(3) - np.outer(c, c))
+
+
+def without_point_mass(body: Inertial, mass: float, point: tuple[float, float, float]) -> Inertial:
+    """``body`` less a point mass ``mass`` (kg) at ``point`` (m, link frame): the mass,
+    first moment and inertia about the link origin each lose the point's share, and the
+    inertia moves back to the new centre of mass (the parallel-axis theorem, both ways)."""
+    m, c, p = float(body.mass), np.array(body.com, dtype=float), np.array(point, dtype=float)
+    origin = body.tensor + _point(m, c) - _point(mass, p)
+    rest = m - mass
+    com = (m * c - mass * p) / rest
+    at_com = origin - _point(rest, com)
+    return Inertial(rest, tuple(float(v) for v in com),
+                    tuple(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
+
+
 def principal_moments(tensor: np.ndarray) -> np.ndarray:
     """The principal moments a <= b <= c (kg m^2) of a symmetric tensor."""
     return np.linalg.eigvalsh(tensor)

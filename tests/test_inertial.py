@@ -1,5 +1,6 @@
 """The one physical check of a link (phantom_pin.inertial), its tolerance against MuJoCo (the
-strictest consumer, loading the generated MJCF at the boundary), and links given in full."""
+strictest consumer, loading the generated MJCF at the boundary), and links given in full
+against the report's adapter."""
 
 import shutil
 
@@ -16,22 +17,42 @@ from phantom_pin.inertial import TRIANGLE_SLACK, Inertial, problem, slack
 SHIPPED = MODELS["premium_1_5"]
 
 
-@pytest.fixture(scope="module")
-def links_folder(tmp_path_factory):
-    """premium_1_5 with its links given in full (the committed links.yaml) instead of the report's numbers."""
-    folder = tmp_path_factory.mktemp("links") / "config"
+def _diagonal(mass, com, xx, yy, zz, about_origin=False):
+    """A body of diagonal inertia (kg m^2, base_link axes) about its COM, or about the link
+    origin moved to the COM by the parallel-axis theorem."""
+    c = np.array(com, dtype=float)
+    tensor = np.diag([xx, yy, zz]) - (mass * (c @ c * np.eye(3) - np.outer(c, c)) if about_origin else 0.0)
+    return {"mass": mass, "com": list(com), "inertia": {"xx": float(tensor[0, 0]), "xy": 0.0, "xz": 0.0,
+                                                        "yy": float(tensor[1, 1]), "yz": 0.0, "zz": float(tensor[2, 2])}}
+
+
+def test_the_report_as_five_bodies_in_full_gives_the_report_adapters_links(tmp_path):
+    """The report's segments written by hand as five bodies in full (report axes (x, y, z) =
+    base (y, z, x); BE and DF printed about the shoulder; the rotors moved to the armature)
+    give, through the links-in-full path and its generic carving of the hinge pins, the links
+    of the report's adapter (report.parameters.links) to rounding."""
+    folder = tmp_path / "config"
     shutil.copytree(SHIPPED.config, folder)
-    links = yaml.safe_load(SHIPPED.links_file.read_text())["links"]
-    (folder / "physical_parameters.yaml").write_text(yaml.safe_dump({"gravity": 9.81, "links": links}))
-    (folder / "links.yaml").unlink()
-    return folder
-
-
-def test_links_in_full_describe_the_same_urdf_as_the_report_numbers(links_folder):
-    """The report's adapter and the links in full give the same URDF, byte for byte."""
-    full, report = describe(links_folder), describe("premium_1_5")
-    assert full.config.report is None and report.config.report is not None
-    assert full.urdf == report.urdf and full.mjcf == report.mjcf
+    c = config.read()
+    p, (j1, j2, j3) = c.report, c.actuation.armature
+    raw = yaml.safe_load((SHIPPED.config / "physical_parameters.yaml").read_text())
+    g = raw["segment_g"]
+    bodies = {
+        "turret_link": _diagonal(g["mass"], (0, 0, 0), g["inertia_zz"], g["inertia_xx"], p.Ibaseyy - j1),
+        "upper_arm_link": _diagonal(p.mbe, (p.l5, 0, 0), p.Ibezz, p.Ibexx - j2, p.Ibeyy, about_origin=True),
+        "crank_link": _diagonal(p.mdf, (0, 0, p.l6), p.Idfzz, p.Idfxx - j3, p.Idfyy, about_origin=True),
+        "lower_bar_link": _diagonal(p.mc, (p.l1 / 2, 0, 0), p.Iczz, p.Icxx, p.Icyy),
+        "forearm_link": _diagonal(p.ma, (0, 0, p.l3 - p.l2 / 2), p.Iazz, p.Iaxx, p.Iayy),
+    }
+    (folder / "physical_parameters.yaml").write_text(
+        yaml.safe_dump({"gravity": 9.81, "links": bodies, "hinge_pin": raw["hinge_pin"]}))
+    full = config.read(folder)
+    assert full.report is None
+    for name, link in c.links.items():
+        other = full.links[name]
+        assert other.mass == pytest.approx(link.mass, rel=1e-15), name
+        np.testing.assert_allclose(other.com, link.com, rtol=1e-14, atol=1e-17, err_msg=name)
+        np.testing.assert_allclose(other.tensor, link.tensor, rtol=1e-12, atol=1e-18, err_msg=name)
 
 
 def _loads_in_mujoco(mjcf: str) -> bool:
@@ -56,10 +77,11 @@ def test_the_boundary_of_the_triangle_inequality_is_the_same_for_us_and_mujoco(f
             describe(overrides={"segment_a.inertia.xx": largest})
 
 
-def test_rotated_links_at_the_boundary_load_in_mujoco(links_folder):
+def test_rotated_links_at_the_boundary_load_in_mujoco():
     """With products of inertia MuJoCo's own eigen-decomposition decides, and rounds: every
     link the check accepts (slack 2 TRIANGLE_SLACK, 100 random orientations) loads from the
-    generated MJCF; links 1e-12 c past the boundary are refused by the check."""
+    generated MJCF (premium_1_5_cad's forearm, given in full); links 1e-12 c past the
+    boundary are refused by the check."""
     rng = np.random.default_rng(7)
     a, b = 1.843e-7, 4.864e-5
     for _ in range(100):
@@ -74,10 +96,10 @@ def test_rotated_links_at_the_boundary_load_in_mujoco(links_folder):
                                                                    tensor[1, 1], tensor[1, 2], tensor[2, 2])))
             overrides = {f"links.forearm_link.inertia.{k}": float(v) for k, v in keys.items()}
             if physical:
-                assert _loads_in_mujoco(describe(links_folder, overrides=overrides).mjcf)
+                assert _loads_in_mujoco(describe("premium_1_5_cad", overrides=overrides).mjcf)
             else:
                 with pytest.raises(ParameterFileError, match="link forearm_link"):
-                    describe(links_folder, overrides=overrides)
+                    describe("premium_1_5_cad", overrides=overrides)
 
 
 def test_the_issue_example_is_refused_with_one_line_and_nothing_written(tmp_path, capsys):

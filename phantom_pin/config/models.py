@@ -15,9 +15,8 @@ from phantom_pin.paths import DESCRIPTION_DIR
 class Model:
     """A configuration of the description package: its ``name``, a one-line ``title``, its
     ``config`` folder (config/NAME), the top-level xacros that generate its URDF and SRDF,
-    and the committed generated files (URDF, SRDF, MJCF and its scene). ``links_file``: the
-    generated YAML of the links in full, committed where the configuration is written in
-    the report's terms (for plain xacro), else None (its physical_parameters.yaml has them)."""
+    and the committed generated files (URDF, SRDF, MJCF and its scene, and ``links_file``: the
+    seven links in full, the xacro's input, generated from physical_parameters.yaml)."""
 
     name: str
     title: str
@@ -28,25 +27,25 @@ class Model:
     srdf: Path
     mjcf: Path
     scene: Path
-    links_file: Path | None
+    links_file: Path
 
     @property
     def config(self) -> Path:
         return DESCRIPTION_DIR / "config" / self.name
 
 
-def _model(name: str, title: str, robot: str, generated_links: bool, scene: str) -> Model:
+def _model(name: str, title: str, robot: str, scene: str) -> Model:
     d = DESCRIPTION_DIR
     return Model(name, title, robot, d / "urdf" / f"{robot}.urdf.xacro", d / "srdf" / "phantom_1_5.srdf.xacro",
                  d / "urdf" / f"{robot}.urdf", d / "srdf" / f"{robot}.srdf", d / "mjcf" / f"{robot}.xml",
-                 d / "mjcf" / scene, d / "config" / name / "links.yaml" if generated_links else None)
+                 d / "mjcf" / scene, d / "config" / name / "links.yaml")
 
 
 #: The shipped configurations, by name; the first is the default everywhere.
 MODELS = {model.name: model for model in (
-    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5", True, "scene.xml"),
+    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5", "scene.xml"),
     _model("premium_1_5_cad", "PHANToM Premium 1.5, mahilab/Phantom's CAD mass properties and lengths",
-           "phantom_1_5_cad", False, "scene_phantom_1_5_cad.xml"),
+           "phantom_1_5_cad", "scene_phantom_1_5_cad.xml"),
 )}
 DEFAULT = "premium_1_5"
 

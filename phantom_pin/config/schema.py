@@ -17,7 +17,7 @@ from typing import Mapping
 import numpy as np
 
 from phantom_pin.config.files import FILES, is_number
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, without_point_mass
 from phantom_pin.exceptions import ParameterFileError
 from phantom_pin.report.parameters import ReportParameters, Unprinted, links as report_links
 
@@ -25,6 +25,8 @@ JOINTS = ("joint1", "joint2", "joint3")
 #: The links of the URDF that carry mass, in the order of the kinematic tree.
 LINKS = ("turret_link", "upper_arm_link", "crank_link", "crank_pin_link", "lower_bar_link",
          "forearm_pin_link", "forearm_link")
+#: The mechanism's five rigid bodies (the report's G, BE, DF, C, A): the links but the hinge pins.
+BODIES = ("turret_link", "upper_arm_link", "crank_link", "lower_bar_link", "forearm_link")
 #: Largest |joint limit| (rad): a revolute joint's range beyond one turn each way repeats
 #: postures and describes no stop of this arm (mahilab's widest stop is 3.74 rad).
 JOINT_LIMIT_BOUND = 2 * math.pi
@@ -360,17 +362,39 @@ def _report(r: _Reader, kinematics: Kinematics,
     return report, unprinted, report_links(report, unprinted, actuation.motor.rotor_inertia, actuation.ratios)
 
 
-def _links(r: _Reader) -> dict[str, Inertial]:
-    """The links in full of physical_parameters.yaml ``links`` (the URDF's form)."""
+def _links(r: _Reader, kinematics: Kinematics) -> dict[str, Inertial]:
+    """The seven links of physical_parameters.yaml in the URDF's form: the five bodies in
+    full (``links``) with the hinge pins (``hinge_pin``) carved out of their neighbours,
+    as the report's adapter does (report.parameters.links): each pin's mass at its pivot
+    out of crank_link (0, 0, -l3) and lower_bar_link (l1, 0, 0), its vertical moment out of
+    turret_link, so that the 3-DoF dynamics stay those of the five bodies exactly."""
     arg = "physical_parameters_file"
     listed = r.node(arg, "links")
-    if not isinstance(listed, dict) or set(listed) != set(LINKS):
-        raise r.error(arg, f"links must name exactly the links {', '.join(LINKS)}, got "
+    if not isinstance(listed, dict) or set(listed) != set(BODIES):
+        raise r.error(arg, f"links must name exactly the bodies {', '.join(BODIES)}, got "
                            f"{sorted(listed) if isinstance(listed, dict) else listed!r}")
-    return {name: Inertial(r.number(arg, "links", name, "mass", positive=True),
-                           r.vector(arg, "links", name, "com", length=3),
-                           tuple(r.number(arg, "links", name, "inertia", k) for k in INERTIA_KEYS))
-            for name in LINKS}
+    bodies = {name: Inertial(r.number(arg, "links", name, "mass", positive=True),
+                             r.vector(arg, "links", name, "com", length=3),
+                             tuple(r.number(arg, "links", name, "inertia", k) for k in INERTIA_KEYS))
+              for name in BODIES}
+    for name, body in bodies.items():  # before the carving, so that the error names the body's own keys
+        trouble = problem(body)
+        if trouble:
+            raise r.error(arg, f"link {name}: {trouble} (from links.{name})")
+    pin_mass = r.number(arg, "hinge_pin", "mass", positive=True)
+    xx, yy, zz = (r.number(arg, "hinge_pin", "inertia", k, positive=True) for k in ("xx", "yy", "zz"))
+    pin = Inertial(pin_mass, (0, 0, 0), (xx, 0, 0, yy, 0, zz))
+    turret = bodies["turret_link"]
+    inertia = turret.inertia
+    return {
+        "turret_link": Inertial(turret.mass, turret.com, (*inertia[:5], inertia[5] - 2 * zz)),
+        "upper_arm_link": bodies["upper_arm_link"],
+        "crank_link": without_point_mass(bodies["crank_link"], pin_mass, (0.0, 0.0, -kinematics.l3)),
+        "crank_pin_link": pin,
+        "lower_bar_link": without_point_mass(bodies["lower_bar_link"], pin_mass, (kinematics.l1, 0.0, 0.0)),
+        "forearm_pin_link": pin,
+        "forearm_link": bodies["forearm_link"],
+    }
 
 
 def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool) -> Config:
@@ -386,11 +410,11 @@ def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool)
     if report_form:
         report, unprinted, links = _report(r, kinematics, actuation)
     else:
-        report, unprinted, links = None, None, _links(r)
+        report, unprinted, links = None, None, _links(r, kinematics)
     for link, inertial in links.items():
         trouble = problem(inertial)
         if trouble:
-            keys = f"links.{link}" if report is None else REPORT_KEYS[link]
+            keys = f"links.{link}, hinge_pin" if report is None else REPORT_KEYS[link]
             raise r.error("physical_parameters_file", f"link {link}: {trouble} (from {keys})")
     return Config(name, folder, overridden, kinematics, r.number("physical_parameters_file", "gravity", positive=True),
                   types.MappingProxyType(links), report, unprinted, actuation, _limits(r), _mujoco(r),

@@ -91,6 +91,10 @@ def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader)
     except (RuntimeError, ValueError, AttributeError) as error:  # Pinocchio's, several lines
         label, what = urdf_name.split(": ", 1)
         raise ParameterFileError(f"{label}: Pinocchio cannot load {what} ({_first_line(error)})") from error
+    if isinstance(source, (Description, str, Path)):  # a URDF file of one's own keeps Pinocchio's g
+        from phantom_pin.dynamics.model import gravity_of
+
+        model.gravity = gravity_of(description.config)
     robot = pin.RobotWrapper(model, *geometry)
     try:
         pin.loadReferenceConfigurationsFromXML(robot.model, srdf, False)

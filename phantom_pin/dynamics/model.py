@@ -60,6 +60,12 @@ def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray, before: tupl
     return np.array(list(map(function, *fixed[0], *arrays, *fixed[1])))
 
 
+def gravity_of(config: Config) -> pin.Motion:
+    """Pinocchio's gravity of a configuration: (0, 0, -g) m/s^2 in base_link (a URDF cannot
+    carry it; Pinocchio's default, 9.81, is the report's)."""
+    return pin.Motion(np.array([0.0, 0.0, -config.gravity]), np.zeros(3))
+
+
 def solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:
     """x with m x = r for a symmetric 3x3 ``m`` (nested lists; the upper triangle is read),
     by its adjugate; None unless m is positive definite (Sylvester: leading minors > 0)."""
@@ -120,6 +126,8 @@ class Phantom:
         self.config: Config = description.config
         self.coupling = Coupling(description.urdf)
         self.model: pin.Model = self.coupling.reduced
+        for model in (self.model, self.coupling.tree):  # the configuration's g, along base_link's -z
+            model.gravity = gravity_of(self.config)
         load_rotor_parameters(self.model, description.srdf)
         self.data = self.model.createData()
         self._tree_data = self.coupling.tree.createData()
