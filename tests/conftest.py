@@ -20,6 +20,9 @@ N_STATES = 1000
 #: The default model's configuration (premium_1_5) and the report's numbers it holds.
 CONFIG = config.read()
 REPORT = CONFIG.report
+#: Its configuration folder and committed generated files.
+MODEL = config.MODELS["premium_1_5"]
+CONFIG_DIR, URDF_PATH, SRDF_PATH, MJCF_PATH, SCENE_PATH = MODEL.config, MODEL.urdf, MODEL.srdf, MODEL.mjcf, MODEL.scene
 
 
 @pytest.fixture(scope="session")

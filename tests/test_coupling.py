@@ -7,8 +7,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from phantom_pin.coupling import Coupling, read_mimic_tags
-from phantom_pin.paths import URDF_PATH
+from phantom_pin.dynamics.coupling import Coupling, read_mimic_tags
+from conftest import URDF_PATH
 
 
 def _robots_dir() -> Path:

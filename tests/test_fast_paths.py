@@ -7,11 +7,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import relative_error
+from conftest import REPORT, URDF_PATH, relative_error
 from phantom_pin import InvalidInputError, closed_form as cf
-from phantom_pin.coupling import Coupling
-from phantom_pin.model import solve_spd
-from phantom_pin.paths import URDF_PATH
+from phantom_pin.dynamics.coupling import Coupling
+from phantom_pin.dynamics.model import solve_spd
 
 # method, number of (3,) arguments; inverse_kinematics takes positions (below)
 METHODS = [("forward_kinematics", 1), ("spatial_jacobian", 1), ("body_jacobian", 1),
@@ -22,7 +21,7 @@ METHODS = [("forward_kinematics", 1), ("spatial_jacobian", 1), ("body_jacobian",
 def _arguments(states, method, count):
     values = list(states[:count])
     if method == "forward_dynamics":
-        values[2] = cf.inverse_dynamics(*states)
+        values[2] = cf.inverse_dynamics(*states, REPORT)
     return values
 
 
@@ -57,7 +56,7 @@ def test_batches_equal_single_states_and_closed_form(phantom, states, method, co
     listed = _stacked(function(*(v[7].tolist() for v in values)))
     np.testing.assert_array_equal(listed, _stacked(function(*(v[7] for v in values))))
     if hasattr(cf, method):
-        reference = getattr(cf, method)(*values)
+        reference = getattr(cf, method)(*values, REPORT)
         if method == "potential_energy":
             batch, reference = batch - batch[0], reference - reference[0]
         assert relative_error(batch, reference) < 1e-9
@@ -137,16 +136,16 @@ def test_batches_still_check_shapes_and_overflow(phantom):
 def test_closed_form_batches_span_chunks_and_equal_single_states(states):
     """50000 states: they cross the chunk boundaries of closed_form.inverse_dynamics (8192)."""
     theta, dtheta, ddtheta = (np.concatenate([s] * 50) for s in states)
-    tau = cf.inverse_dynamics(theta, dtheta, ddtheta)
-    m, c, n = cf.mass_matrix(theta), cf.coriolis_matrix(theta, dtheta), cf.gravity(theta)
+    tau = cf.inverse_dynamics(theta, dtheta, ddtheta, REPORT)
+    m, c, n = cf.mass_matrix(theta, REPORT), cf.coriolis_matrix(theta, dtheta, REPORT), cf.gravity(theta, REPORT)
     expected = np.einsum("nij,nj->ni", m, ddtheta) + np.einsum("nij,nj->ni", c, dtheta) + n
     assert relative_error(tau, expected) < 1e-12
     for k in (0, 8191, 8192, 16384, 49999):
-        np.testing.assert_allclose(cf.inverse_dynamics(theta[k], dtheta[k], ddtheta[k]), tau[k],
+        np.testing.assert_allclose(cf.inverse_dynamics(theta[k], dtheta[k], ddtheta[k], REPORT), tau[k],
                                    rtol=1e-13, atol=1e-15)
-        np.testing.assert_array_equal(cf.mass_matrix(theta[k]), m[k])
-        np.testing.assert_array_equal(cf.gravity(theta[k]), n[k])
-    shaped = cf.inverse_dynamics(*(s.reshape(500, 100, 3) for s in (theta, dtheta, ddtheta)))
+        np.testing.assert_array_equal(cf.mass_matrix(theta[k], REPORT), m[k])
+        np.testing.assert_array_equal(cf.gravity(theta[k], REPORT), n[k])
+    shaped = cf.inverse_dynamics(*(s.reshape(500, 100, 3) for s in (theta, dtheta, ddtheta)), REPORT)
     np.testing.assert_array_equal(shaped.reshape(-1, 3), tau)
 
 

@@ -1,6 +1,6 @@
 """The committed URDF and MJCF in other tools: MuJoCo, Drake and urdfdom's check_urdf.
 
-Each tool's dynamics are compared with the report's closed form (phantom_pin.closed_form),
+Each tool's dynamics are compared with the report's closed form (phantom_pin.report.closed_form),
 projected to theta1..theta3 through the coupling matrix G read from the URDF's mimic tags
 (v_tree = G dtheta): M = G^T M_tree G, N = G^T N_tree. Free swings are compared with an
 RK4 integration of the closed form written here. States are seeded and inside the device's
@@ -19,10 +19,10 @@ import pydrake.all as drake
 import pytest
 import yaml
 
-from conftest import relative_error
-from phantom_pin import closed_form
-from phantom_pin.coupling import Coupling
-from phantom_pin.paths import CONFIG_DIR, DESCRIPTION_DIR, URDF_PATH
+from conftest import CONFIG, CONFIG_DIR, REPORT, URDF_PATH, relative_error
+from phantom_pin.report import closed_form
+from phantom_pin.dynamics.coupling import Coupling
+from phantom_pin.paths import DESCRIPTION_DIR
 
 
 MJCF_PATH = DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml"
@@ -55,9 +55,9 @@ def rk4_closed_form(theta0: np.ndarray, duration: float, step: float, damping: f
     (N m s/rad), RK4 on eq. 80."""
     def rate(x):
         theta, dtheta = x[:3], x[3:]
-        force = (-closed_form.coriolis_matrix(theta, dtheta) @ dtheta - closed_form.gravity(theta)
+        force = (-closed_form.coriolis_matrix(theta, dtheta, REPORT) @ dtheta - closed_form.gravity(theta, REPORT)
                  - damping * dtheta)
-        return np.concatenate([dtheta, np.linalg.solve(closed_form.mass_matrix(theta), force)])
+        return np.concatenate([dtheta, np.linalg.solve(closed_form.mass_matrix(theta, REPORT), force)])
     x = np.concatenate([theta0, np.zeros(3)])
     for _ in range(round(duration / step)):
         k1 = rate(x)
@@ -97,11 +97,11 @@ class MujocoArm:
 def test_mujoco_loads_the_committed_urdf_with_the_report_dynamics(coupling):
     arm = MujocoArm(mujoco.MjModel.from_xml_path(str(URDF_PATH)), coupling)
     assert arm.model.neq == 4  # the mimic tags, as joint equalities
-    armature = np.diag(closed_form.shipped_parameters().armature)  # the URDF has no armature
+    armature = np.diag(CONFIG.actuation.armature)  # the URDF has no armature
     for theta in inside_stops(200, seed=1):
         mass, gravity = arm.reduced_mass_and_gravity(theta)
-        assert relative_error(mass, closed_form.mass_matrix(theta) - armature) < 1e-9
-        assert relative_error(gravity, closed_form.gravity(theta)) < 1e-9
+        assert relative_error(mass, closed_form.mass_matrix(theta, REPORT) - armature) < 1e-9
+        assert relative_error(gravity, closed_form.gravity(theta, REPORT)) < 1e-9
 
 
 def test_no_self_contact_in_mujoco_inside_the_limits(coupling):
@@ -120,8 +120,8 @@ def test_mjcf_has_the_report_dynamics_with_the_rotors(coupling):
     arm = MujocoArm(mujoco.MjModel.from_xml_path(str(MJCF_PATH)), coupling)
     for theta in inside_stops(200, seed=3):
         mass, gravity = arm.reduced_mass_and_gravity(theta)
-        assert relative_error(mass, closed_form.mass_matrix(theta)) < 1e-9
-        assert relative_error(gravity, closed_form.gravity(theta)) < 1e-9
+        assert relative_error(mass, closed_form.mass_matrix(theta, REPORT)) < 1e-9
+        assert relative_error(gravity, closed_form.gravity(theta, REPORT)) < 1e-9
 
 
 def test_mjcf_tip_site_is_eq10(coupling):
@@ -131,7 +131,7 @@ def test_mjcf_tip_site_is_eq10(coupling):
     for theta in inside_stops(100, seed=4):
         arm.set(theta)
         position = arm.data.site_xmat[s].reshape(3, 3).T @ (arm.data.site_xpos[tip] - arm.data.site_xpos[s])
-        np.testing.assert_allclose(position, closed_form.forward_kinematics(theta)[:3, 3], atol=1e-12)
+        np.testing.assert_allclose(position, closed_form.forward_kinematics(theta, REPORT)[:3, 3], atol=1e-12)
 
 
 def test_mjcf_actuators_sensors_and_options_follow_the_yaml():
@@ -219,8 +219,8 @@ def test_drake_reads_the_mimic_tags_and_the_rotor_inertia(drake_plant, coupling)
         plant.SetPositions(context, q)
         mass = plant.CalcMassMatrix(context)[np.ix_(index, index)]
         gravity = -plant.CalcGravityGeneralizedForces(context)[index]
-        assert relative_error(G.T @ mass @ G, closed_form.mass_matrix(theta)) < 1e-9
-        assert relative_error(G.T @ gravity, closed_form.gravity(theta)) < 1e-9
+        assert relative_error(G.T @ mass @ G, closed_form.mass_matrix(theta, REPORT)) < 1e-9
+        assert relative_error(G.T @ gravity, closed_form.gravity(theta, REPORT)) < 1e-9
 
 
 def test_drake_sap_free_swing_follows_the_closed_form(drake_plant, coupling):

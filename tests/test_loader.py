@@ -9,11 +9,10 @@ import pytest
 import yaml
 import yourdfpy
 
-from conftest import relative_error
-from phantom_pin import closed_form
+from conftest import CONFIG_DIR, REPORT, SRDF_PATH, URDF_PATH, relative_error
+from phantom_pin.report import closed_form
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
-from phantom_pin.loader import PhantomLoader, load
-from phantom_pin.paths import CONFIG_DIR, SRDF_PATH, URDF_PATH
+from phantom_pin.dynamics.loader import PhantomLoader, load
 
 
 @pytest.fixture(scope="module")
@@ -54,8 +53,8 @@ def test_dynamics_of_the_loaded_model_are_the_closed_form(robot, states):
     mass = np.array([robot.mass(q) for q in theta])
     mass = np.triu(mass) + np.transpose(np.triu(mass, 1), (0, 2, 1))
     tau = np.array([pin.rnea(robot.model, robot.data, *x) for x in zip(theta, dtheta, ddtheta)])
-    assert relative_error(mass, closed_form.mass_matrix(theta)) < 1e-9
-    assert relative_error(tau, closed_form.inverse_dynamics(theta, dtheta, ddtheta)) < 1e-9
+    assert relative_error(mass, closed_form.mass_matrix(theta, REPORT)) < 1e-9
+    assert relative_error(tau, closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT)) < 1e-9
 
 
 def test_visual_placements_match_yourdfpy(robot, states):

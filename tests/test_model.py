@@ -7,9 +7,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import relative_error
+from conftest import CONFIG_DIR, REPORT, relative_error
 from phantom_pin import InvalidInputError, Phantom, UnreachableTargetError, closed_form as cf
-from phantom_pin.paths import CONFIG_DIR
 
 TOLERANCE = 1e-9  # relative, both sides exact
 
@@ -18,13 +17,13 @@ TOLERANCE = 1e-9  # relative, both sides exact
                                     "mass_matrix", "gravity"])
 def test_kinematic_and_static_methods_equal_closed_form(phantom, states, method):
     theta = states[0]
-    assert relative_error(getattr(phantom, method)(theta), getattr(cf, method)(theta)) < TOLERANCE
-    assert relative_error(getattr(phantom, method)(theta[7]), getattr(cf, method)(theta[7])) < TOLERANCE
+    assert relative_error(getattr(phantom, method)(theta), getattr(cf, method)(theta, REPORT)) < TOLERANCE
+    assert relative_error(getattr(phantom, method)(theta[7]), getattr(cf, method)(theta[7], REPORT)) < TOLERANCE
 
 
 def test_coriolis_matrix_equals_closed_form(phantom, states):
     theta, dtheta, _ = states
-    assert relative_error(phantom.coriolis_matrix(theta, dtheta), cf.coriolis_matrix(theta, dtheta)) < TOLERANCE
+    assert relative_error(phantom.coriolis_matrix(theta, dtheta), cf.coriolis_matrix(theta, dtheta, REPORT)) < TOLERANCE
 
 
 def test_coriolis_projection_is_right_and_pinocchio_mimic_coriolis_is_reported(phantom, states):
@@ -33,7 +32,7 @@ def test_coriolis_projection_is_right_and_pinocchio_mimic_coriolis_is_reported(p
     (DEVELOPERS.md) is reported as a warning, not asserted: a fix upstream must not fail
     the suite, it only means Phantom.coriolis_matrix could call Pinocchio directly."""
     theta, dtheta, _ = (s[:50] for s in states)
-    expected = cf.coriolis_matrix(theta, dtheta)
+    expected = cf.coriolis_matrix(theta, dtheta, REPORT)
     assert relative_error(phantom.coriolis_matrix(theta, dtheta), expected) < TOLERANCE
     data = phantom.model.createData()
     raw = np.array([pin.computeCoriolisMatrix(phantom.model, data, q, v) for q, v in zip(theta, dtheta)])
@@ -44,7 +43,7 @@ def test_coriolis_projection_is_right_and_pinocchio_mimic_coriolis_is_reported(p
 
 
 def test_inverse_dynamics_equals_closed_form(phantom, states):
-    expected = cf.inverse_dynamics(*states)
+    expected = cf.inverse_dynamics(*states, REPORT)
     assert relative_error(phantom.inverse_dynamics(*states), expected) < TOLERANCE
     single = phantom.inverse_dynamics(states[0][3], states[1][3], states[2][3])
     assert relative_error(single, expected[3]) < TOLERANCE
@@ -54,13 +53,13 @@ def test_inverse_dynamics_equals_closed_form(phantom, states):
 
 def test_potential_energy_equals_closed_form_up_to_a_constant(phantom, states):
     theta = states[0]
-    difference = phantom.potential_energy(theta) - cf.potential_energy(theta)
+    difference = phantom.potential_energy(theta) - cf.potential_energy(theta, REPORT)
     assert np.ptp(difference) < 1e-12
 
 
 def test_forward_dynamics_inverts_inverse_dynamics(phantom, states):
     theta, dtheta, ddtheta = states
-    tau = cf.inverse_dynamics(theta, dtheta, ddtheta)
+    tau = cf.inverse_dynamics(theta, dtheta, ddtheta, REPORT)
     assert relative_error(phantom.forward_dynamics(theta, dtheta, tau), ddtheta) < TOLERANCE
 
 
@@ -69,8 +68,8 @@ def test_inverse_dynamics_derivatives_match_finite_differences(phantom, states):
     d_theta, d_dtheta = phantom.inverse_dynamics_derivatives(theta, dtheta, ddtheta)
     h = 1e-6  # central differences of the closed form: truncation ~h^2, rounding ~1e-16/h
     for i, e in enumerate(np.eye(3)):
-        fd_theta = (cf.inverse_dynamics(theta + h * e, dtheta, ddtheta) - cf.inverse_dynamics(theta - h * e, dtheta, ddtheta)) / (2 * h)
-        fd_dtheta = (cf.inverse_dynamics(theta, dtheta + h * e, ddtheta) - cf.inverse_dynamics(theta, dtheta - h * e, ddtheta)) / (2 * h)
+        fd_theta = (cf.inverse_dynamics(theta + h * e, dtheta, ddtheta, REPORT) - cf.inverse_dynamics(theta - h * e, dtheta, ddtheta, REPORT)) / (2 * h)
+        fd_dtheta = (cf.inverse_dynamics(theta, dtheta + h * e, ddtheta, REPORT) - cf.inverse_dynamics(theta, dtheta - h * e, ddtheta, REPORT)) / (2 * h)
         np.testing.assert_allclose(d_theta[:, :, i], fd_theta, atol=1e-8)
         np.testing.assert_allclose(d_dtheta[:, :, i], fd_dtheta, atol=1e-8)
 
@@ -78,16 +77,16 @@ def test_inverse_dynamics_derivatives_match_finite_differences(phantom, states):
 def test_inverse_kinematics_round_trips(phantom, states):
     """Where the tip is in front of axis 1 (eq. 11's theta1 is the posture's), IK gives the
     posture back; behind it (theta2 near its upper stop), another posture with the same tip."""
-    p = phantom.parameters
+    p = phantom.config.report
     theta = states[0]
     front = p.l1 * np.cos(theta[:, 1]) + p.l2 * np.sin(theta[:, 2]) > 0
     assert 0 < (~front).sum() < len(theta) / 4
-    position = cf.forward_kinematics(theta)[:, :3, 3]
+    position = cf.forward_kinematics(theta, REPORT)[:, :3, 3]
     np.testing.assert_allclose(phantom.inverse_kinematics(position[front]), theta[front], atol=1e-9)
     behind = phantom.inverse_kinematics(position[~front])
-    np.testing.assert_allclose(cf.forward_kinematics(behind)[:, :3, 3], position[~front], atol=1e-12)
+    np.testing.assert_allclose(cf.forward_kinematics(behind, REPORT)[:, :3, 3], position[~front], atol=1e-12)
     other = phantom.inverse_kinematics(position[:100], branch="other")
-    np.testing.assert_allclose(cf.forward_kinematics(other)[:, :3, 3], position[:100], atol=1e-12)
+    np.testing.assert_allclose(cf.forward_kinematics(other, REPORT)[:, :3, 3], position[:100], atol=1e-12)
     with pytest.raises(UnreachableTargetError, match="position"):
         phantom.inverse_kinematics([0.0, 0.17, 0.5])
 
@@ -99,7 +98,7 @@ def test_free_swing_conserves_energy(phantom):
     dt = 1e-3
 
     def energy(q, dq):
-        return 0.5 * dq @ cf.mass_matrix(q) @ dq + cf.potential_energy(q)
+        return 0.5 * dq @ cf.mass_matrix(q, REPORT) @ dq + cf.potential_energy(q, REPORT)
 
     def rate(q, dq):
         return dq, phantom.forward_dynamics(q, dq, np.zeros(3))
@@ -111,7 +110,7 @@ def test_free_swing_conserves_energy(phantom):
         k4 = rate(theta + dt * k3[0], dtheta + dt * k3[1])
         theta = theta + dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
         dtheta = dtheta + dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-        potentials.append(cf.potential_energy(theta))
+        potentials.append(cf.potential_energy(theta, REPORT))
         drift = max(drift, abs(energy(theta, dtheta) - start))
     assert np.ptp(potentials) > 0.1  # the arm really swung
     assert drift < 1e-9
@@ -137,8 +136,8 @@ def test_results_are_fresh_arrays(phantom):
     first_m = phantom.mass_matrix(theta)
     phantom.inverse_dynamics(-theta, theta, theta)
     phantom.mass_matrix(-theta)
-    np.testing.assert_allclose(first, cf.inverse_dynamics(theta, theta, theta), rtol=1e-12)
-    np.testing.assert_allclose(first_m, cf.mass_matrix(theta), rtol=1e-12)
+    np.testing.assert_allclose(first, cf.inverse_dynamics(theta, theta, theta, REPORT), rtol=1e-12)
+    np.testing.assert_allclose(first_m, cf.mass_matrix(theta, REPORT), rtol=1e-12)
 
 
 def test_modified_parameter_file_is_used(tmp_path, states):
@@ -147,11 +146,11 @@ def test_modified_parameter_file_is_used(tmp_path, states):
     kinematics = config / "kinematics.yaml"
     kinematics.write_text(kinematics.read_text().replace("l1: 0.215", "l1: 0.2096"))
     modified = Phantom(config)
-    assert modified.parameters.l1 == 0.2096
+    assert modified.config.report.l1 == modified.config.kinematics.l1 == 0.2096
     theta = states[0][:50]
     assert relative_error(modified.inverse_dynamics(*(s[:50] for s in states)),
-                          cf.inverse_dynamics(*(s[:50] for s in states), modified.parameters)) < TOLERANCE
-    assert relative_error(modified.forward_kinematics(theta), cf.forward_kinematics(theta, modified.parameters)) < TOLERANCE
+                          cf.inverse_dynamics(*(s[:50] for s in states), modified.config.report)) < TOLERANCE
+    assert relative_error(modified.forward_kinematics(theta), cf.forward_kinematics(theta, modified.config.report)) < TOLERANCE
 
 
 @pytest.mark.parametrize("bad, message", [
@@ -168,8 +167,8 @@ def test_inverse_dynamics_single_state_names_every_bad_argument(phantom, bad, me
         phantom.inverse_dynamics(*values)
 
 
-@pytest.mark.parametrize("function", [lambda p, x: cf.mass_matrix(x), lambda p, x: cf.forward_kinematics(x),
-                                      lambda p, x: cf.inverse_dynamics(x, x.real, x.real),
+@pytest.mark.parametrize("function", [lambda p, x: cf.mass_matrix(x, REPORT), lambda p, x: cf.forward_kinematics(x, REPORT),
+                                      lambda p, x: cf.inverse_dynamics(x, x.real, x.real, REPORT),
                                       lambda p, x: p.within_limits(x), lambda p, x: p.gravity(x)])
 def test_complex_input_is_refused_not_truncated(phantom, function):
     with pytest.raises(InvalidInputError, match="theta: expected real numbers, got complex"):
@@ -183,7 +182,7 @@ def test_overflowing_results_raise_instead_of_returning_nan(phantom):
              lambda: phantom.inverse_dynamics(np.zeros((2, 3)), np.stack([big, big]), np.zeros((2, 3))),
              lambda: phantom.forward_dynamics(np.zeros(3), big, np.zeros(3)),
              lambda: phantom.inverse_dynamics_derivatives(np.zeros(3), big, np.zeros(3)),
-             lambda: cf.inverse_dynamics(np.zeros(3), big, np.zeros(3))]
+             lambda: cf.inverse_dynamics(np.zeros(3), big, np.zeros(3), REPORT)]
     for call in calls:
         with pytest.raises(InvalidInputError, match="too large, the result overflows"):
             call()
@@ -209,7 +208,7 @@ def test_inverse_kinematics_agrees_with_the_closed_form_everywhere_on_the_shell(
     the closed form give the same angles, compared modulo 2 pi. Inside to 1e-9 rad; on a
     boundary the map is folded and both sides are good only to about sqrt(eps) (measured
     2.4e-6 rad), so 1e-5 rad there, with the tips within 1e-12 m."""
-    p = phantom.parameters
+    p = phantom.config.report
     shoulder = np.array([0.0, p.l2, -p.l1])
     rng = np.random.default_rng(11)
     direction = np.vstack([rng.normal(size=(60, 3)), np.eye(3), -np.eye(3)])
@@ -217,16 +216,16 @@ def test_inverse_kinematics_agrees_with_the_closed_form_everywhere_on_the_shell(
     for radius, tolerance in ((abs(p.l1 - p.l2), 1e-5), (p.l1 + p.l2, 1e-5), (0.25, 1e-9)):
         target = shoulder + radius * direction
         for branch in ("report", "other"):
-            ours, reference = phantom.inverse_kinematics(target, branch), cf.inverse_kinematics(target, branch)
+            ours, reference = phantom.inverse_kinematics(target, branch), cf.inverse_kinematics(target, REPORT, branch)
             assert np.abs(np.angle(np.exp(1j * (ours - reference)))).max() < tolerance, (radius, branch)
-            np.testing.assert_allclose(cf.forward_kinematics(ours)[:, :3, 3], target, atol=1e-12)
+            np.testing.assert_allclose(cf.forward_kinematics(ours, REPORT)[:, :3, 3], target, atol=1e-12)
 
 
 def test_inverse_kinematics_behind_the_shoulder_gives_plus_pi_like_the_closed_form(phantom):
     """Straight behind axis 1 (x = 0, z < -l1), theta1 is pi in both (Newton's to 1e-12
     rad), not -pi."""
-    target = cf.forward_kinematics([np.pi, 0.2, 0.3])[:3, 3]
+    target = cf.forward_kinematics([np.pi, 0.2, 0.3], REPORT)[:3, 3]
     target[0] = 0.0
-    for theta in (phantom.inverse_kinematics(target), cf.inverse_kinematics(target)):
+    for theta in (phantom.inverse_kinematics(target), cf.inverse_kinematics(target, REPORT)):
         assert abs(theta[0] - np.pi) < 1e-12
         np.testing.assert_allclose(theta[1:], [0.2, 0.3], atol=1e-9)

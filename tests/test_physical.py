@@ -1,16 +1,19 @@
-"""physical.check_urdf against the physical laws it states, and the one place it guards:
-generate_urdf (so `phantom-pin urdf` and Phantom(config_dir)) and load()."""
+"""The one physical check of a link where it guards: the configuration (so `phantom-pin urdf`,
+describe() and Phantom(folder)), and physical.check_urdf of a URDF given to load()."""
 
+import shutil
 from pathlib import Path
 
 import pytest
+import yaml
 
 from phantom_pin import ParameterFileError, Phantom
 from phantom_pin.cli import main
-from phantom_pin.loader import PhantomLoader, load
-from phantom_pin.parameters import write_overridden
-from phantom_pin.paths import SRDF_PATH, URDF_PATH
-from phantom_pin.physical import check_urdf
+from phantom_pin.dynamics.loader import PhantomLoader, load
+from phantom_pin.config.files import FILES, apply_overrides, read_documents
+from phantom_pin.inertial import TRIANGLE_SLACK
+from phantom_pin.description.physical import check_urdf
+from conftest import CONFIG_DIR, SRDF_PATH, URDF_PATH
 
 #: Overrides that write a non-physical link (the issue's list), and the link they break.
 NON_PHYSICAL = [
@@ -18,9 +21,9 @@ NON_PHYSICAL = [
     ("segment_be.inertia.xx=1e9", "upper_arm_link: principal moments"),        # triangle
     ("segment_be.com=-0.2", "upper_arm_link: inertia at the centre of mass is not positive"),
     ("actuation.motor.rotor_inertia=1e-4", "turret_link: inertia at the centre of mass is not positive"),
-    ("segment_g.mass=-1", "turret_link: mass must be a positive"),
-    ("segment_g.mass=0", "turret_link: mass must be a positive"),
-    ("segment_g.inertia_xx=-1", "turret_link: inertia at the centre of mass is not positive"),
+    ("segment_g.mass=-1", "segment_g.mass must be positive"),
+    ("segment_g.mass=0", "segment_g.mass must be positive"),
+    ("segment_g.inertia_xx=-1", "segment_g.inertia_xx must be positive"),
     ("tip_ball.diameter=-1", "forearm_link: visual sphere radius must be positive"),
 ]
 
@@ -42,7 +45,11 @@ def test_urdf_command_refuses_non_physical_links_and_writes_nothing(tmp_path, ca
 @pytest.mark.parametrize("override, message", NON_PHYSICAL[:5])
 def test_phantom_refuses_a_non_physical_configuration(tmp_path, override, message):
     key, value = override.split("=")
-    config = write_overridden({key: float(value)}, tmp_path)   # the YAML itself is well-formed
+    config = tmp_path / "config"
+    shutil.copytree(CONFIG_DIR, config)
+    documents = apply_overrides(read_documents(config), {key: float(value)})  # well-formed YAML
+    for arg, name in FILES.items():
+        (config / name).write_text(yaml.safe_dump(documents[arg]))
     with pytest.raises(ParameterFileError, match=message):
         Phantom(config)
 
@@ -51,7 +58,7 @@ def test_load_refuses_a_non_physical_urdf(tmp_path):
     urdf = tmp_path / "phantom.urdf"
     urdf.write_text(URDF_PATH.read_text().replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>'))
     loader = type("Negative", (PhantomLoader,), {"urdf_path": urdf, "srdf_path": SRDF_PATH})
-    with pytest.raises(ParameterFileError, match="urdf_path: .*forearm_link: mass must be a positive"):
+    with pytest.raises(ParameterFileError, match="urdf_path: .*forearm_link: mass must be positive"):
         load(loader)
 
 
@@ -61,11 +68,13 @@ def test_shipped_urdf_and_pure_frames_pass():
 
 
 def test_triangle_inequality_at_its_stated_tolerance():
-    """A thin rod (c = a + b, the law's limit) passes; c larger by 1e-6 relative fails;
+    """A thin rod 2 TRIANGLE_SLACK inside the law's limit passes; one on the limit (c = a + b,
+    which MuJoCo may refuse after rounding: tests/test_inertial.py) or past it fails;
     rotating the tensor (off-diagonal terms) does not change the verdict."""
-    check_urdf(_link("1", 0.5, 0.5, 1.0))
-    with pytest.raises(ParameterFileError, match="link l: .*triangle"):
-        check_urdf(_link("1", 0.5, 0.5, 1.0 + 1e-6))
+    check_urdf(_link("1", 0.5, 0.5, 1.0 / (1 + 2 * TRIANGLE_SLACK)))
+    for c in (1.0, 1.0 + 1e-6):
+        with pytest.raises(ParameterFileError, match="link l: .*triangle"):
+            check_urdf(_link("1", 0.5, 0.5, c))
     # principal moments (1, 2) in the x-y plane rotated by 45 degrees about z, with izz:
     # (1, 2, 2.9) is valid, (1, 2, 3.1) is not, though the diagonal (1.5, 1.5, 3.1) looks valid
     check_urdf(_link("1", 1.5, 1.5, 2.9, ixy=0.5))
@@ -75,9 +84,10 @@ def test_triangle_inequality_at_its_stated_tolerance():
         check_urdf(_link("1", 1.0, 1.0, 1.0, ixy=1.5))   # moments -0.5, 1, 2.5
 
 
-@pytest.mark.parametrize("mass", ["0", "-1", "nan", "abc"])
-def test_mass_must_be_a_positive_number(mass):
-    with pytest.raises(ParameterFileError, match="link l: mass must be a positive"):
+@pytest.mark.parametrize("mass, message", [("0", "mass must be positive"), ("-1", "mass must be positive"),
+                                           ("nan", "must be finite numbers"), ("abc", "needs .* a mass")])
+def test_mass_must_be_a_positive_number(mass, message):
+    with pytest.raises(ParameterFileError, match=f"link l: .*{message}"):
         check_urdf(_link(mass, 1.0, 1.0, 1.0))
 
 

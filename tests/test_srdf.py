@@ -11,8 +11,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from phantom_pin.paths import DESCRIPTION_DIR, SRDF_PATH, URDF_PATH
+from phantom_pin.paths import DESCRIPTION_DIR
 from test_interop import inside_stops
+from conftest import SRDF_PATH, URDF_PATH
 
 
 @pytest.fixture(scope="module")
