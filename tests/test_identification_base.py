@@ -6,21 +6,30 @@ import dataclasses
 import numpy as np
 import pytest
 
-from phantom_pin import closed_form
-from phantom_pin.identification import constants, parameterization as pz
+from phantom_pin import Phantom, describe
+from phantom_pin.report import closed_form
+from phantom_pin.identification import base, constants, parameterization as pz
 from phantom_pin.identification.base import Structured, base_parameters
 from phantom_pin.identification.estimation import base_regressor
-from phantom_pin.identification.regressor import Regressor, smoothing_speed
-from test_identification_regressor import states
+from phantom_pin.identification.regressor import Regressor
+from test_identification_regressor import states as _states
+from conftest import CONFIG, REPORT
+
+REGRESSOR = Regressor(Phantom())
+DESCRIPTION = REGRESSOR.phantom.description
+
+
+def states(n, seed):
+    return _states(REGRESSOR, n, seed)
 
 
 @pytest.fixture(scope="module")
 def structured():
-    return Structured(Regressor())
+    return Structured(REGRESSOR)
 
 
 def test_general_model_has_26_base_parameters():
-    regressor = Regressor()
+    regressor = REGRESSOR
     base = base_parameters(regressor.stacked(*states(300, 5)), regressor.names)
     # 20 inertial combinations (the report's 8 + 6 products of inertia + 6 off-plane first
     # moments) and the 6 friction coefficients
@@ -30,10 +39,10 @@ def test_general_model_has_26_base_parameters():
 
 def test_report_structure_base_is_the_report_constants(structured):
     phi = structured(*states(300, 6))[0].reshape(-1, len(structured.names))
-    x0 = pz.report_vector()
+    x0 = pz.report_vector(CONFIG)
     base = base_parameters(phi, structured.names, np.concatenate([np.abs(x0), [1e-3] * 6]))
     assert base.rank == 14
-    c = constants.constants_matrix()
+    c = constants.constants_matrix(DESCRIPTION)
     assert np.linalg.matrix_rank(c) == 8
     # every constant is a combination of the base parameters and vice versa: the same span
     rigid = base.matrix[:, :20]
@@ -44,36 +53,46 @@ def test_report_structure_base_is_the_report_constants(structured):
 
 
 def test_constants_equal_the_report_equations_at_the_shipped_values():
-    p = closed_form.shipped_parameters()
+    p = REPORT
     k1, k2, k3, lam = closed_form._coefficients(p)
     expected = [k1, k2, k3, lam, p.Ibexx + p.Icxx + p.l1**2 * p.ma + p.l1**2 * p.mc / 4,     # eq 82
                 p.Iaxx + p.Idfxx + p.l2**2 * p.ma / 4 + p.l3**2 * p.mc,                     # eq 85
                 p.g / 2 * (2 * p.l1 * p.ma + 2 * p.l5 * p.mbe + p.l1 * p.mc),               # eq 93
                 p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf)]               # eq 94
-    x0 = pz.report_vector()
-    np.testing.assert_allclose(constants.report_constants(x0), expected, rtol=1e-12)
-    np.testing.assert_allclose(constants.constants_matrix() @ x0, expected, rtol=1e-12)
+    x0 = pz.report_vector(CONFIG)
+    np.testing.assert_allclose(constants.report_constants(x0, DESCRIPTION), expected, rtol=1e-12)
+    np.testing.assert_allclose(constants.constants_matrix(DESCRIPTION) @ x0, expected, rtol=1e-12)
 
 
 def test_pinocchio_base_regressor_equals_the_closed_form_one(structured):
     theta, dtheta, ddtheta = states(200, 7)
     phi, tau0 = base_regressor(structured, theta, dtheta, ddtheta)
-    closed = constants.regressor(theta, dtheta, ddtheta)
+    closed = constants.regressor(theta, dtheta, ddtheta, DESCRIPTION)
     assert np.abs(phi - closed).max() <= 1e-11 * np.abs(closed).max()
-    beta = constants.nominal()
-    friction = 5e-4 * dtheta + 0.01 * np.tanh(dtheta / smoothing_speed())
-    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta) + friction
+    beta = constants.nominal(DESCRIPTION)
+    friction = 5e-4 * dtheta + 0.01 * np.tanh(dtheta / CONFIG.actuation.friction.smoothing_speed)
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + friction
     assert np.abs(phi @ beta + tau0 - tau).max() <= 1e-12 * np.abs(tau).max()
 
 
 def test_constants_follow_other_parameters():
     """report_constants is linear in x: C x at perturbed parameters equals closed_form's."""
-    p = closed_form.shipped_parameters()
+    p = REPORT
     q = dataclasses.replace(p, ma=1.3 * p.ma, Ibeyy=0.8 * p.Ibeyy, mdf=1.2 * p.mdf, l6=0.9 * p.l6)
     x = np.array([q.ma, q.Iaxx, q.Iayy, q.Iazz, q.mc, q.Icxx, q.Icyy, q.Iczz, q.mbe, q.mbe * q.l5,
                   q.Ibexx, q.Ibeyy, q.Ibezz, q.mdf, q.mdf * q.l6, q.Idfxx, q.Idfyy, q.Idfzz,
-                  q.Ibaseyy, q.rotor_inertia])
+                  q.Ibaseyy, CONFIG.actuation.motor.rotor_inertia])
     theta, dtheta, ddtheta = states(50, 8)
-    phi = constants.regressor(theta, dtheta, ddtheta)[..., :8]
+    phi = constants.regressor(theta, dtheta, ddtheta, DESCRIPTION)[..., :8]
     tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, q)
-    assert np.abs(phi @ (constants.constants_matrix() @ x) - tau).max() <= 1e-12 * np.abs(tau).max()
+    assert np.abs(phi @ (constants.constants_matrix(DESCRIPTION) @ x) - tau).max() <= 1e-12 * np.abs(tau).max()
+
+
+def test_sample_stays_inside_the_regressors_own_limits():
+    """Before, base.sample ignored its regressor and sampled the shipped limits: with joint1
+    limited to 0.2 rad (box and stop), a third of the shipped box's theta1 lies above it."""
+    narrow = Regressor(Phantom(describe(overrides={"joint1.upper": 0.2, "joint_limits.stops.joint1.upper": 0.2})))
+    theta = base.sample(narrow, 300, seed=3)[0]
+    assert theta[:, 0].max() <= 0.2 and (narrow.phantom.config.limits.slack(theta) >= 0).all()
+    wide = base.sample(REGRESSOR, 300, seed=3)[0]
+    assert wide[:, 0].max() > 0.2  # the shipped limits reach beyond: the test can tell them apart

@@ -4,43 +4,52 @@ parameters to an inconsistent estimate generate a URDF that passes it."""
 import numpy as np
 import pytest
 
-from phantom_pin import ParameterFileError
+from phantom_pin import ParameterFileError, Phantom, describe
 from phantom_pin.identification import constants, parameterization as pz, physical
-from phantom_pin.paths import URDF_PATH
-from phantom_pin.physical import check_urdf
+from phantom_pin.identification.regressor import Regressor
+from phantom_pin.description.physical import check_urdf
+from conftest import CONFIG, URDF_PATH
+
+DESCRIPTION = describe()
+BODIES = Regressor(Phantom(DESCRIPTION)).bodies
+
+
+def _urdf(x):
+    """The URDF describe() generates for the report parameters x (ParameterFileError if not physical)."""
+    return describe(overrides=pz.overrides(x)).urdf
 
 
 def test_shipped_urdf_is_physical():
     check_urdf(URDF_PATH.read_text(), "the shipped URDF")
-    affine, offset = pz.affine_map()
-    assert physical.consistent(pz.report_vector(), affine, offset)
+    affine, offset = pz.affine_map(DESCRIPTION, BODIES)
+    assert physical.consistent(pz.report_vector(CONFIG), affine, offset)
 
 
 def test_non_physical_links_are_found():
-    x = pz.report_vector()
+    x = pz.report_vector(CONFIG)
     rotor2 = x[pz.ROTOR] * 11.6**2
     lumped = x.copy()
     lumped[pz.NAMES.index("segment_be.inertia.xx")] = 0.5 * rotor2     # less than the rotor alone
     with pytest.raises(ParameterFileError, match="upper_arm_link: inertia at the centre of mass is not positive definite"):
-        pz.urdf(lumped)
+        _urdf(lumped)
     rod = x.copy()
     yy, zz = rod[pz.NAMES.index("segment_a.inertia.yy")], rod[pz.NAMES.index("segment_a.inertia.zz")]
     rod[pz.NAMES.index("segment_a.inertia.xx")] = 1.001 * (yy + zz)     # just past the boundary
     with pytest.raises(ParameterFileError, match="forearm_link: .*triangle inequality"):
-        pz.urdf(rod)
-    affine, offset = pz.affine_map()
+        _urdf(rod)
+    affine, offset = pz.affine_map(DESCRIPTION, BODIES)
     assert not physical.consistent(lumped, affine, offset) and not physical.consistent(rod, affine, offset)
 
 
 def test_nearest_consistent_parameters_keep_the_reachable_constants():
-    affine, offset = pz.affine_map()
-    x0 = pz.report_vector()
-    c = constants.constants_matrix()
+    affine, offset = pz.affine_map(DESCRIPTION, BODIES)
+    x0 = pz.report_vector(CONFIG)
+    c = constants.constants_matrix(DESCRIPTION)
     bad = x0.copy()
     bad[pz.NAMES.index("segment_a.inertia.xx")] *= 3          # M33 up by 2 Iaxx: a real change
     target = c @ bad
     x = physical.nearest(target, 1.0 / np.abs(target), c, x0, affine, offset)
     assert physical.consistent(x, affine, offset)
-    check_urdf(pz.urdf(x), "the nearest consistent parameters' URDF")
+    check_urdf(_urdf(x), "the nearest consistent parameters' URDF")
     # M33 = Iaxx + Idfxx + ...: the fit moves Idfxx instead of making the forearm non-physical
     np.testing.assert_allclose(c @ x, target, rtol=1e-6)

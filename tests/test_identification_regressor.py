@@ -1,63 +1,85 @@
 """The regressor in the report's coordinates against Phantom.inverse_dynamics, and the
-report parameters' affine map against the URDF the xacro generates."""
+report parameters' affine map (computed from the configuration alone) against the URDF that
+describe() generates through xacro and Pinocchio reads."""
 
 import numpy as np
 import pytest
 
-from phantom_pin import Phantom
+from phantom_pin import Phantom, describe
+from phantom_pin.config.sampling import sample_postures
+from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.excitation import Limits
-from phantom_pin.identification.regressor import Regressor, smoothing_speed
+from phantom_pin.identification.regressor import Regressor
 
 
 @pytest.fixture(scope="module")
 def regressor():
-    return Regressor()
+    return Regressor(Phantom())
 
 
-def states(n, seed):
-    """Seeded states inside the joint box and the coupled stops."""
+def states(regressor, n, seed):
+    """Seeded states inside the limits of the regressor's configuration."""
     rng = np.random.default_rng(seed)
-    return Limits.read().sample(n, seed), rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+    theta = sample_postures(regressor.phantom.config.limits, n, np.random.default_rng(seed), draws=4 * n)
+    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
 
 
 def test_regressor_times_shipped_parameters_is_inverse_dynamics(regressor):
-    theta, dtheta, ddtheta = states(1000, 0)
+    theta, dtheta, ddtheta = states(regressor, 1000, 0)
     tau = Phantom().inverse_dynamics(theta, dtheta, ddtheta)
     predicted = regressor(theta, dtheta, ddtheta) @ regressor.parameters()
     assert np.abs(predicted - tau).max() <= 1e-12 * np.abs(tau).max()
 
 
 def test_friction_columns_follow_the_actuation_law(regressor):
-    theta, dtheta, ddtheta = states(50, 1)
+    theta, dtheta, ddtheta = states(regressor, 50, 1)
     viscous, coulomb = np.array([1e-3, 2e-3, 3e-3]), np.array([0.01, 0.02, 0.03])
-    law = viscous * dtheta + coulomb * np.tanh(dtheta / smoothing_speed())
+    speed = regressor.phantom.config.actuation.friction.smoothing_speed
+    law = viscous * dtheta + coulomb * np.tanh(dtheta / speed)
     rigid = regressor(theta, dtheta, ddtheta) @ regressor.parameters()
     with_friction = regressor(theta, dtheta, ddtheta) @ regressor.parameters(viscous, coulomb)
     np.testing.assert_allclose(with_friction - rigid, law, rtol=0, atol=1e-15)
 
 
+def test_the_coulomb_column_uses_the_phantoms_own_smoothing_speed():
+    """Before, Regressor(Phantom(cfg)) took the shipped 0.1 rad/s, not cfg's: at dtheta =
+    0.05 rad/s the column was tanh(0.5) = 0.46 instead of tanh(1) = 0.76."""
+    slow = Regressor(Phantom(describe(overrides={"actuation.friction.smoothing_speed": 0.05})))
+    column = slow(np.zeros(3), np.full(3, 0.05), np.zeros(3))[:, slow.friction][:, 3:]
+    np.testing.assert_allclose(np.diag(column), np.tanh(1.0), rtol=1e-15)
+
+
 def test_single_state_equals_the_batch_row(regressor):
-    theta, dtheta, ddtheta = states(3, 2)
+    theta, dtheta, ddtheta = states(regressor, 3, 2)
     np.testing.assert_array_equal(regressor(theta[1], dtheta[1], ddtheta[1]),
                                   regressor(theta, dtheta, ddtheta)[1])
 
 
-def test_affine_map_reproduces_the_generated_urdf():
-    affine, offset = pz.affine_map()
-    x0 = pz.report_vector()
-    ratios = np.array(Phantom().parameters.ratios)
+def _urdf_parameters(x: np.ndarray) -> np.ndarray:
+    """pi without friction of the URDF that describe() generates for the report parameters x:
+    Pinocchio's tree inertias, then J r_i^2."""
+    description = describe(overrides=pz.overrides(x))
+    tree = Coupling(description.urdf).tree
+    ratios = np.array(description.config.actuation.ratios)
+    inertial = [tree.inertias[i].toDynamicParameters() for i in range(1, tree.njoints)]
+    return np.concatenate(inertial + [x[pz.ROTOR] * ratios**2])
+
+
+def test_affine_map_reproduces_the_generated_urdf(regressor):
+    description = regressor.phantom.description
+    affine, offset = pz.affine_map(description, regressor.bodies)
+    x0 = pz.report_vector(description.config)
     # each parameter 0.2 % below its value, another point than the map's (0.1 % above); more
-    # would leave the thin forearm rod (Izz 0.4 % of Ixx = Iyy) non-physical, which the xacro refuses
+    # would leave the thin forearm rod (Izz 0.4 % of Ixx = Iyy) non-physical, which describe() refuses
     for k in range(len(x0)):
         x = x0.copy()
         x[k] *= 0.998
-        urdf_pi = pz.tree_parameters(pz.urdf(x), x[pz.ROTOR], ratios)
+        urdf_pi = _urdf_parameters(x)
         assert np.abs(affine @ x + offset - urdf_pi).max() <= 1e-12 * np.abs(urdf_pi).max(), pz.NAMES[k]
 
 
 def test_the_known_parameters_give_no_torque(regressor):
     """The hinge pins' compensation and the base's fixed mass and x/z inertias cancel."""
-    _, offset = pz.affine_map()
-    y = regressor.stacked(*states(200, 4))
+    _, offset = pz.affine_map(regressor.phantom.description, regressor.bodies)
+    y = regressor.stacked(*states(regressor, 200, 4))
     assert np.abs(y[:, :len(offset)] @ offset).max() < 1e-12  # N m, against torques of 0.1 N m
