@@ -16,21 +16,24 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import common
-from phantom_pin import closed_form
+from phantom_pin import Phantom, describe
 from phantom_pin.identification import constants, estimation, excitation, simulation
 from phantom_pin.identification.base import Structured
-from phantom_pin.identification.regressor import smoothing_speed
+from phantom_pin.identification.regressor import Regressor
 
 FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
            "Iczz": 0.85, "mbe": 1.25, "l5": 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3,
            "mdf": 1.3, "l6": 0.9, "Idfxx": 1.2, "Idfyy": 1.1, "Idfzz": 1.25, "Ibaseyy": 1.15}
 
 
-def run_device(trajectory, duration, truth, seed):
-    p = closed_form.shipped_parameters()
-    resolution = 2 * np.pi / (1024 * 4 * np.array(p.ratios))
-    return simulation.simulate(trajectory, duration, truth, np.full(3, 8e-4), np.full(3, 0.015),
-                               smoothing_speed(), torque_noise=0.005, resolution=resolution, seed=seed)
+def run_device(phantom, trajectory, duration, truth, seed):
+    """A log of the simulated device ``truth`` (ReportParameters) with the friction of
+    phantom's law at other coefficients, fed forward with phantom's report model."""
+    config = phantom.config
+    resolution = 2 * np.pi / (1024 * 4 * np.array(config.actuation.ratios))
+    friction = dataclasses.replace(config.actuation.friction, viscous=8e-4, coulomb=0.015)
+    return simulation.simulate(trajectory, duration, truth, config.report, friction,
+                               torque_noise=0.005, resolution=resolution, seed=seed)
 
 
 def main(argv: list[str] | None) -> None:
@@ -39,18 +42,20 @@ def main(argv: list[str] | None) -> None:
     parser.add_argument("--iterations", type=int, default=15, help="excitation optimiser iterations")
     args = parser.parse_args(argv)
     path = common.output(args, "identify_simulated.png")
-    p = closed_form.shipped_parameters()
+    description = describe()                           # the report's model: the prior and the controller's
+    phantom = Phantom(description)
+    p = description.config.report
     truth = dataclasses.replace(p, **{k: getattr(p, k) * f for k, f in FACTORS.items()})
-    design = excitation.optimise(iterations=args.iterations, restarts=1)
+    design = excitation.optimise(description, iterations=args.iterations, restarts=1)
     print(f"excitation: condition number {design.condition:.3g}")
-    fit = estimation.estimate(run_device(design.trajectory, args.duration, truth, 0))
+    fit = estimation.estimate(run_device(phantom, design.trajectory, args.duration, truth, 0), phantom)
     print("residual RMS per joint [N m]: " + " ".join(f"{r:.3g}" for r in fit.rms))
-    held_out = excitation.optimise(iterations=1, restarts=1, seed=7).trajectory
-    log = run_device(held_out, 5.0, truth, 1)
+    held_out = excitation.optimise(description, iterations=1, restarts=1, seed=7).trajectory
+    log = run_device(phantom, held_out, 5.0, truth, 1)
     theta, dtheta, ddtheta, tau = estimation.filtered(log, 20.0)
-    phi, _ = estimation.base_regressor(Structured(), theta, dtheta, ddtheta)
+    phi, _ = estimation.base_regressor(Structured(Regressor(phantom)), theta, dtheta, ddtheta)
     identified = phi @ np.concatenate([fit.constants, fit.beta[8:]])
-    report = phi @ constants.nominal()
+    report = phi @ constants.nominal(description)
     step = max(1, int(log.rate / (5 * 20.0)))          # estimation.filtered's decimation
     t = estimation.EDGE + np.arange(len(tau)) * step / log.rate
     errors = {}

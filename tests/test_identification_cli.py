@@ -7,8 +7,12 @@ import yaml
 
 from phantom_pin.cli import main
 from phantom_pin.identification import io
-from phantom_pin.identification.excitation import Limits
-from phantom_pin.paths import CONFIG_DIR
+from phantom_pin import describe
+from phantom_pin.identification.excitation import continuous_effort
+from conftest import CONFIG, CONFIG_DIR, REPORT
+
+DESCRIPTION = describe()
+EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
 
 
 def run(capsys, *argv):
@@ -24,7 +28,6 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
     assert code == 0 and "condition number" in out
     table = np.loadtxt(path, delimiter=",", skiprows=1)
     assert np.loadtxt(path, delimiter=",", max_rows=1, dtype=str).tolist() == list(io.TRAJECTORY_COLUMNS)
-    limits = Limits.read()
     theta = table[:, 1:4]
     # the coupled stops of the issue (65 and 55 deg) and the joint box, 0.05 rad margin on the
     # optimiser's grid
@@ -32,7 +35,7 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
     assert (theta[:, 2] - theta[:, 1] <= np.deg2rad(55) - 0.045).all()
     lower, upper = box()
     assert (theta >= lower + 0.045).all() and (theta <= upper - 0.045).all()
-    assert (np.abs(table[:, 10:13]) <= limits.effort).all()
+    assert (np.abs(table[:, 10:13]) <= EFFORT).all()
     np.testing.assert_allclose(table[[0, -1], 4:10], 0, atol=1e-12)    # at rest at both ends
     np.testing.assert_allclose(np.diff(table[:, 0]), 1 / 200, rtol=1e-9)
     # the velocities are the positions' derivatives
@@ -52,13 +55,16 @@ def box():
 
 
 def test_limits_are_the_box_and_the_coupled_stops():
-    limits = Limits.read()
-    np.testing.assert_array_equal(limits.lower, box()[0])
-    np.testing.assert_array_equal(limits.upper, box()[1])
+    """Limits.slack: upper bounds of (theta1, theta2, theta3, theta2 - theta3), then lower ones."""
+    limits = CONFIG.limits
+    lower, upper = box()
+    np.testing.assert_array_equal(limits.slack(lower)[:3], upper - lower)
+    np.testing.assert_array_equal(limits.slack(upper)[4:7], upper - lower)
     at_stops = np.array([[0.0, 0.9, 0.9 - np.deg2rad(65)], [0.0, 0.0, np.deg2rad(55)]])
     slack = limits.slack(at_stops)
-    np.testing.assert_allclose([slack[0, 6], slack[1, 7]], 0, atol=1e-15)
-    assert (limits.slack(limits.sample(500, 3)) >= 0).all()
+    np.testing.assert_allclose([slack[0, 3], slack[1, 7]], 0, atol=1e-15)
+    from phantom_pin.config.sampling import sample_postures
+    assert (limits.slack(sample_postures(limits, 500, np.random.default_rng(3))) >= 0).all()
 
 
 def write(path, header, rows):
@@ -115,12 +121,12 @@ def test_excitation_respects_a_tight_torque_limit():
     """With 20 % of the continuous torque allowed the constraint is active; the torques,
     computed independently (closed form + the friction law), stay below it between the
     optimiser's samples too (2 % slack)."""
-    from phantom_pin import closed_form
+    from phantom_pin.report import closed_form
     from phantom_pin.identification import excitation
 
-    result = excitation.optimise(torque_share=0.2, iterations=10, restarts=1)
+    result = excitation.optimise(DESCRIPTION, torque_share=0.2, iterations=10, restarts=1)
     t = np.linspace(0, result.trajectory.period, 2001)
     theta, dtheta, ddtheta = result.trajectory(t)
-    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta) + 5e-4 * dtheta + 0.01 * np.tanh(dtheta / 0.1)
-    share = np.abs(tau).max(axis=0) / Limits.read().effort
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + 5e-4 * dtheta + 0.01 * np.tanh(dtheta / 0.1)
+    share = np.abs(tau).max(axis=0) / EFFORT
     assert share.max() <= 0.2 * 1.02 and share.max() >= 0.15, share

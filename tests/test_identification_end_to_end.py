@@ -15,11 +15,22 @@ from phantom_pin import Phantom, closed_form, load
 from phantom_pin.cli import main
 from phantom_pin.identification import constants, io, simulation
 from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.excitation import Limits
-from phantom_pin.identification.regressor import smoothing_speed
-from phantom_pin.loader import PhantomLoader
-from phantom_pin.parameters import read_overrides, write_overridden
-from phantom_pin.physical import check_urdf
+from phantom_pin.config import read_overrides
+from phantom_pin.config.sampling import sample_postures
+from phantom_pin.dynamics.loader import PhantomLoader
+from phantom_pin.description.physical import check_urdf
+from conftest import CONFIG, REPORT
+
+
+def sample(n, seed):
+    """n seeded postures inside every limit (rad)."""
+    return sample_postures(CONFIG.limits, n, np.random.default_rng(seed), draws=4 * n)
+
+
+def overlaid(path):
+    """The Description of the shipped configuration with an identify overlay applied."""
+    from phantom_pin import describe
+    return describe(overrides=read_overrides(path))
 
 #: The simulated device: every report parameter moved by 10-30 % (physically consistent).
 FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
@@ -29,7 +40,7 @@ VISCOUS, COULOMB, TORQUE_NOISE = 8e-4, 0.015, 0.005       # N m s/rad, N m, N m 
 
 
 def truth():
-    p = closed_form.shipped_parameters()
+    p = REPORT
     return dataclasses.replace(p, **{k: getattr(p, k) * f for k, f in FACTORS.items()})
 
 
@@ -45,10 +56,11 @@ def identified(tmp_path_factory):
                  "--restarts", "1"]) == 0
     table = np.loadtxt(trajectory, delimiter=",", skiprows=1)
     t = table[:, 0]
-    p = closed_form.shipped_parameters()
-    resolution = 2 * np.pi / (1024 * 4 * np.array(p.ratios))     # HEDM-5500 X4 at the joint
-    log = simulation.simulate(lambda _: (table[:, 1:4], table[:, 4:7], table[:, 7:10]), t[-1], truth(),
-                              np.full(3, VISCOUS), np.full(3, COULOMB), smoothing_speed(),
+    p = REPORT
+    resolution = 2 * np.pi / (1024 * 4 * np.array(CONFIG.actuation.ratios))     # HEDM-5500 X4 at the joint
+    friction = dataclasses.replace(CONFIG.actuation.friction, viscous=VISCOUS, coulomb=COULOMB)
+    log = simulation.simulate(lambda _: (table[:, 1:4], table[:, 4:7], table[:, 7:10]), t[-1], truth(), p,
+                              friction,
                               torque_noise=TORQUE_NOISE, resolution=resolution, seed=1)
     assert np.abs(log.theta / resolution - np.round(log.theta / resolution)).max() < 1e-6
     io.write_log(folder / "log.csv", log.t, log.theta, log.tau)
@@ -65,12 +77,11 @@ def identified(tmp_path_factory):
 def test_overlay_is_accepted_by_phantom_and_mujoco(identified, tmp_path):
     import mujoco
 
-    config = write_overridden(read_overrides(identified / "id.yaml"), tmp_path)
-    phantom = Phantom(config)
+    phantom = Phantom(overlaid(identified / "id.yaml"))
     loader = type("Identified", (PhantomLoader,), {"urdf_path": identified / "id.urdf",
                                                    "srdf_path": identified / "id.srdf"})
     robot = load(loader)
-    theta = Limits.read().sample(20, 13)
+    theta = sample(20, 13)
     for q in theta:
         np.testing.assert_allclose(phantom.mass_matrix(q), pin.crba(robot.model, robot.data, q), atol=1e-15)
     model = mujoco.MjModel.from_xml_path(str(identified / "id.mjcf"))
@@ -86,11 +97,11 @@ def test_identified_urdf_predicts_held_out_torques(identified):
                                                    "srdf_path": identified / "id.srdf"})
     robot = load(loader)
     rng = np.random.default_rng(11)
-    theta = Limits.read().sample(500, 12)
+    theta = sample(500, 12)
     dtheta, ddtheta = rng.normal(0, 2, (500, 3)), rng.normal(0, 20, (500, 3))
     true_tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, truth())
     predicted = np.array([pin.rnea(robot.model, robot.data, *s) for s in zip(theta, dtheta, ddtheta)])
-    report = closed_form.inverse_dynamics(theta, dtheta, ddtheta)
+    report = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT)
     identified_error = rms(predicted - true_tau, true_tau)
     report_error = rms(report - true_tau, true_tau)
     print(f"held-out RMS error: identified {identified_error:.4f}, report {report_error:.4f}")
@@ -107,12 +118,13 @@ def test_friction_is_identified_and_written(identified):
 
 def test_written_constants_are_the_true_ones(identified, tmp_path):
     """The eight identifiable combinations of the written parameters vs the simulated device's."""
-    written = pz.report_vector(write_overridden(read_overrides(identified / "id.yaml"), tmp_path))
+    description = overlaid(identified / "id.yaml")
+    written = pz.report_vector(description.config)
     t = truth()
     true_x = np.array([t.ma, t.Iaxx, t.Iayy, t.Iazz, t.mc, t.Icxx, t.Icyy, t.Iczz, t.mbe, t.mbe * t.l5,
                        t.Ibexx, t.Ibeyy, t.Ibezz, t.mdf, t.mdf * t.l6, t.Idfxx, t.Idfyy, t.Idfzz,
-                       t.Ibaseyy, t.rotor_inertia])
-    error = constants.report_constants(written) / constants.report_constants(true_x) - 1
+                       t.Ibaseyy, CONFIG.actuation.motor.rotor_inertia])
+    error = constants.report_constants(written, description) / constants.report_constants(true_x, description) - 1
     print("relative error of K1 K2 K3 L M22 M33 N2 N3:", np.array2string(error, precision=4))
     assert np.abs(error).max() < 0.02
 

@@ -22,7 +22,7 @@ def _urdf(x):
 def test_shipped_urdf_is_physical():
     check_urdf(URDF_PATH.read_text(), "the shipped URDF")
     affine, offset = pz.affine_map(DESCRIPTION, BODIES)
-    assert physical.consistent(pz.report_vector(CONFIG), affine, offset)
+    assert physical.consistent(pz.report_vector(CONFIG), CONFIG)
 
 
 def test_non_physical_links_are_found():
@@ -38,7 +38,7 @@ def test_non_physical_links_are_found():
     with pytest.raises(ParameterFileError, match="forearm_link: .*triangle inequality"):
         _urdf(rod)
     affine, offset = pz.affine_map(DESCRIPTION, BODIES)
-    assert not physical.consistent(lumped, affine, offset) and not physical.consistent(rod, affine, offset)
+    assert not physical.consistent(lumped, CONFIG) and not physical.consistent(rod, CONFIG)
 
 
 def test_nearest_consistent_parameters_keep_the_reachable_constants():
@@ -48,8 +48,8 @@ def test_nearest_consistent_parameters_keep_the_reachable_constants():
     bad = x0.copy()
     bad[pz.NAMES.index("segment_a.inertia.xx")] *= 3          # M33 up by 2 Iaxx: a real change
     target = c @ bad
-    x = physical.nearest(target, 1.0 / np.abs(target), c, x0, affine, offset)
-    assert physical.consistent(x, affine, offset)
+    x = physical.nearest(target, 1.0 / np.abs(target), c, x0, affine, offset, CONFIG)
+    assert physical.consistent(x, CONFIG)
     check_urdf(_urdf(x), "the nearest consistent parameters' URDF")
     # M33 = Iaxx + Idfxx + ...: the fit moves Idfxx instead of making the forearm non-physical
     np.testing.assert_allclose(c @ x, target, rtol=1e-6)

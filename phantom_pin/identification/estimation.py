@@ -110,7 +110,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: flo
     root = np.linalg.cholesky(info).T                       # root^T root = covariance^-1
     affine, offset = structured.affine, structured.offset
     prior = parameterization.report_vector(phantom.config)
-    x = physical.nearest(beta[:n], root, c, prior, affine, offset, prior_weight)
+    x = physical.nearest(beta[:n], root, c, prior, affine, offset, phantom.config, prior_weight)
     general = structured.regressor.stacked(theta, dtheta, ddtheta)
     base = base_parameters(general, structured.regressor.names)
     independent = general[:, list(base.independent)]

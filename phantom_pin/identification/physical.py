@@ -8,8 +8,16 @@ from __future__ import annotations
 import numpy as np
 import scipy.optimize
 
+from phantom_pin.config import Config
 from phantom_pin.identification import parameterization
-from phantom_pin.inertial import TRIANGLE_SLACK, Inertial, problem
+from phantom_pin.inertial import problem
+from phantom_pin.report.parameters import links
+
+#: How far inside the triangle inequality (a share of the largest moment) SLSQP aims. It is
+#: not a tolerance of the law: ``consistent`` decides with the exact links and the one check
+#: (phantom_pin.inertial.problem); this margin only covers the affine map's rounding (up to
+#: about 1e-12 of the largest parameter), so that the optimiser's answer passes that check.
+_AIM = 1e-9
 
 
 def body_margins(pi_inertial: np.ndarray) -> np.ndarray:
@@ -30,22 +38,24 @@ def _constraints(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> np.nd
     """The smooth margins of the physical check (>= 0 where it holds, scaled for SLSQP)."""
     pi = affine @ x + offset
     margins = body_margins(pi[:-3])
-    return np.concatenate([margins[:, 0], margins[:, 1] * 1e4, (margins[:, 2] - TRIANGLE_SLACK * margins[:, 3]) * 1e4,
+    return np.concatenate([margins[:, 0], margins[:, 1] * 1e4, (margins[:, 2] - _AIM * margins[:, 3]) * 1e4,
                            [x[parameterization.ROTOR] * 1e6]])
 
 
-def consistent(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> bool:
-    """True if every tree body of pi = affine x + offset passes phantom_pin.inertial.problem
-    and the rotor inertia x[ROTOR] is positive."""
-    pi = affine @ x + offset
-    if not x[parameterization.ROTOR] > 0:
+def consistent(x: np.ndarray, config: Config) -> bool:
+    """True if the report parameters ``x`` give links (report.parameters.links, as describe()
+    computes them from the written overlay) that all pass phantom_pin.inertial.problem, with
+    a positive rotor inertia x[ROTOR] and masses."""
+    x = np.asarray(x, float)
+    if not (x[parameterization.ROTOR] > 0 and (x[list(parameterization.MASSES)] > 0).all()):
         return False
-    bodies = np.asarray(pi[:-3]).reshape(-1, 10)
-    return all(body[0] > 0 and problem(Inertial.from_dynamic_parameters(body)) is None for body in bodies)
+    linked = links(parameterization.report_parameters(x, config), config.unprinted, float(x[parameterization.ROTOR]),
+                   config.actuation.ratios)
+    return all(problem(link) is None for link in linked.values())
 
 
 def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarray,
-            prior: np.ndarray, affine: np.ndarray, offset: np.ndarray,
+            prior: np.ndarray, affine: np.ndarray, offset: np.ndarray, config: Config,
             prior_weight: float = 1e-3) -> np.ndarray:
     """The report parameters x nearest to the estimated constants ``target``:
     minimise |W (C x - target)|^2 + prior_weight^2 |(x - prior) / prior|^2 subject to
@@ -72,14 +82,14 @@ def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarra
 
     z0 = prior / scale
     unconstrained = scipy.optimize.least_squares(residual, z0, method="lm").x
-    if consistent(unconstrained * scale, affine, offset):
+    if consistent(unconstrained * scale, config):
         return unconstrained * scale
     # the farthest consistent point on the segment from the (consistent) prior to the
     # unconstrained optimum, by bisection: always available, and SLSQP's start
     low, high = 0.0, 1.0
     for _ in range(60):
         middle = (low + high) / 2
-        if consistent((z0 + middle * (unconstrained - z0)) * scale, affine, offset):
+        if consistent((z0 + middle * (unconstrained - z0)) * scale, config):
             low = middle
         else:
             high = middle
@@ -89,6 +99,6 @@ def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarra
         lambda z: cost(z) / norm, fallback, jac=lambda z: gradient(z) / norm, method="SLSQP",
         constraints=[{"type": "ineq", "fun": lambda z: _constraints(z * scale, affine, offset)}],
         options={"maxiter": 500, "ftol": 1e-12})
-    if consistent(result.x * scale, affine, offset) and cost(result.x) < cost(fallback):
+    if consistent(result.x * scale, config) and cost(result.x) < cost(fallback):
         return result.x * scale
     return fallback * scale

@@ -14,20 +14,21 @@ from typing import Callable
 import numpy as np
 
 from phantom_pin.report import closed_form
+from phantom_pin.config import Friction
 from phantom_pin.identification.io import Log
 from phantom_pin.integration import rk4_step
 from phantom_pin.report.parameters import ReportParameters
 
 
 def simulate(reference: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-             duration: float, truth: ReportParameters, model: ReportParameters, viscous: np.ndarray, coulomb: np.ndarray,
-             smoothing_speed: float, rate: float = 1000.0, torque_noise: float = 0.0,
+             duration: float, truth: ReportParameters, model: ReportParameters, friction: Friction,
+             rate: float = 1000.0, torque_noise: float = 0.0,
              resolution: np.ndarray | float = 0.0, kp: float = 5.0, kd: float = 0.05,
              seed: int = 0) -> Log:
     """Track ``reference(t) -> (theta, dtheta, ddtheta)`` (rad, rad/s, rad/s^2 at (N,) times)
     for ``duration`` s on the device ``truth``, fed forward with the inverse dynamics of
-    ``model`` (the parameters the controller believes), with friction viscous * dtheta + coulomb *
-    tanh(dtheta / smoothing_speed) (N m s/rad, N m, rad/s). ``torque_noise``: standard
+    ``model`` (the parameters the controller believes), with the friction law ``friction``
+    (phantom_pin.config.Friction, the same on each joint). ``torque_noise``: standard
     deviation (N m) of white noise added to the applied torque; ``resolution``: encoder step
     at the joint (rad); kp (N m/rad), kd (N m s/rad): feedback gains."""
     rng = np.random.default_rng(seed)
@@ -42,9 +43,8 @@ def simulate(reference: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.
         return np.where(resolution > 0, np.round(q / np.where(resolution > 0, resolution, 1)) * resolution, q)
 
     def acceleration(q, v, torque):
-        friction = viscous * v + coulomb * np.tanh(v / smoothing_speed)
         bias = closed_form.coriolis_matrix(q, v, truth) @ v + closed_form.gravity(q, truth)
-        return np.linalg.solve(closed_form.mass_matrix(q, truth), torque - friction - bias)
+        return np.linalg.solve(closed_form.mass_matrix(q, truth), torque - friction.torque(v) - bias)
 
     q, v = ref_q[0].copy(), ref_v[0].copy()
     measured, commanded = np.empty((n, 3)), np.empty((n, 3))
