@@ -108,3 +108,20 @@ def test_phantom_premium_1_5_cad_matches_the_reference(reference):
     phantom = Phantom("premium_1_5_cad")
     assert _relative(np.array([phantom.mass_matrix(t) for t in thetas]), ref_m) < TOLERANCE
     assert _relative(np.array([phantom.gravity(t) for t in thetas]), ref_n) < TOLERANCE
+
+
+def test_the_cad_mjcf_in_mujoco_matches_the_reference(reference):
+    """(c) MuJoCo's reading of the committed MJCF (armature, gravity 9.80665 m/s^2 as an option)."""
+    import mujoco
+
+    from phantom_pin.config import MODELS
+    from phantom_pin.dynamics.coupling import Coupling
+    from test_interop import MujocoArm
+
+    model = MODELS["premium_1_5_cad"]
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(model.mjcf)), Coupling(model.urdf.read_text()))
+    assert arm.model.opt.gravity[2] == -9.80665
+    thetas, ref_m, ref_n = reference
+    reduced = [arm.reduced_mass_and_gravity(t) for t in thetas[:50]]
+    assert _relative(np.array([m for m, _ in reduced]), ref_m[:50]) < TOLERANCE
+    assert _relative(np.array([n for _, n in reduced]), ref_n[:50]) < TOLERANCE
