@@ -82,12 +82,13 @@ class Friction:
     coulomb: float
     smoothing_speed: float
 
-    def torque(self, dtheta: np.ndarray) -> np.ndarray:
+    def torque(self, dtheta: np.ndarray | float) -> np.ndarray | float:
         """The friction law: tau_f = viscous * dtheta + coulomb * tanh(dtheta / smoothing_speed)
-        (N m) at rates dtheta (rad/s), opposing motion. Smooth at rest, so it holds nothing
-        still (no stiction); below smoothing_speed it acts as a damper of coulomb /
-        smoothing_speed N m s/rad."""
-        return self.viscous * dtheta + self.coulomb * np.tanh(dtheta / self.smoothing_speed)
+        (N m) at rates dtheta (rad/s, an array or one float: the simulator's scalar loop),
+        opposing motion. Smooth at rest, so it holds nothing still (no stiction); below
+        smoothing_speed it acts as a damper of coulomb / smoothing_speed N m s/rad."""
+        tanh = math.tanh if isinstance(dtheta, float) else np.tanh
+        return self.viscous * dtheta + self.coulomb * tanh(dtheta / self.smoothing_speed)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -151,8 +151,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         Device.friction and Device.stop_torque, without their per-call checks."""
         qs, vs, total = q.tolist(), v.tolist(), list(tau)
         if friction:
-            losses = friction_torque(v).tolist()
-            total = [total[0] - losses[0], total[1] - losses[1], total[2] - losses[2]]
+            total = [total[0] - friction_torque(vs[0]), total[1] - friction_torque(vs[1]),
+                     total[2] - friction_torque(vs[2])]
         if hard_stops:
             for i, j, lo, hi in stops:
                 c, rate = (qs[i], vs[i]) if j is None else (qs[i] - qs[j], vs[i] - vs[j])
