@@ -134,6 +134,12 @@ class Stops:
         return (np.array([*lo, -self.coupled.theta3_minus_theta2_max]),
                 np.array([*hi, self.coupled.theta2_minus_theta3_max]))
 
+    def force(self, depth: np.ndarray | float, rate: np.ndarray | float) -> np.ndarray | float:
+        """The hard-stop law: K depth + B rate (N m) of stop coordinates ``depth`` (rad, from
+        penetration) beyond their stops at rates ``rate`` (rad/s); the damper acts only while
+        penetrating. Arrays or floats (the simulator's scalar loop)."""
+        return self.stiffness * depth + self.damping * rate * (depth != 0)
+
     def penetration(self, theta: np.ndarray) -> np.ndarray:
         """Signed depth (rad) of each stop coordinate of postures (..., 3) beyond its stop:
         (..., 4), zero inside. The one stop geometry (Device's stops, the samplers' limits)."""

@@ -116,7 +116,7 @@ class Device:
     def _stop_torque(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
         stops = self.config.limits.stops
         depth = self.config.limits.stops.penetration(theta)
-        force = stops.stiffness * depth + stops.damping * (dtheta @ STOP_COORDINATES.T) * (depth != 0)
+        force = stops.force(depth, dtheta @ STOP_COORDINATES.T)
         return -force @ STOP_COORDINATES
 
     # -- friction --------------------------------------------------------------------

@@ -139,7 +139,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     data = model.createData()
     peak = device.peak_torque
     bounds = list(zip(device._stop_lower.tolist(), device._stop_upper.tolist()))
-    stop_k, stop_b = device.config.limits.stops.stiffness, device.config.limits.stops.damping
+    stop_force = device.config.limits.stops.force
     friction_torque = device.config.actuation.friction.torque
 
     # Stop coordinates c = theta1, theta2, theta3, theta2 - theta3 with their gradients
@@ -158,7 +158,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                 c, rate = (qs[i], vs[i]) if j is None else (qs[i] - qs[j], vs[i] - vs[j])
                 depth = c - hi if c > hi else c - lo if c < lo else 0.0
                 if depth:
-                    force = stop_k * depth + stop_b * rate
+                    force = stop_force(depth, rate)
                     total[i] -= force
                     if j is not None:
                         total[j] += force
