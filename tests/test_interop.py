@@ -4,7 +4,7 @@ Each tool's dynamics are compared with the report's closed form (phantom_pin.rep
 projected to theta1..theta3 through the coupling matrix G read from the URDF's mimic tags
 (v_tree = G dtheta): M = G^T M_tree G, N = G^T N_tree. Free swings are compared with an
 RK4 integration of the closed form written here. States are seeded and inside the device's
-limits: the URDF's joint box and the coupled stops of config/joint_limits.yaml.
+limits: the URDF's joint box and the coupled stops of the configuration's joint_limits.yaml.
 """
 
 import shutil
@@ -19,14 +19,11 @@ import pydrake.all as drake
 import pytest
 import yaml
 
-from conftest import CONFIG, CONFIG_DIR, REPORT, URDF_PATH, relative_error
+from conftest import CONFIG, CONFIG_DIR, MJCF_PATH, REPORT, SCENE_PATH, URDF_PATH, relative_error
 from phantom_pin.report import closed_form
 from phantom_pin.dynamics.coupling import Coupling
-from phantom_pin.paths import DESCRIPTION_DIR
 
 
-MJCF_PATH = DESCRIPTION_DIR / "mjcf" / "phantom_1_5.xml"
-SCENE_PATH = DESCRIPTION_DIR / "mjcf" / "scene.xml"
 ACTUATED = ("joint1", "joint2", "joint3")
 THETA0 = np.array([0.3, 0.8, 0.4])  # rad, the free swing's rest state
 

@@ -68,11 +68,15 @@ def test_shipped_urdf_and_pure_frames_pass():
 
 
 def test_triangle_inequality_at_its_stated_tolerance():
-    """A thin rod 2 TRIANGLE_SLACK inside the law's limit passes; one on the limit (c = a + b,
-    which MuJoCo may refuse after rounding: tests/test_inertial.py) or past it fails;
-    rotating the tensor (off-diagonal terms) does not change the verdict."""
-    check_urdf(_link("1", 0.5, 0.5, 1.0 / (1 + 2 * TRIANGLE_SLACK)))
-    for c in (1.0, 1.0 + 1e-6):
+    """A thin rod 1e-9 relative inside the triangle boundary (a + b - c = 1e-9 c) passes, and
+    so does one only 2 TRIANGLE_SLACK inside; one on the boundary (c = a + b, which MuJoCo
+    may refuse after rounding: tests/test_inertial.py), 1e-10 past it (which the former law,
+    c - (a + b) <= 1e-9 c, accepted) or 1e-6 past it fails; rotating the tensor
+    (off-diagonal terms) does not change the verdict."""
+    assert TRIANGLE_SLACK == 1e-12
+    for c in (1.0 / (1 + 1e-9), 1.0 / (1 + 2 * TRIANGLE_SLACK)):
+        check_urdf(_link("1", 0.5, 0.5, c))
+    for c in (1.0, 1.0 + 1e-10, 1.0 + 1e-6):
         with pytest.raises(ParameterFileError, match="link l: .*triangle"):
             check_urdf(_link("1", 0.5, 0.5, c))
     # principal moments (1, 2) in the x-y plane rotated by 45 degrees about z, with izz:

@@ -2,7 +2,7 @@
 
 Distances come from Pinocchio's collision library (coal) on the URDF's collision geometry;
 the states are seeded, in the URDF's joint box (where "Never" must hold) or also inside the
-coupled stops of config/joint_limits.yaml (where every pair must be apart).
+coupled stops of the configuration's joint_limits.yaml (where every pair must be apart).
 """
 
 import xml.etree.ElementTree as ET
