@@ -6,11 +6,11 @@ from phantom_pin.description.build import Description, describe
 from phantom_pin.device import Device, SimulationResult, simulate
 from phantom_pin.dynamics.loader import PhantomLoader, load
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.exceptions import (InvalidInputError, ParameterFileError, PhantomPinError,
-                                    UnreachableTargetError)
+from phantom_pin.exceptions import (InvalidInputError, MissingDataError, ParameterFileError,
+                                    PhantomPinError, UnreachableTargetError)
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
 
 __all__ = ["Phantom", "Device", "simulate", "SimulationResult", "load", "PhantomLoader", "Description",
            "describe", "models", "Config", "ReportParameters", "closed_form", "PhantomPinError",
-           "InvalidInputError", "ParameterFileError", "UnreachableTargetError"]
+           "InvalidInputError", "ParameterFileError", "UnreachableTargetError", "MissingDataError"]

@@ -73,7 +73,8 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
     joints = [{"name": model.names[i], "lower": float(model.lowerPositionLimit[i - 1]),
                "upper": float(model.upperPositionLimit[i - 1]),
                "velocity": float(model.velocityLimit[i - 1]), "effort": float(model.effortLimit[i - 1]),
-               "armature": float(model.armature[i - 1]), "ratio": actuation.ratios[i - 1]} for i in (1, 2, 3)]
+               "armature": float(model.armature[i - 1]),
+               "ratio": None if actuation.ratios is None else actuation.ratios[i - 1]} for i in (1, 2, 3)]
     tree = phantom.coupling.tree
     body: dict[int, str] = {}
     for frame in tree.frames:  # the first body frame of a joint is its link
@@ -84,14 +85,16 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
               "inertia": [tree.inertias[i].inertia[j, k] for j, k in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))]}
              for i in range(1, tree.njoints) if tree.inertias[i].mass > 0]
     data = {"model": phantom.config.name, "joints": joints, "links": links,
-            "rotor_inertia": actuation.motor.rotor_inertia}
+            "rotor_inertia": None if actuation.motor is None else actuation.motor.rotor_inertia}
     lines = ["joint    lower[rad] upper[rad] vel[rad/s] effort[Nm] armature[kg m2] ratio"]
     lines += [f"{j['name']:8} {j['lower']:10.3f} {j['upper']:10.3f} {j['velocity']:10.2f} "
-              f"{j['effort']:10.3f} {j['armature']:15.4e} {j['ratio']:5.1f}" for j in joints]
+              f"{j['effort']:10.3f} {j['armature']:15.4e} "
+              f"{'-' if j['ratio'] is None else format(j['ratio'], '5.1f'):>5}" for j in joints]
     lines += ["", "link            mass[kg]  com[m] (link frame)       inertia xx xy xz yy yz zz at the COM [kg m2]"]
     lines += [f"{lk['name']:15} {lk['mass']:8.4f}  {_vector(lk['com'], '{:7.4f}'):26}"
               f"{_vector(lk['inertia'], '{:.3e}')}" for lk in links]
-    lines += ["", f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
+    lines += ["", "rotor inertia: not public (no armature; the links carry the rotors)" if actuation.motor is None
+              else f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
     lines.insert(0, f"model {phantom.config.name}")
     data["device"], device_lines = device_cli.info(phantom)  # stops, friction, motor, encoder
     lines += ["", *device_lines]

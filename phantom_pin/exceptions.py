@@ -15,3 +15,8 @@ class UnreachableTargetError(InvalidInputError):
 
 class ParameterFileError(PhantomPinError, ValueError):
     """A parameter file is missing, malformed, or holds a non-physical value."""
+
+
+class MissingDataError(InvalidInputError):
+    """The model lacks the data a call needs: its motors, transmission or encoders are not
+    public (the Touch), so its currents or encoder counts cannot be computed."""

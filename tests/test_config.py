@@ -47,7 +47,7 @@ def test_shipped_gravity_and_ratios_are_the_report_numbers():
 
 
 def test_models_are_named_and_resolve_like_folders():
-    assert config.models() == phantom_pin.models() == ["premium_1_5", "premium_1_5_cad"]
+    assert config.models() == phantom_pin.models() == ["premium_1_5", "premium_1_5_cad", "touch"]
     by_name, by_folder = config.read("premium_1_5"), config.read(MODELS["premium_1_5"].config)
     assert by_name == by_folder and by_name.name == "premium_1_5"
     for call in (config.read, describe, Phantom, Device, phantom_pin.load):

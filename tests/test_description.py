@@ -17,7 +17,7 @@ SHIPPED = MODELS["premium_1_5"]
 URDF_PATH, SRDF_PATH = SHIPPED.urdf, SHIPPED.srdf
 
 ACTUATED = ["joint1", "joint2", "joint3"]
-# (joint, primary, multiplier) of the parallelogram, as designed in urdf/phantom_1_5_macro.xacro
+# (joint, primary, multiplier) of the parallelogram, as designed in urdf/phantom_macro.xacro
 PASSIVE = [("crank_pin_a", "joint3", -1.0), ("crank_pin_b", "joint2", 1.0),
            ("forearm_pin_a", "joint2", -1.0), ("forearm_pin_b", "joint3", 1.0)]
 SEGMENT_LINKS = ["turret_link", "upper_arm_link", "crank_link", "lower_bar_link", "forearm_link"]

@@ -16,7 +16,7 @@ BODIES = Regressor(Phantom(DESCRIPTION)).bodies
 
 def _urdf(x):
     """The URDF describe() generates for the report parameters x (ParameterFileError if not physical)."""
-    return describe(overrides=pz.overrides(x)).urdf
+    return describe(overrides=pz.overrides(x, CONFIG)).urdf
 
 
 def test_shipped_urdf_is_physical():

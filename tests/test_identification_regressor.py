@@ -10,6 +10,7 @@ from phantom_pin.config.sampling import sample_postures
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.regressor import Regressor
+from conftest import CONFIG
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +59,7 @@ def test_single_state_equals_the_batch_row(regressor):
 def _urdf_parameters(x: np.ndarray) -> np.ndarray:
     """pi without friction of the URDF that describe() generates for the report parameters x:
     Pinocchio's tree inertias, then J r_i^2."""
-    description = describe(overrides=pz.overrides(x))
+    description = describe(overrides=pz.overrides(x, CONFIG))
     tree = Coupling(description.urdf).tree
     ratios = np.array(description.config.actuation.ratios)
     inertial = [tree.inertias[i].toDynamicParameters() for i in range(1, tree.njoints)]

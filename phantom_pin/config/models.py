@@ -46,6 +46,8 @@ MODELS = {model.name: model for model in (
     _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5", "scene.xml"),
     _model("premium_1_5_cad", "PHANToM Premium 1.5, mahilab/Phantom's CAD mass properties and lengths",
            "phantom_1_5_cad", "scene_phantom_1_5_cad.xml"),
+    _model("touch", "Geomagic Touch / PHANToM Omni: the report's arm at its size, ESTIMATED inertias, "
+                    "no public motor data", "phantom_touch", "scene_phantom_touch.xml"),
 )}
 DEFAULT = "premium_1_5"
 

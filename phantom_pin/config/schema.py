@@ -35,6 +35,8 @@ STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 
 STOP_COORDINATES.flags.writeable = False
 #: MuJoCo's integrators, as config/mjcf.yaml may name them.
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+#: The SRDF's named postures, which joint_limits.yaml gives (srdf/phantom_1_5.srdf.xacro).
+POSTURES = ("zero", "resting")
 #: The ``sources`` entries each file must have (a non-empty text per section).
 SOURCES = {"actuation_file": ("transmission_ratio", "motor", "encoder", "friction"),
            "joint_limits_file": ("stops",)}
@@ -93,17 +95,39 @@ class Friction:
 
 @dataclasses.dataclass(frozen=True)
 class Actuation:
-    """Transmission ratios (joint angle = motor angle / ratio), motor, encoder, friction."""
+    """Transmission ratios (joint angle = motor angle / ratio), motor, encoder, friction, and
+    each joint's torque limit ``effort`` (N m) and speed limit ``velocity`` (rad/s), the URDF's.
 
-    ratios: tuple[float, float, float]
-    motor: Motor
-    encoder: Encoder
+    ``ratios``, ``motor`` and ``encoder`` are None where a model's are not public (the Touch):
+    actuation.yaml says so with ``null``, and then gives ``joint_torque_limit`` and
+    ``joint_velocity_limit`` itself. With a motor, effort = max_continuous_torque * ratio and
+    velocity = max_speed / ratio; ``peak`` (N m) is the stall torque at the joint, or the
+    configuration's joint_torque_limit.
+    """
+
+    ratios: tuple[float, float, float] | None
+    motor: Motor | None
+    encoder: Encoder | None
     friction: Friction
+    effort: tuple[float, float, float]
+    velocity: tuple[float, float, float]
+    peak: tuple[float, float, float]
+
+    @property
+    def rotor(self) -> tuple[float, tuple[float, float, float]]:
+        """(rotor inertia at the motor shaft (kg m^2), transmission ratios): (0, (0, 0, 0))
+        without motor data, where the rotors are part of the links' own inertia (the report's
+        I_bexx, I_dfxx and I_baseyy include them)."""
+        if self.motor is None:
+            return 0.0, (0.0, 0.0, 0.0)
+        return self.motor.rotor_inertia, self.ratios
 
     @property
     def armature(self) -> tuple[float, float, float]:
-        """Reflected rotor inertia of each joint, rotor_inertia * ratio^2 (kg m^2)."""
-        return tuple(self.motor.rotor_inertia * r**2 for r in self.ratios)
+        """Reflected rotor inertia of each joint, rotor_inertia * ratio^2 (kg m^2); zero
+        without motor data (see ``rotor``)."""
+        inertia, ratios = self.rotor
+        return tuple(inertia * r**2 for r in ratios)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -149,11 +173,13 @@ class Stops:
 
 @dataclasses.dataclass(frozen=True)
 class Limits:
-    """The URDF's joint box ``lower``..``upper`` (rad, theta1..theta3) and the device's stops."""
+    """The URDF's joint box ``lower``..``upper`` (rad, theta1..theta3), the device's stops, and
+    the SRDF's named ``postures`` (name -> theta, rad; inside the box)."""
 
     lower: tuple[float, float, float]
     upper: tuple[float, float, float]
     stops: Stops
+    postures: Mapping[str, tuple[float, float, float]]
 
     def slack(self, theta: np.ndarray) -> np.ndarray:
         """(..., 8) distances (rad) of postures (..., 3) to every limit: the upper, then the
@@ -295,15 +321,42 @@ def _kinematics(r: _Reader) -> Kinematics:
     return Kinematics(*(r.number("kinematics_file", k, positive=True) for k in ("l1", "l2", "l3")))
 
 
-def _actuation(r: _Reader) -> Actuation:
-    def act(*keys: str, **kind: bool) -> float:
-        return r.number("actuation_file", *keys, **kind)
+#: The sections of actuation.yaml that a model may declare not public (``null``).
+DRIVE = ("transmission_ratio", "motor", "encoder")
+#: The joint limits actuation.yaml gives itself when the motor is not public.
+JOINT_LIMITS = ("joint_torque_limit", "joint_velocity_limit")
 
-    motor = Motor(*(act("motor", f.name, positive=True) for f in dataclasses.fields(Motor)))
-    encoder = Encoder(*(act("encoder", f.name, positive=True) for f in dataclasses.fields(Encoder)))
+
+def _actuation(r: _Reader) -> Actuation:
+    arg = "actuation_file"
+
+    def act(*keys: str, **kind: bool) -> float:
+        return r.number(arg, *keys, **kind)
+
     friction = Friction(act("friction", "viscous", non_negative=True), act("friction", "coulomb", non_negative=True),
                         act("friction", "smoothing_speed", positive=True))
-    return Actuation(tuple(act("transmission_ratio", j, positive=True) for j in JOINTS), motor, encoder, friction)
+    public = [r.node(arg, section) is not None for section in DRIVE]
+    document = r.documents[arg]
+    if any(public) and not all(public[:2]):
+        raise r.error(arg, "transmission_ratio and motor are either both given or both null (not public)")
+    if not public[1]:
+        if public[2]:
+            raise r.error(arg, "encoder needs the transmission_ratio and the motor (it is read at the motor shaft)")
+        effort = tuple(act("joint_torque_limit", j, positive=True) for j in JOINTS)
+        velocity = tuple(act("joint_velocity_limit", j, positive=True) for j in JOINTS)
+        return Actuation(None, None, None, friction, effort, velocity, effort)
+    extra = [key for key in JOINT_LIMITS if key in document]
+    if extra:
+        raise r.error(arg, f"{extra[0]} is for a model without motor data; with a motor, the joint limits "
+                           "follow from max_continuous_torque, max_speed and the ratios")
+    motor = Motor(*(act("motor", f.name, positive=True) for f in dataclasses.fields(Motor)))
+    encoder = None if not public[2] else \
+        Encoder(*(act("encoder", f.name, positive=True) for f in dataclasses.fields(Encoder)))
+    ratios = tuple(act("transmission_ratio", j, positive=True) for j in JOINTS)
+    return Actuation(ratios, motor, encoder, friction,
+                     tuple(motor.max_continuous_torque * k for k in ratios),
+                     tuple(motor.max_speed / k for k in ratios),
+                     tuple(motor.stall_torque * k for k in ratios))
 
 
 def _limits(r: _Reader) -> Limits:
@@ -322,9 +375,20 @@ def _limits(r: _Reader) -> Limits:
         if forward <= low or -backward >= high:
             raise r.error(arg, f"the coupled stops {-backward:.4f} <= theta2 - theta3 <= {forward:.4f} rad "
                                f"leave no posture in the {name}, where theta2 - theta3 spans {low:.4f} .. {high:.4f} rad")
+    listed = r.node(arg, "postures")
+    if not isinstance(listed, dict) or set(listed) != set(POSTURES):
+        raise r.error(arg, f"postures must give exactly {' and '.join(POSTURES)} (the SRDF's named postures, "
+                           f"[theta1, theta2, theta3] rad), got {listed!r}")
+    postures = {}
+    for name in POSTURES:
+        theta = r.vector(arg, "postures", name, length=3)
+        if not all(lo <= t <= hi for t, lo, hi in zip(theta, lower, upper)):
+            raise r.error(arg, f"postures.{name} {list(theta)} rad is outside the box joint1..joint3")
+        postures[name] = theta
     return Limits(lower, upper, Stops(tuple(s[0] for s in stops), tuple(s[1] for s in stops), coupled,
                                       r.number(arg, "stops", "stiffness", positive=True),
-                                      r.number(arg, "stops", "damping", non_negative=True)))
+                                      r.number(arg, "stops", "damping", non_negative=True)),
+                  types.MappingProxyType(postures))
 
 
 def _mujoco(r: _Reader) -> MujocoSettings:
@@ -366,7 +430,7 @@ def _report(r: _Reader, kinematics: Kinematics,
         phys("segment_g", "inertia_yy"))
     unprinted = Unprinted(phys("segment_g", "mass"), phys("segment_g", "inertia_xx"), phys("segment_g", "inertia_zz"),
                           phys("hinge_pin", "mass"), tuple(phys("hinge_pin", "inertia", a) for a in ("xx", "yy", "zz")))
-    return report, unprinted, report_links(report, unprinted, actuation.motor.rotor_inertia, actuation.ratios)
+    return report, unprinted, report_links(report, unprinted, *actuation.rotor)
 
 
 def _links(r: _Reader, kinematics: Kinematics) -> dict[str, Inertial]:

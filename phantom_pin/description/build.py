@@ -14,6 +14,7 @@ import yaml
 
 from phantom_pin import config as configuration
 from phantom_pin.config import Config, Model
+from phantom_pin.config.schema import JOINTS
 from phantom_pin.description.mjcf import mjcf_texts
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
@@ -61,10 +62,13 @@ def _xacro_inputs(config: Config, folder: Path) -> dict[str, str]:
     documents = {
         "kinematics_file": dataclasses.asdict(config.kinematics),
         "actuation_file": {
-            "transmission_ratio": dict(zip(("joint1", "joint2", "joint3"), a.ratios)),
-            "motor": dataclasses.asdict(a.motor), "friction": dataclasses.asdict(a.friction)},
-        "joint_limits_file": {j: {"lower": lo, "upper": hi}
-                              for j, lo, hi in zip(("joint1", "joint2", "joint3"), lim.lower, lim.upper)},
+            "transmission_ratio": None if a.ratios is None else dict(zip(JOINTS, a.ratios)),
+            "motor": None if a.motor is None else dataclasses.asdict(a.motor),
+            "friction": dataclasses.asdict(a.friction),
+            "joint_torque_limit": dict(zip(JOINTS, a.effort)),
+            "joint_velocity_limit": dict(zip(JOINTS, a.velocity))},
+        "joint_limits_file": {**{j: {"lower": lo, "upper": hi} for j, lo, hi in zip(JOINTS, lim.lower, lim.upper)},
+                              "postures": {name: list(theta) for name, theta in lim.postures.items()}},
         "visual_parameters_file": configuration.schema.thaw(config.visual),
     }
     paths = {}
@@ -126,7 +130,8 @@ def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
         inputs = _xacro_inputs(config, Path(folder))
         urdf = _process(model.urdf_xacro, {"prefix": prefix, **inputs})
         srdf = _process(model.srdf_xacro, {"name": model.robot_name, "prefix": prefix,
-                                           "actuation_file": inputs["actuation_file"]})
+                                           "actuation_file": inputs["actuation_file"],
+                                           "joint_limits_file": inputs["joint_limits_file"]})
     check_urdf(urdf, "the generated URDF")
     robot_file = model.mjcf.name if robot_file is None else robot_file
     mjcf, scene = mjcf_texts(urdf, srdf, config, prefix, robot_file, model.robot_name)

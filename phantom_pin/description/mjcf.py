@@ -7,7 +7,9 @@ joints and frames; the MJCF adds what the URDF cannot say in MuJoCo's terms:
   settings of config/mjcf.yaml (MuJoCo enforces them softly);
 - the rotors' reflected inertia as joint ``armature`` (rotor_inertia * ratio^2, kg m^2);
 - one ``<motor>`` per actuated joint: gear = transmission ratio, so that the control is
-  the motor-shaft torque (N m) and its range is the motor's max. continuous torque;
+  the motor-shaft torque (N m) and its range is the motor's max. continuous torque; without
+  public motor data, gear 1: the control is the joint torque (N m, the joint-torque
+  interface of OpenHaptics) within the configuration's joint_torque_limit;
 - ``<contact><exclude>`` for the SRDF's disabled pairs (MuJoCo excludes only parent-child);
 - the coupled stops (theta2 - theta3 between -55 and 65 deg) as a limited fixed tendon;
 - joint damping and frictionloss from the URDF's <dynamics> (actuation.yaml's friction);
@@ -155,7 +157,7 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
         if joint is not None:
             _place(body, joint.find("origin"))
             if joint.get("type") == "revolute":
-                ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.motor.rotor_inertia,
+                ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
                                                                joint.get("name") in mimics))
             elif joint.get("type") != "fixed":
                 raise ValueError(f"unsupported URDF joint type {joint.get('type')!r}")
@@ -198,9 +200,10 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
             "solref": solref, "solimp": _vec(settings.equality_solimp)})
 
     actuator = ET.SubElement(mujoco, "actuator")
-    torque = config.actuation.motor.max_continuous_torque
-    for name, transmission in transmissions.items():
+    motor = config.actuation.motor
+    for index, (name, transmission) in enumerate(transmissions.items()):
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
+        torque = config.actuation.effort[index] if motor is None else motor.max_continuous_torque
         ET.SubElement(actuator, "motor", {"name": transmission.find("actuator").get("name"),
                                           "joint": name, "gear": _num(ratio),
                                           "ctrlrange": _vec([-torque, torque]),
@@ -231,7 +234,7 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
     if axis != "0 -1 0":  # the default class's axis, that of joints 2, 3 and the pins
         attributes["axis"] = axis
     transmission = transmissions.get(joint.get("name"))
-    if transmission is not None:
+    if transmission is not None and rotor_inertia:  # no rotor without public motor data
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
         attributes["armature"] = _num(rotor_inertia * ratio**2)
     dynamics = joint.find("dynamics")

@@ -74,15 +74,22 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     return 0
 
 
+def _columns(result: SimulationResult) -> dict[str, str]:
+    """The result's columns with their units: UNITS, without ``current`` for a model
+    without public motor data."""
+    return {name: unit for name, unit in UNITS.items() if getattr(result, name) is not None}
+
+
 def _json(result: SimulationResult, settings: dict) -> str:
-    data = {"settings": settings, "units": UNITS}
-    data.update({name: getattr(result, name).tolist() for name in UNITS})
+    columns = _columns(result)
+    data = {"settings": settings, "units": columns}
+    data.update({name: getattr(result, name).tolist() for name in columns})
     return json.dumps(data) + "\n"
 
 
 def _csv(result: SimulationResult) -> str:
     header, columns = [], []
-    for name, unit in UNITS.items():
+    for name, unit in _columns(result).items():
         values = getattr(result, name).reshape(len(result.t), -1)
         suffixes = [""] if values.shape[1] == 1 else (["_x", "_y", "_z"] if name == "tip" else ["1", "2", "3"])
         header += [f"{name}{s} [{unit.split(' (')[0]}]" for s in suffixes]
@@ -97,16 +104,7 @@ def info(phantom: Phantom) -> tuple[dict, list[str]]:
     config = device.config
     stops, friction, motor, encoder = (config.limits.stops, config.actuation.friction, config.actuation.motor,
                                        config.actuation.encoder)
-    sections = {
-        "stops": dataclasses.asdict(stops),
-        "friction": dataclasses.asdict(friction),
-        "motor": dataclasses.asdict(motor) | {"continuous_joint_torque": device.continuous_torque.tolist(),
-                                              "peak_joint_torque": device.peak_torque.tolist()},
-        "encoder": dataclasses.asdict(encoder) | {"resolution": device.encoder_resolution.tolist()},
-        "transmission_ratio": {"ratios": device.ratios.tolist()},
-    }
-    for name, section in sections.items():
-        section["source"] = config.sources[name]
+    sections = {"stops": dataclasses.asdict(stops), "friction": dataclasses.asdict(friction)}
     deg = 180 / math.pi
     vector = " ".join
     text = {
@@ -117,16 +115,37 @@ def info(phantom: Phantom) -> tuple[dict, list[str]]:
           f"B {stops.damping:g} N m s/rad",
         "friction": f"friction: viscous {friction.viscous:g} N m s/rad + coulomb {friction.coulomb:g} N m * "
                     f"tanh(dtheta / {friction.smoothing_speed:g} rad/s)",
-        "motor": f"motor: continuous {motor.max_continuous_torque * 1e3:g} mN m / {motor.max_continuous_current:g} A, "
-                 f"stall {motor.stall_torque * 1e3:g} mN m / {motor.stall_current:g} A, Kt "
-                 f"{motor.torque_constant * 1e3:g} mN m/A, R {motor.terminal_resistance:g} Ohm, no-load "
-                 f"{motor.max_speed:.1f} rad/s; at the joints: "
-                 f"continuous [{vector(f'{x:.4f}' for x in device.continuous_torque)}] N m, peak "
-                 f"[{vector(f'{x:.4f}' for x in device.peak_torque)}] N m",
-        "encoder": f"encoder: {encoder.cycles_per_revolution:g} cycles/rev x {encoder.counts_per_cycle:g} counts/cycle on "
-                   f"the motor; resolution [{vector(f'{x:.3e}' for x in device.encoder_resolution)}] rad at the joints",
-        "transmission_ratio": f"transmission ratios: [{vector(f'{x:g}' for x in device.ratios)}]",
     }
+    if motor is None:
+        # what the model lacks, said instead of invented (its sources say why)
+        sections["motor"] = {"public": False, "peak_joint_torque": device.peak_torque.tolist()}
+        text["motor"] = (f"motor: none public; joint torque limits [{vector(f'{x:.4f}' for x in device.peak_torque)}] "
+                         f"N m (joint_torque_limit); no currents, no armature")
+    else:
+        sections["motor"] = dataclasses.asdict(motor) | {"continuous_joint_torque": device.continuous_torque.tolist(),
+                                                         "peak_joint_torque": device.peak_torque.tolist()}
+        text["motor"] = (f"motor: continuous {motor.max_continuous_torque * 1e3:g} mN m / "
+                         f"{motor.max_continuous_current:g} A, stall {motor.stall_torque * 1e3:g} mN m / "
+                         f"{motor.stall_current:g} A, Kt {motor.torque_constant * 1e3:g} mN m/A, R "
+                         f"{motor.terminal_resistance:g} Ohm, no-load {motor.max_speed:.1f} rad/s; at the joints: "
+                         f"continuous [{vector(f'{x:.4f}' for x in device.continuous_torque)}] N m, peak "
+                         f"[{vector(f'{x:.4f}' for x in device.peak_torque)}] N m")
+    if encoder is None:
+        sections["encoder"] = {"public": False}
+        text["encoder"] = "encoder: none public; no counts, no quantization"
+    else:
+        sections["encoder"] = dataclasses.asdict(encoder) | {"resolution": device.encoder_resolution.tolist()}
+        text["encoder"] = (f"encoder: {encoder.cycles_per_revolution:g} cycles/rev x {encoder.counts_per_cycle:g} "
+                           f"counts/cycle on the motor; resolution "
+                           f"[{vector(f'{x:.3e}' for x in device.encoder_resolution)}] rad at the joints")
+    if device.ratios is None:
+        sections["transmission_ratio"] = {"public": False}
+        text["transmission_ratio"] = "transmission ratios: none public"
+    else:
+        sections["transmission_ratio"] = {"ratios": device.ratios.tolist()}
+        text["transmission_ratio"] = f"transmission ratios: [{vector(f'{x:g}' for x in device.ratios)}]"
+    for name, section in sections.items():
+        section["source"] = config.sources[name]
     lines = ["device (phantom_pin.Device), SI units at the joints unless said:"]
     for name, section in sections.items():
         lines += [text[name], f"  source: {section['source']}"]

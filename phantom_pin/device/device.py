@@ -12,7 +12,7 @@ from phantom_pin.description.build import Description
 import numpy as np
 
 from phantom_pin.report import closed_form
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.validation import as_states, same_batch
 
@@ -35,9 +35,15 @@ class Device:
     positive direction, tau_i = ratio_i * torque_constant * i_i. A real amplifier may flip
     directions (mahilab/Phantom uses +1, -1, -1); that belongs to the driver, not here.
 
+    A model whose motors, transmission or encoders are not public (the Touch: ``motor``,
+    ``transmission_ratio`` and ``encoder`` are null in its actuation.yaml) still has its
+    stops, friction and torque limits (``peak_torque``, the configuration's
+    joint_torque_limit); what needs the missing data (currents, the continuous torque,
+    encoder counts) raises MissingDataError, naming what the model lacks.
+
     Attributes: ``phantom`` (the rigid body), ``config`` (its Config: ``actuation`` and
     ``limits.stops`` hold the device's numbers, ``sources`` where they come from),
-    ``ratios`` (3,).
+    ``ratios`` (3,), or None without public transmission ratios.
     """
 
     def __init__(self, phantom: Phantom | Description | str | Path | None = None) -> None:
@@ -48,11 +54,19 @@ class Device:
             phantom = Phantom(phantom)
         self.phantom = phantom
         self.config: Config = phantom.config
-        stops, encoder = self.config.limits.stops, self.config.actuation.encoder
-        #: joint angle = motor angle / ratio (the Phantom's actuation.yaml)
-        self.ratios = np.array(self.config.actuation.ratios, dtype=float)
-        self._stop_lower, self._stop_upper = stops.bounds()
-        self._counts_per_radian = self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
+        actuation = self.config.actuation
+        #: joint angle = motor angle / ratio (the Phantom's actuation.yaml); None if not public
+        self.ratios = None if actuation.ratios is None else np.array(actuation.ratios, dtype=float)
+        self._stop_lower, self._stop_upper = self.config.limits.stops.bounds()
+        encoder = actuation.encoder
+        self._counts_per_radian = None if encoder is None else \
+            self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
+
+    def _require(self, section: str, needed_by: str) -> None:
+        """MissingDataError unless the configuration has its ``section`` of actuation.yaml."""
+        if getattr(self.config.actuation, section) is None:
+            raise MissingDataError(f"{needed_by}: model {self.config.name} has no {section} data "
+                                   f"({self.config.sources[section]})")
 
     # -- stops -----------------------------------------------------------------------
     def within_limits(self, theta: object) -> bool | np.ndarray:
@@ -137,25 +151,32 @@ class Device:
     # -- motors ----------------------------------------------------------------------
     @property
     def continuous_torque(self) -> np.ndarray:
-        """Joint torque (N m) of each motor's max. continuous torque: max_continuous_torque * ratio."""
-        return self.config.actuation.motor.max_continuous_torque * self.ratios
+        """Joint torque (N m) of each motor's max. continuous torque: max_continuous_torque * ratio.
+        MissingDataError without public motor data."""
+        self._require("motor", "continuous_torque")
+        return np.array(self.config.actuation.effort)
 
     @property
     def peak_torque(self) -> np.ndarray:
-        """Joint torque (N m) of each motor's stall torque, the most it gives: stall_torque * ratio.
-        simulate() clips commanded torques here."""
-        return self.config.actuation.motor.stall_torque * self.ratios
+        """The most torque (N m) each joint's drive gives: the motor's stall_torque * ratio, or
+        the configuration's joint_torque_limit without public motor data. simulate() clips
+        commanded torques here."""
+        return np.array(self.config.actuation.peak)
 
     def _limit(self, continuous: bool) -> np.ndarray:
         return self.continuous_torque if continuous else self.peak_torque
 
     def motor_currents(self, tau: object) -> np.ndarray:
-        """Winding currents (A) that give joint torques tau (N m): tau / (ratio * torque_constant)."""
+        """Winding currents (A) that give joint torques tau (N m): tau / (ratio * torque_constant).
+        MissingDataError without public motor data."""
+        self._require("motor", "motor_currents")
         t, _ = as_states(tau, "tau")
         return t / (self.ratios * self.config.actuation.motor.torque_constant)
 
     def joint_torques(self, currents: object) -> np.ndarray:
-        """Joint torques (N m) of winding currents (A): ratio * torque_constant * currents."""
+        """Joint torques (N m) of winding currents (A): ratio * torque_constant * currents.
+        MissingDataError without public motor data."""
+        self._require("motor", "joint_torques")
         i, _ = as_states(currents, "currents")
         return i * self.ratios * self.config.actuation.motor.torque_constant
 
@@ -202,18 +223,21 @@ class Device:
     @property
     def encoder_resolution(self) -> np.ndarray:
         """Joint angle of one encoder count (rad): 2 pi / (ratio * cycles_per_revolution *
-        counts_per_cycle), (3,)."""
+        counts_per_cycle), (3,). MissingDataError without public encoder data."""
+        self._require("encoder", "encoder_resolution")
         return 1.0 / self._counts_per_radian
 
     def encoder_counts(self, theta: object) -> np.ndarray:
         """Encoder counts (int64) at theta (rad): round(theta * ratio * cycles * counts_per_cycle
         / (2 pi)). Count 0 is the report's zero configuration; a real device reads counts
         from wherever it was switched on and needs a calibration offset."""
+        self._require("encoder", "encoder_counts")
         q, _ = as_states(theta, "theta")
         return np.rint(q * self._counts_per_radian).astype(np.int64)
 
     def encoder_theta(self, counts: object) -> np.ndarray:
         """Joint angles (rad) of encoder counts: counts * encoder_resolution."""
+        self._require("encoder", "encoder_theta")
         c, _ = as_states(counts, "counts")
         return c * self.encoder_resolution
 

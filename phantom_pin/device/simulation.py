@@ -41,7 +41,7 @@ class SimulationResult:
     rad/s: the plant's true state (not quantized). ``tau_commanded`` (K, 3) N m: what the
     controller returned at t[k]; ``tau`` (K, 3) N m: the motor torque applied over
     [t[k], t[k+1]) after saturation (the last row is never applied); ``current`` (K, 3) A:
-    the winding currents of ``tau``. ``tip`` (K, 3) m: the tip position in the report's
+    the winding currents of ``tau`` (None for a model without public motor data). ``tip`` (K, 3) m: the tip position in the report's
     frame s. ``rate`` Hz and ``substeps`` (RK4 steps per sample period) describe the run.
     """
 
@@ -50,7 +50,7 @@ class SimulationResult:
     dtheta: np.ndarray
     tau: np.ndarray
     tau_commanded: np.ndarray
-    current: np.ndarray
+    current: np.ndarray | None
     tip: np.ndarray
     rate: float
     substeps: int
@@ -105,13 +105,14 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     on the Phantom's mimic model, the computation of Phantom.forward_dynamics),
     ``friction`` Device.friction, ``hard_stops`` Device.stop_torque, and with
     ``saturation`` tau_motor = the command clipped to +-Device.peak_torque (the motors'
-    stall torque). Between samples: fixed-step RK4 with ``substeps`` steps per period
+    stall torque, or the configuration's joint_torque_limit). Between samples: fixed-step RK4 with ``substeps`` steps per period
     (default from the stiffest term, see _substeps: 4 at 1 kHz with the shipped numbers),
     and a step in which a stop engages or releases is bisected around the event
     (EVENT_BISECTIONS halvings).
 
     ``device``: the Device to simulate (default: the shipped one, built once).
-    Raises InvalidInputError naming the bad argument, or the controller's bad return.
+    Raises InvalidInputError naming the bad argument, or the controller's bad return;
+    MissingDataError for ``quantization`` on a model without public encoder data.
     """
     theta = as_state(theta0, "theta0").copy()
     velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
@@ -122,6 +123,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         device = default_device()
     elif not isinstance(device, Device):
         raise InvalidInputError(f"device: expected a phantom_pin.Device or None, got {device!r}")
+    if quantization:
+        device._require("encoder", "quantization")
     samples = math.floor(duration * rate * (1 + 1e-12)) + 1
     if samples < 2:
         raise InvalidInputError(f"duration: {duration} s is shorter than one sample period (1 / rate = {1 / rate} s)")
@@ -215,7 +218,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             raise InvalidInputError(f"the state diverged at t = {t + period:.6g} s (torques too large?)")
     return SimulationResult(
         t=np.arange(samples) * period, theta=out_theta, dtheta=out_dtheta, tau=applied,
-        tau_commanded=commanded, current=device.motor_currents(applied),
+        tau_commanded=commanded, current=None if device.config.actuation.motor is None else device.motor_currents(applied),
         tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=substeps)
 
 

@@ -98,8 +98,9 @@ def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader)
     robot = pin.RobotWrapper(model, *geometry)
     try:
         pin.loadReferenceConfigurationsFromXML(robot.model, srdf, False)
-        if loader.has_rotor_parameters:
-            load_rotor_parameters(robot.model, srdf)
+        if loader.has_rotor_parameters and (
+                not isinstance(source, (Description, str, Path)) or description.config.actuation.motor is not None):
+            load_rotor_parameters(robot.model, srdf)  # a model without public motor data has none
         robot.collision_model.addAllCollisionPairs()
         pin.removeCollisionPairsFromXML(robot.model, robot.collision_model, srdf, False)
     except (RuntimeError, ValueError, AttributeError) as error:

@@ -128,7 +128,8 @@ class Phantom:
         self.model: pin.Model = self.coupling.reduced
         for model in (self.model, self.coupling.tree):  # the configuration's g, along base_link's -z
             model.gravity = gravity_of(self.config)
-        load_rotor_parameters(self.model, description.srdf)
+        if self.config.actuation.motor is not None:  # else no rotor_params, armature 0 (Actuation.rotor)
+            load_rotor_parameters(self.model, description.srdf)
         self.data = self.model.createData()
         self._tree_data = self.coupling.tree.createData()
         self._frame_s = self.model.getFrameId("report_s")

@@ -79,7 +79,7 @@ def identify(args: argparse.Namespace, phantom) -> int:
         fit = estimation.estimate(log, phantom, args.cutoff)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
-    keys, notes = io.overlay(fit)
+    keys, notes = io.overlay(fit, phantom.config)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)
     except PhantomPinError as error:
@@ -101,6 +101,6 @@ def identify(args: argparse.Namespace, phantom) -> int:
           "parameters, products of inertia and off-axis centres of mass included) leaves "
           + ", ".join(f"{r:.3g}" for r in fit.general_rms) + " N m RMS; much less than the fit's "
           "residual means the report's structure misses something on this device")
-    io.write_overlay(args.output, fit, args.log.name)
+    io.write_overlay(args.output, fit, args.log.name, phantom.config)
     print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
     return 0

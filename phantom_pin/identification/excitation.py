@@ -48,9 +48,10 @@ class Fourier:
 
 
 def continuous_effort(description: Description) -> np.ndarray:
-    """Each motor's max. continuous torque at its joint (N m): the excitation's torque bound."""
-    actuation = description.config.actuation
-    return actuation.motor.max_continuous_torque * np.array(actuation.ratios)
+    """Each joint's torque limit, the URDF's effort (N m): the motor's max. continuous torque at
+    its joint, or the configuration's joint_torque_limit without public motor data (the Touch).
+    The excitation's torque bound."""
+    return np.array(description.config.actuation.effort)
 
 
 def condition_number(phi: np.ndarray) -> float:

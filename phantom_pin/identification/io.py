@@ -90,11 +90,12 @@ def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2)
     return mean if ok.all() else None
 
 
-def overlay(fit) -> tuple[dict[str, float], list[str]]:
-    """The --params keys of an identification and the comment lines that explain them."""
+def overlay(fit, config) -> tuple[dict[str, float], list[str]]:
+    """The --params keys of an identification on the configuration ``config`` and the comment
+    lines that explain them."""
     from phantom_pin.identification import constants, parameterization
 
-    keys = parameterization.overrides(fit.x)
+    keys = parameterization.overrides(fit.x, config)
     notes = []
     n = len(constants.NAMES)
     for kind, first in (("viscous", n), ("coulomb", n + 3)):
@@ -110,11 +111,11 @@ def overlay(fit) -> tuple[dict[str, float], list[str]]:
     return keys, notes
 
 
-def write_overlay(path: Path | str, fit, source: str) -> None:
+def write_overlay(path: Path | str, fit, source: str, config) -> None:
     """Write the identified parameters as a --params YAML file (dotted keys, SI units)."""
     from phantom_pin.identification import constants
 
-    keys, notes = overlay(fit)
+    keys, notes = overlay(fit, config)
     lines = [f"# Identified by phantom-pin identify from {source}: a --params overlay for",
              "# phantom-pin urdf/srdf/mjcf and Phantom (docs/identification.md). SI units.",
              f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g}; "

@@ -4,7 +4,9 @@ A vector ``x`` of the 20 *report parameters* (``NAMES``): the masses (kg) and di
 inertias (kg m^2, the report's segment axes) of segments A, C, BE and DF; the first moments
 m l5 and m l6 (kg m) of BE and DF; I_baseyy (kg m^2, axis 1); the rotor inertia J (kg m^2, at
 the motor shaft). As in the report, I_bexx, I_dfxx and I_baseyy include the reflected rotor
-inertia J r^2; A and C are about their COM, BE and DF about the shoulder. The lengths l1..l3,
+inertia J r^2; A and C are about their COM, BE and DF about the shoulder. Without public motor
+data (the Touch) J is 0 and has no effect: the links carry the rotors (Actuation.rotor), and
+no rotor inertia is written. The lengths l1..l3,
 the hinge pins, the base's mass and x/z inertias and the transmission ratios are known
 (taken from the configuration).
 
@@ -55,7 +57,7 @@ def report_vector(config: Config) -> np.ndarray:
     p = report_of(config)
     return np.array([p.ma, p.Iaxx, p.Iayy, p.Iazz, p.mc, p.Icxx, p.Icyy, p.Iczz, p.mbe,
                      p.mbe * p.l5, p.Ibexx, p.Ibeyy, p.Ibezz, p.mdf, p.mdf * p.l6, p.Idfxx,
-                     p.Idfyy, p.Idfzz, p.Ibaseyy, config.actuation.motor.rotor_inertia])
+                     p.Idfyy, p.Idfzz, p.Ibaseyy, config.actuation.rotor[0]])
 
 
 def report_parameters(x: np.ndarray, config: Config) -> ReportParameters:
@@ -68,11 +70,14 @@ def report_parameters(x: np.ndarray, config: Config) -> ReportParameters:
         Idfxx=v["Idfxx"], Idfyy=v["Idfyy"], Idfzz=v["Idfzz"], Ibaseyy=v["Ibaseyy"])
 
 
-def overrides(x: np.ndarray) -> dict[str, float]:
-    """The --params keys of ``x``: first moments become segment_be.com = l5 and segment_df.com = l6 (m)."""
+def overrides(x: np.ndarray, config: Config) -> dict[str, float]:
+    """The --params keys of ``x``: first moments become segment_be.com = l5 and segment_df.com = l6
+    (m); no rotor inertia for a configuration without public motor data."""
     out = {}
     for name, value in zip(NAMES, np.asarray(x, float)):
         out[name] = float(value)
+    if config.actuation.motor is None:
+        del out[NAMES[ROTOR]]
     out["segment_be.com"] = out.pop("segment_be.first_moment") / out["segment_be.mass"]
     out["segment_df.com"] = out.pop("segment_df.first_moment") / out["segment_df.mass"]
     return out
@@ -82,8 +87,8 @@ def tree_parameters(x: np.ndarray, description: Description, bodies: list[str]) 
     """pi without friction of the report parameters ``x``: the standard parameters of each
     tree body (``bodies``, link names with the description's prefix), then J r_i^2 (kg m^2)."""
     config = description.config
-    ratios = np.array(config.actuation.ratios)
-    linked = links(report_parameters(x, config), config.unprinted, float(x[ROTOR]), config.actuation.ratios)
+    ratios = np.array(config.actuation.rotor[1])
+    linked = links(report_parameters(x, config), config.unprinted, float(x[ROTOR]), config.actuation.rotor[1])
     prefix = description.prefix
     inertial = [linked[name[len(prefix):]].dynamic_parameters() for name in bodies]
     return np.concatenate(inertial + [float(x[ROTOR]) * ratios**2])

@@ -45,12 +45,13 @@ def _constraints(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> np.nd
 def consistent(x: np.ndarray, config: Config) -> bool:
     """True if the report parameters ``x`` give links (report.parameters.links, as describe()
     computes them from the written overlay) that all pass phantom_pin.inertial.problem, with
-    a positive rotor inertia x[ROTOR] and masses."""
+    positive masses and rotor inertia x[ROTOR] (zero, without public motor data: Actuation.rotor)."""
     x = np.asarray(x, float)
-    if not (x[parameterization.ROTOR] > 0 and (x[list(parameterization.MASSES)] > 0).all()):
+    rotor = x[parameterization.ROTOR]
+    if not ((rotor > 0 if config.actuation.motor else rotor == 0) and (x[list(parameterization.MASSES)] > 0).all()):
         return False
-    linked = links(parameterization.report_parameters(x, config), config.unprinted, float(x[parameterization.ROTOR]),
-                   config.actuation.ratios)
+    linked = links(parameterization.report_parameters(x, config), config.unprinted, float(rotor),
+                   config.actuation.rotor[1])
     return all(problem(link) is None for link in linked.values())
 
 
@@ -65,7 +66,7 @@ def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarra
     a matrix with W^T W = the inverse covariance of ``target`` (or a vector: its diagonal).
     The prior (the report's values) fixes the directions the data cannot see; its weight is
     small so that it does not move the identifiable constants measurably."""
-    scale = np.abs(prior)
+    scale = np.where(prior != 0, np.abs(prior), 1.0)  # J = 0 without public motor data
     weights = np.diag(weights) if np.ndim(weights) == 1 else np.asarray(weights)
 
     def residual(z):
