@@ -1,4 +1,6 @@
-"""The committed URDF and MJCF in other tools: MuJoCo, Drake and urdfdom's check_urdf.
+"""The committed URDF and MJCF in other tools: MuJoCo, Drake and urdfdom's check_urdf, for
+every model written in the report's terms (premium_1_5 and touch: the closed form applies;
+premium_1_5_cad has its own SymPy reference, tests/test_cad_model.py).
 
 Each tool's dynamics are compared with the report's closed form (phantom_pin.report.closed_form),
 projected to theta1..theta3 through the coupling matrix G read from the URDF's mimic tags
@@ -7,6 +9,7 @@ RK4 integration of the closed form written here. States are seeded and inside th
 limits: the URDF's joint box and the coupled stops of the configuration's joint_limits.yaml.
 """
 
+import dataclasses
 import shutil
 import subprocess
 import sys
@@ -19,24 +22,51 @@ import pydrake.all as drake
 import pytest
 import yaml
 
-from conftest import CONFIG, CONFIG_DIR, MJCF_PATH, REPORT, SCENE_PATH, URDF_PATH, relative_error
+from conftest import CONFIG_DIR, relative_error
+from phantom_pin import config
 from phantom_pin.report import closed_form
 from phantom_pin.dynamics.coupling import Coupling
 
 
 ACTUATED = ("joint1", "joint2", "joint3")
-THETA0 = np.array([0.3, 0.8, 0.4])  # rad, the free swing's rest state
+THETA0 = np.array([0.3, 0.8, 0.4])  # rad, the free swing's rest state (inside every model's stops)
+
+
+@dataclasses.dataclass(frozen=True)
+class Case:
+    """A model written in the report's terms: its Config and report numbers, its folder and files."""
+    name: str
+    config: config.Config
+    config_dir: Path
+    urdf: Path
+    mjcf: Path
+    scene: Path
+
+    @property
+    def report(self):
+        return self.config.report
+
+
+#: The models the closed form describes.
+REPORT_MODELS = [name for name in config.models() if config.read(name).report is not None]
+
+
+@pytest.fixture(scope="module", params=REPORT_MODELS)
+def case(request) -> Case:
+    model = config.MODELS[request.param]
+    return Case(model.name, config.read(model.name), model.config, model.urdf, model.mjcf, model.scene)
 
 
 @pytest.fixture(scope="module")
-def coupling() -> Coupling:
-    return Coupling(URDF_PATH.read_text())
+def coupling(case) -> Coupling:
+    return Coupling(case.urdf.read_text())
 
 
-def inside_stops(n: int, seed: int, pool: np.ndarray | None = None) -> np.ndarray:
+def inside_stops(n: int, seed: int, pool: np.ndarray | None = None, config_dir: Path = CONFIG_DIR) -> np.ndarray:
     """At most ``n`` seeded theta (rad), uniform in the URDF box and inside the coupled
-    stops: the first of ``pool`` (default: 4 n seeded states in the box) that are inside."""
-    limits = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())
+    stops of ``config_dir``'s joint_limits.yaml: the first of ``pool`` (default: 4 n seeded
+    states in the box) that are inside."""
+    limits = yaml.safe_load((config_dir / "joint_limits.yaml").read_text())
     stops = limits["stops"]
     if pool is None:
         lower = [limits[j]["lower"] for j in ACTUATED]
@@ -47,14 +77,14 @@ def inside_stops(n: int, seed: int, pool: np.ndarray | None = None) -> np.ndarra
     return pool[keep][:n]
 
 
-def rk4_closed_form(theta0: np.ndarray, duration: float, step: float, damping: float = 0.0) -> np.ndarray:
+def rk4_closed_form(theta0: np.ndarray, duration: float, step: float, report, damping: float = 0.0) -> np.ndarray:
     """theta (rad) after ``duration`` s of motion from rest under tau = -damping * dtheta
-    (N m s/rad), RK4 on eq. 80."""
+    (N m s/rad), RK4 on eq. 80 with the report numbers ``report``."""
     def rate(x):
         theta, dtheta = x[:3], x[3:]
-        force = (-closed_form.coriolis_matrix(theta, dtheta, REPORT) @ dtheta - closed_form.gravity(theta, REPORT)
+        force = (-closed_form.coriolis_matrix(theta, dtheta, report) @ dtheta - closed_form.gravity(theta, report)
                  - damping * dtheta)
-        return np.concatenate([dtheta, np.linalg.solve(closed_form.mass_matrix(theta, REPORT), force)])
+        return np.concatenate([dtheta, np.linalg.solve(closed_form.mass_matrix(theta, report), force)])
     x = np.concatenate([theta0, np.zeros(3)])
     for _ in range(round(duration / step)):
         k1 = rate(x)
@@ -91,21 +121,22 @@ class MujocoArm:
         return G.T @ tree @ G, G.T @ self.data.qfrc_bias[self.dof]  # bias at rest = gravity
 
 
-def test_mujoco_loads_the_committed_urdf_with_the_report_dynamics(coupling):
-    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(URDF_PATH)), coupling)
+def test_mujoco_loads_the_committed_urdf_with_the_report_dynamics(case, coupling):
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(case.urdf)), coupling)
+    arm.model.opt.gravity[:] = [0, 0, -case.config.gravity]  # a URDF has no g (MuJoCo's default: 9.81)
     assert arm.model.neq == 4  # the mimic tags, as joint equalities
-    armature = np.diag(CONFIG.actuation.armature)  # the URDF has no armature
-    for theta in inside_stops(200, seed=1):
+    armature = np.diag(case.config.actuation.armature)  # the URDF has no armature
+    for theta in inside_stops(200, seed=1, config_dir=case.config_dir):
         mass, gravity = arm.reduced_mass_and_gravity(theta)
-        assert relative_error(mass, closed_form.mass_matrix(theta, REPORT) - armature) < 1e-9
-        assert relative_error(gravity, closed_form.gravity(theta, REPORT)) < 1e-9
+        assert relative_error(mass, closed_form.mass_matrix(theta, case.report) - armature) < 1e-9
+        assert relative_error(gravity, closed_form.gravity(theta, case.report)) < 1e-9
 
 
-def test_no_self_contact_in_mujoco_inside_the_limits(coupling):
+def test_no_self_contact_in_mujoco_inside_the_limits(case, coupling):
     """MuJoCo excludes only parent-child pairs: the geometry itself must stay apart."""
-    for path in (URDF_PATH, SCENE_PATH):
+    for path in (case.urdf, case.scene):
         arm = MujocoArm(mujoco.MjModel.from_xml_path(str(path)), coupling)
-        for theta in inside_stops(300, seed=2):
+        for theta in inside_stops(300, seed=2, config_dir=case.config_dir):
             arm.set(theta)
             pairs = {(arm.model.body(arm.model.geom_bodyid[c.geom1]).name,
                       arm.model.body(arm.model.geom_bodyid[c.geom2]).name)
@@ -113,36 +144,42 @@ def test_no_self_contact_in_mujoco_inside_the_limits(coupling):
             assert not pairs, f"{path.name}: contact {pairs} at theta = {theta}"
 
 
-def test_mjcf_has_the_report_dynamics_with_the_rotors(coupling):
-    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(MJCF_PATH)), coupling)
-    for theta in inside_stops(200, seed=3):
+def test_mjcf_has_the_report_dynamics_with_the_rotors(case, coupling):
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(case.mjcf)), coupling)
+    for theta in inside_stops(200, seed=3, config_dir=case.config_dir):
         mass, gravity = arm.reduced_mass_and_gravity(theta)
-        assert relative_error(mass, closed_form.mass_matrix(theta, REPORT)) < 1e-9
-        assert relative_error(gravity, closed_form.gravity(theta, REPORT)) < 1e-9
+        assert relative_error(mass, closed_form.mass_matrix(theta, case.report)) < 1e-9
+        assert relative_error(gravity, closed_form.gravity(theta, case.report)) < 1e-9
 
 
-def test_mjcf_tip_site_is_eq10(coupling):
+def test_mjcf_tip_site_is_eq10(case, coupling):
     """The tip site, seen from the report_s site, is eq. 10's position (1e-12 m)."""
-    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(MJCF_PATH)), coupling)
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(case.mjcf)), coupling)
     tip, s = arm.model.site("tip").id, arm.model.site("report_s").id
-    for theta in inside_stops(100, seed=4):
+    for theta in inside_stops(100, seed=4, config_dir=case.config_dir):
         arm.set(theta)
         position = arm.data.site_xmat[s].reshape(3, 3).T @ (arm.data.site_xpos[tip] - arm.data.site_xpos[s])
-        np.testing.assert_allclose(position, closed_form.forward_kinematics(theta, REPORT)[:3, 3], atol=1e-12)
+        np.testing.assert_allclose(position, closed_form.forward_kinematics(theta, case.report)[:3, 3], atol=1e-12)
 
 
-def test_mjcf_actuators_sensors_and_options_follow_the_yaml():
-    model = mujoco.MjModel.from_xml_path(str(MJCF_PATH))
-    actuation = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())
-    settings = yaml.safe_load((CONFIG_DIR / "mjcf.yaml").read_text())
-    torque = actuation["motor"]["max_continuous_torque"]
+def test_mjcf_actuators_sensors_and_options_follow_the_yaml(case):
+    """Motors at the motor shaft (gear = ratio, range = continuous torque, armature J r^2), or,
+    without public motor data, at the joint (gear 1, range = joint_torque_limit, no armature)."""
+    model = mujoco.MjModel.from_xml_path(str(case.mjcf))
+    actuation = yaml.safe_load((case.config_dir / "actuation.yaml").read_text())
+    settings = yaml.safe_load((case.config_dir / "mjcf.yaml").read_text())
+    motor = actuation["motor"]
     for i, joint in enumerate(ACTUATED):
         assert model.joint(model.actuator_trnid[i, 0]).name == joint
-        assert model.actuator_gear[i, 0] == actuation["transmission_ratio"][joint]
-        np.testing.assert_array_equal(model.actuator_ctrlrange[i], [-torque, torque])
         dof = model.jnt_dofadr[model.joint(joint).id]
-        assert model.dof_armature[dof] == pytest.approx(
-            actuation["motor"]["rotor_inertia"] * actuation["transmission_ratio"][joint] ** 2, rel=1e-15)
+        if motor is None:
+            torque, gear, armature = actuation["joint_torque_limit"][joint], 1.0, 0.0
+        else:
+            torque, gear = motor["max_continuous_torque"], actuation["transmission_ratio"][joint]
+            armature = motor["rotor_inertia"] * gear ** 2
+        assert model.actuator_gear[i, 0] == gear
+        np.testing.assert_array_equal(model.actuator_ctrlrange[i], [-torque, torque])
+        assert model.dof_armature[dof] == pytest.approx(armature, rel=1e-15)
     for joint in ACTUATED:
         assert model.dof_damping[model.jnt_dofadr[model.joint(joint).id]] == actuation["friction"]["viscous"]
         assert model.dof_frictionloss[model.jnt_dofadr[model.joint(joint).id]] == actuation["friction"]["coulomb"]
@@ -152,10 +189,10 @@ def test_mjcf_actuators_sensors_and_options_follow_the_yaml():
         *(f"{j}_pos" for j in ACTUATED), *(f"{j}_vel" for j in ACTUATED), "tip_pos"]
 
 
-def test_mjcf_tendon_is_the_coupled_stops(coupling):
+def test_mjcf_tendon_is_the_coupled_stops(case, coupling):
     """MuJoCo's tendon theta2 - theta3 limits exactly the postures outside the stops."""
-    stops = yaml.safe_load((CONFIG_DIR / "joint_limits.yaml").read_text())["stops"]
-    model = mujoco.MjModel.from_xml_path(str(MJCF_PATH))
+    stops = yaml.safe_load((case.config_dir / "joint_limits.yaml").read_text())["stops"]
+    model = mujoco.MjModel.from_xml_path(str(case.mjcf))
     arm = MujocoArm(model, coupling)
     limit = mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON
     rng = np.random.default_rng(6)
@@ -169,9 +206,9 @@ def test_mjcf_tendon_is_the_coupled_stops(coupling):
         assert (limit in arm.data.efc_type[:arm.data.nefc]) == outside, theta
 
 
-def test_mjcf_free_swing_follows_the_closed_form(coupling):
+def test_mjcf_free_swing_follows_the_closed_form(case, coupling):
     """1 s from rest at THETA0 with RK4 at 1 ms (limits, contacts, friction, damping off)."""
-    model = mujoco.MjModel.from_xml_path(str(MJCF_PATH))
+    model = mujoco.MjModel.from_xml_path(str(case.mjcf))
     for flag in ("mjDSBL_LIMIT", "mjDSBL_CONTACT", "mjDSBL_FRICTIONLOSS", "mjDSBL_DAMPER"):
         model.opt.disableflags |= getattr(mujoco.mjtDisableBit, flag)
     arm = MujocoArm(model, coupling)
@@ -179,7 +216,7 @@ def test_mjcf_free_swing_follows_the_closed_form(coupling):
     for _ in range(1000):
         mujoco.mj_step(model, arm.data)
     theta = arm.data.qpos[arm.qpos[:3]]
-    reference = rk4_closed_form(THETA0, 1.0, 1e-4)  # converged: 1e-3 s differs by 5e-10 rad
+    reference = rk4_closed_form(THETA0, 1.0, 1e-4, case.report)  # converged: 1e-3 s differs by 5e-10 rad
     assert np.abs(theta - reference).max() < 1e-5
     assert np.abs(theta - THETA0).max() > 1.0  # it did swing
 
@@ -187,14 +224,15 @@ def test_mjcf_free_swing_follows_the_closed_form(coupling):
 # -- Drake -------------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def drake_plant():
+def drake_plant(case):
     builder = drake.DiagramBuilder()
     plant, _ = drake.AddMultibodyPlantSceneGraph(builder, time_step=1e-4)
     plant.set_discrete_contact_approximation(drake.DiscreteContactApproximation.kSap)
     with warnings.catch_warnings():  # Drake warns that it ignores mechanicalReduction
         warnings.simplefilter("ignore")
-        drake.Parser(plant).AddModels(str(URDF_PATH))
+        drake.Parser(plant).AddModels(str(case.urdf))
     plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("base_link"))
+    plant.mutable_gravity_field().set_gravity_vector([0, 0, -case.config.gravity])  # a URDF has no g
     plant.Finalize()
     diagram = builder.Build()
     return plant, diagram
@@ -204,23 +242,23 @@ def _drake_positions(plant, coupling: Coupling) -> list[int]:
     return [plant.GetJointByName(n).position_start() for n in coupling.tree.names[1:]]
 
 
-def test_drake_reads_the_mimic_tags_and_the_rotor_inertia(drake_plant, coupling):
+def test_drake_reads_the_mimic_tags_and_the_rotor_inertia(case, drake_plant, coupling):
     plant, _ = drake_plant
     assert plant.num_constraints() == 4  # coupler constraints from the mimic tags
     context = plant.CreateDefaultContext()
     index = _drake_positions(plant, coupling)
     G = coupling.matrix
-    for theta in inside_stops(200, seed=5):
+    for theta in inside_stops(200, seed=5, config_dir=case.config_dir):
         q = np.zeros(plant.num_positions())
         q[index] = coupling.configuration(theta)
         plant.SetPositions(context, q)
         mass = plant.CalcMassMatrix(context)[np.ix_(index, index)]
         gravity = -plant.CalcGravityGeneralizedForces(context)[index]
-        assert relative_error(G.T @ mass @ G, closed_form.mass_matrix(theta, REPORT)) < 1e-9
-        assert relative_error(G.T @ gravity, closed_form.gravity(theta, REPORT)) < 1e-9
+        assert relative_error(G.T @ mass @ G, closed_form.mass_matrix(theta, case.report)) < 1e-9
+        assert relative_error(G.T @ gravity, closed_form.gravity(theta, case.report)) < 1e-9
 
 
-def test_drake_sap_free_swing_follows_the_closed_form(drake_plant, coupling):
+def test_drake_sap_free_swing_follows_the_closed_form(case, drake_plant, coupling):
     """A discrete SAP plant at 1e-4 s, 0.15 s from rest at THETA0, within 1e-3 rad.
 
     Drake applies the URDF's joint damping (actuation.yaml's viscous friction); it has no
@@ -235,18 +273,6 @@ def test_drake_sap_free_swing_follows_the_closed_form(drake_plant, coupling):
     plant.get_actuation_input_port().FixValue(plant_context, np.zeros(plant.num_actuators()))
     drake.Simulator(diagram, context).AdvanceTo(0.15)
     theta = plant.GetPositions(plant_context)[index][:3]
-    viscous = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())["friction"]["viscous"]
-    assert np.abs(theta - rk4_closed_form(THETA0, 0.15, 1e-4, damping=viscous)).max() < 1e-3
+    viscous = yaml.safe_load((case.config_dir / "actuation.yaml").read_text())["friction"]["viscous"]
+    assert np.abs(theta - rk4_closed_form(THETA0, 0.15, 1e-4, case.report, damping=viscous)).max() < 1e-3
     assert np.abs(theta - THETA0).max() > 0.3  # it did swing
-
-
-# -- urdfdom -----------------------------------------------------------------------------
-
-def test_check_urdf_accepts_the_urdf():
-    check_urdf = Path(sys.executable).parent / "check_urdf"
-    if not check_urdf.exists():
-        check_urdf = shutil.which("check_urdf")
-    assert check_urdf, "check_urdf ships with pin's urdfdom"
-    result = subprocess.run([str(check_urdf), str(URDF_PATH)], capture_output=True, text=True)
-    assert result.returncode == 0, result.stdout + result.stderr
-    assert "Successfully Parsed XML" in result.stdout

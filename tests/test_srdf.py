@@ -2,7 +2,8 @@
 
 Distances come from Pinocchio's collision library (coal) on the URDF's collision geometry;
 the states are seeded, in the URDF's joint box (where "Never" must hold) or also inside the
-coupled stops of the configuration's joint_limits.yaml (where every pair must be apart).
+coupled stops of the configuration's joint_limits.yaml (where every pair must be apart), for
+every model.
 """
 
 import xml.etree.ElementTree as ET
@@ -11,22 +12,27 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from phantom_pin.config import MODELS, models
 from phantom_pin.paths import DESCRIPTION_DIR
 from test_interop import inside_stops
-from conftest import SRDF_PATH, URDF_PATH
+
+
+@pytest.fixture(scope="module", params=models())
+def shipped(request):
+    return MODELS[request.param]
 
 
 @pytest.fixture(scope="module")
-def geometry():
-    model = pin.buildModelFromUrdf(str(URDF_PATH), mimic=True)
-    collision = pin.buildGeomFromUrdf(model, str(URDF_PATH), pin.GeometryType.COLLISION,
+def geometry(shipped):
+    model = pin.buildModelFromUrdf(str(shipped.urdf), mimic=True)
+    collision = pin.buildGeomFromUrdf(model, str(shipped.urdf), pin.GeometryType.COLLISION,
                                       package_dirs=[str(DESCRIPTION_DIR.parent)])
     collision.addAllCollisionPairs()
-    return model, collision
+    return model, collision, shipped
 
 
-def _disabled(reason: str) -> set[frozenset[str]]:
-    srdf = ET.parse(SRDF_PATH).getroot()
+def _disabled(shipped, reason: str) -> set[frozenset[str]]:
+    srdf = ET.parse(shipped.srdf).getroot()
     return {frozenset((p.get("link1"), p.get("link2"))) for p in srdf.iter("disable_collisions")
             if p.get("reason") == reason}
 
@@ -44,18 +50,18 @@ def _distances(model, collision, theta: np.ndarray) -> dict[frozenset[str], floa
     return out
 
 
-def test_arm_group_lists_the_three_actuated_joints():
-    srdf = ET.parse(SRDF_PATH).getroot()
+def test_arm_group_lists_the_three_actuated_joints(shipped):
+    srdf = ET.parse(shipped.srdf).getroot()
     (group,) = [g for g in srdf.iter("group") if g.get("name") == "arm"]
     assert [j.get("name") for j in group.findall("joint")] == ["joint1", "joint2", "joint3"]
     assert group.find("chain") is None
 
 
-def test_adjacent_pairs_are_joined_by_a_joint_or_a_pin_without_geometry(geometry):
-    urdf = ET.parse(URDF_PATH).getroot()
+def test_adjacent_pairs_are_joined_by_a_joint_or_a_pin_without_geometry(shipped):
+    urdf = ET.parse(shipped.urdf).getroot()
     parent = {j.find("child").get("link"): j.find("parent").get("link") for j in urdf.findall("joint")}
     with_geometry = {link.get("name") for link in urdf.findall("link") if link.find("collision") is not None}
-    for pair in _disabled("Adjacent"):
+    for pair in _disabled(shipped, "Adjacent"):
         a, b = sorted(pair)
         hops = {parent.get(a), parent.get(parent.get(a), None), parent.get(b), parent.get(parent.get(b), None)}
         joined = (parent.get(a) == b or parent.get(b) == a
@@ -65,8 +71,8 @@ def test_adjacent_pairs_are_joined_by_a_joint_or_a_pin_without_geometry(geometry
 
 
 def test_never_pairs_never_touch_anywhere_in_the_joint_box(geometry):
-    model, collision = geometry
-    never = _disabled("Never")
+    model, collision, shipped = geometry
+    never = _disabled(shipped, "Never")
     assert never
     rng = np.random.default_rng(11)
     worst = {pair: np.inf for pair in never}
@@ -80,14 +86,14 @@ def test_never_pairs_never_touch_anywhere_in_the_joint_box(geometry):
 def test_every_pair_is_apart_inside_the_stops_and_the_checked_ones_touch_outside(geometry):
     """Inside the coupled stops no two links touch; the pairs left checked are those that
     do touch somewhere in the box outside the stops (they flag unreachable states)."""
-    model, collision = geometry
-    for theta in inside_stops(1000, seed=12):
+    model, collision, shipped = geometry
+    for theta in inside_stops(1000, seed=12, config_dir=shipped.config):
         distances = _distances(model, collision, theta)
         assert min(distances.values()) > 0, (theta, min(distances, key=distances.get))
-    disabled = _disabled("Never") | _disabled("Adjacent")
+    disabled = _disabled(shipped, "Never") | _disabled(shipped, "Adjacent")
     rng = np.random.default_rng(13)
     box = rng.uniform(model.lowerPositionLimit, model.upperPositionLimit, (60000, 3))
-    inside = {tuple(theta) for theta in inside_stops(60000, seed=13, pool=box)}
+    inside = {tuple(theta) for theta in inside_stops(60000, seed=13, pool=box, config_dir=shipped.config)}
     outside = [theta for theta in box if tuple(theta) not in inside]
     touched = set()
     for theta in outside[:3000]:
