@@ -337,11 +337,11 @@ def _actuation(r: _Reader) -> Actuation:
                         act("friction", "smoothing_speed", positive=True))
     public = [r.node(arg, section) is not None for section in DRIVE]
     document = r.documents[arg]
-    if any(public) and not all(public[:2]):
+    if public[0] != public[1]:
         raise r.error(arg, "transmission_ratio and motor are either both given or both null (not public)")
+    if public[2] and not public[1]:
+        raise r.error(arg, "encoder needs the transmission_ratio and the motor (it is read at the motor shaft)")
     if not public[1]:
-        if public[2]:
-            raise r.error(arg, "encoder needs the transmission_ratio and the motor (it is read at the motor shaft)")
         effort = tuple(act("joint_torque_limit", j, positive=True) for j in JOINTS)
         velocity = tuple(act("joint_velocity_limit", j, positive=True) for j in JOINTS)
         return Actuation(None, None, None, friction, effort, velocity, effort)

@@ -10,6 +10,10 @@ import numpy as np
 from phantom_pin.exceptions import PhantomPinError
 
 
+#: The conventions of the CSV columns (phantom_pin.drivers).
+CONVENTIONS = ("report", "openhaptics")
+
+
 def _refuse(path: Path, force: bool) -> None:
     if path.exists() and not force:
         raise PhantomPinError(f"--output: {path} exists; add --force to overwrite it")
@@ -28,16 +32,23 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     excite.add_argument("--restarts", type=int, default=2, help="random starts (default 2)")
     excite.add_argument("--seed", type=int, default=0)
     excite.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+    excite.add_argument("--convention", choices=CONVENTIONS, default="report",
+                        help="columns in the report's theta (rad) and N m (default), or OpenHaptics' joint "
+                             "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+    identify.add_argument("--convention", choices=CONVENTIONS, default="report",
+                          help="the log's theta and tau columns: the report's theta (rad) and N m (default), "
+                               "or OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad) and joint torques (mN m)")
 
 
 def excite(args: argparse.Namespace, phantom) -> int:
     """phantom-pin excite, for the configuration of ``phantom`` (--model or --config)."""
+    from phantom_pin import drivers
     from phantom_pin.identification import constants, excitation, io
 
     description = phantom.description
@@ -57,13 +68,18 @@ def excite(args: argparse.Namespace, phantom) -> int:
     theta, dtheta, ddtheta = result.trajectory(t)
     beta = constants.nominal(description)
     tau = constants.regressor(theta, dtheta, ddtheta, description) @ beta
+    peak = np.abs(tau).max(axis=0)
+    if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
+        theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
+        tau = drivers.openhaptics_torque_from_tau(tau)
     io.write_csv(args.output, io.TRAJECTORY_COLUMNS, np.column_stack([t, theta, dtheta, ddtheta, tau]))
     effort = excitation.continuous_effort(description)
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
-          f"{args.harmonics} harmonics per joint")
+          f"{args.harmonics} harmonics per joint" + (", in OpenHaptics' joint angles (rad) and joint torques "
+                                                    "(mN m)" if args.convention == "openhaptics" else ""))
     print(f"condition number of the base regressor (14 columns scaled to unit norm): {result.condition:.3g}")
-    print("peak torque [N m] (report model + the configuration's friction) / motor continuous limit: "
-          + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(np.abs(tau).max(axis=0), effort)))
+    print("peak torque [N m] (report model + the configuration's friction) / joint torque limit: "
+          + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(peak, effort)))
     print(f"nearest approach to a stop: {result.min_slack:.3f} rad; the file starts and ends at rest")
     return 0
 
@@ -74,7 +90,7 @@ def identify(args: argparse.Namespace, phantom) -> int:
     from phantom_pin.identification import constants, estimation, io, parameterization
 
     _refuse(args.output, args.force)
-    log = io.read_log(args.log)
+    log = io.read_log(args.log, args.convention)
     try:
         fit = estimation.estimate(log, phantom, args.cutoff)
     except RuntimeError as error:

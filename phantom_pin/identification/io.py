@@ -2,7 +2,9 @@
 
 Log: header ``t,theta1,theta2,theta3,tau1,tau2,tau3`` (more columns allowed, any order): time
 (s) at a fixed rate, joint angles (rad, the report's theta, as measured) and joint torques
-(N m, as commanded). ``read_log`` raises LogError with one line on a malformed log.
+(N m, as commanded); or, in OpenHaptics' convention (``read_log(path, "openhaptics")``), its
+joint angles (rad) and joint torques (mN m), converted by phantom_pin.drivers. ``read_log``
+raises LogError with one line on a malformed log.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from phantom_pin import drivers
 from phantom_pin.exceptions import PhantomPinError
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
@@ -44,7 +47,12 @@ def write_log(path: Path | str, t: np.ndarray, theta: np.ndarray, tau: np.ndarra
     write_csv(path, LOG_COLUMNS, np.column_stack([t, theta, tau]))
 
 
-def read_log(path: Path | str) -> Log:
+def read_log(path: Path | str, convention: str = "report") -> Log:
+    """The log at ``path``, in the report's theta (rad) and N m: its columns are in the
+    ``convention`` "report" or "openhaptics" (HD_CURRENT_JOINT_ANGLES, rad, and joint torques,
+    mN m)."""
+    if convention not in ("report", "openhaptics"):
+        raise LogError(f"convention: expected 'report' or 'openhaptics', got {convention!r}")
     path = Path(path)
     try:
         lines = path.read_text(encoding="utf-8").splitlines()
@@ -76,8 +84,11 @@ def read_log(path: Path | str) -> Log:
         raise LogError(f"{path}: too short ({t[-1] - t[0]:.3g} s; at least {MIN_DURATION} s)")
     if np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
         raise LogError(f"{path}: not at a fixed rate (intervals {step.min():.4g}..{step.max():.4g} s)")
-    return Log(t, np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)]),
-               np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)]))
+    theta = np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)])
+    tau = np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)])
+    if convention == "openhaptics":
+        theta, tau = drivers.theta_from_openhaptics(theta), drivers.tau_from_openhaptics_torque(tau)
+    return Log(t, theta, tau)
 
 
 def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2) -> float | None:

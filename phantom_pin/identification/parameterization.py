@@ -104,7 +104,9 @@ def affine_map(description: Description, bodies: list[str]) -> tuple[np.ndarray,
         base = tree_parameters(x0, description, bodies)
         columns = []
         for k in range(len(NAMES)):
-            step = 1e-3 * abs(x0[k])  # the map is affine; a small step keeps every link physical
+            # the map is affine; a small step keeps every link physical (1e-9 kg m^2 for J = 0
+            # without public motor data, where J r^2 = 0 anyway)
+            step = 1e-3 * abs(x0[k]) if x0[k] else 1e-9
             x = x0.copy()
             x[k] += step
             columns.append((tree_parameters(x, description, bodies) - base) / step)

@@ -1,0 +1,106 @@
+"""Every model of the family (phantom_pin.models()), each as its tool's own test would have it:
+urdfdom's check_urdf on plain xacro with and without a prefix (Universal Robots' description
+test), the MuJoCo scene stepped under random control (mujoco_menagerie's model test), the
+joints load() gives (example-robot-data's test), and the tip against eq. 10 written here with
+the model's own lengths, read from its kinematics.yaml."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pinocchio as pin
+import pytest
+import yaml
+
+from phantom_pin import load
+from phantom_pin.config import MODELS, models
+from phantom_pin.config.sampling import sample_postures
+from phantom_pin import config
+
+PREFIXES = ("", "left_")
+
+
+def _tool(name: str) -> str:
+    path = Path(sys.executable).parent / name
+    found = str(path) if path.exists() else shutil.which(name)
+    assert found, f"{name} ships with the test dependencies (xacro, pin's urdfdom)"
+    return found
+
+
+@pytest.mark.parametrize("prefix", PREFIXES)
+@pytest.mark.parametrize("name", models())
+def test_plain_xacro_of_every_model_passes_check_urdf(name, prefix, tmp_path):
+    """xacro on the committed top-level xacro (its default parameter files), then check_urdf."""
+    model = MODELS[name]
+    urdf = tmp_path / f"{name}.urdf"
+    arguments = [f"prefix:={prefix}"] if prefix else []
+    result = subprocess.run([_tool("xacro"), str(model.urdf_xacro), *arguments, "-o", str(urdf)],
+                            capture_output=True, text=True, cwd=model.urdf_xacro.parent)
+    assert result.returncode == 0, result.stderr
+    result = subprocess.run([_tool("check_urdf"), str(urdf)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "Successfully Parsed XML" in result.stdout
+    assert f"root Link: {prefix}base_link has 3 child(ren)" in result.stdout
+    children = [line.split(":", 1)[1].strip() for line in result.stdout.splitlines() if "child(" in line]
+    assert len(children) == 12 and all(child.startswith(prefix) for child in children), children
+    assert {child[len(prefix):] for child in children} >= {"turret_link", "forearm_link", "tip", "report_s"}
+
+
+@pytest.mark.parametrize("name", models())
+def test_every_scene_steps_one_second_under_random_control_without_a_warning(name):
+    """1000 steps of the model's timestep under seeded control noise of half its range."""
+    model = mujoco.MjModel.from_xml_path(str(MODELS[name].scene))
+    data = mujoco.MjData(model)
+    assert model.nu == 3 and model.opt.timestep == 0.001
+    mujoco.mj_resetData(model, data)
+    rng = np.random.default_rng(17)
+    low, high = model.actuator_ctrlrange.T
+    for _ in range(1000):
+        data.ctrl[:] = rng.uniform(low, high) * 0.5
+        mujoco.mj_step(model, data)
+    assert data.time == pytest.approx(1.0)
+    assert [data.warning[i].number for i in range(len(data.warning))] == [0] * len(data.warning)
+    assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
+    assert np.abs(data.qvel).max() > 0  # it moved
+
+
+@pytest.mark.parametrize("name", models())
+def test_load_gives_the_three_report_joints_the_frames_and_the_srdf_postures(name):
+    robot = load(name)
+    limits = yaml.safe_load((MODELS[name].config / "joint_limits.yaml").read_text())
+    assert (robot.model.nq, robot.model.nv) == (3, 3)
+    assert list(robot.model.names) == ["universe", "joint1", "joint2", "joint3",  # then the mimic joints
+                                       "crank_pin_a", "crank_pin_b", "forearm_pin_a", "forearm_pin_b"]
+    for frame in ("base_link", "report_s", "report_dynamics", "tip", "elbow"):
+        assert robot.model.existFrame(frame), frame
+    for joint, lower, upper in zip(("joint1", "joint2", "joint3"), robot.model.lowerPositionLimit,
+                                   robot.model.upperPositionLimit):
+        assert (lower, upper) == (limits[joint]["lower"], limits[joint]["upper"])
+    for posture, theta in limits["postures"].items():
+        np.testing.assert_array_equal(robot.model.referenceConfigurations[posture], theta)
+    np.testing.assert_array_equal(robot.q0, limits["postures"]["resting"])
+
+
+@pytest.mark.parametrize("name", models())
+def test_every_tip_follows_eq10_with_its_own_lengths(name):
+    """The tip in report_s, by Pinocchio on the committed URDF, against eq. 10 (the report's
+    g_st position: x = s1 (l1 c2 + l2 s3), y = l2 - l2 c3 + l1 s2, z = -l1 + c1 (l1 c2 + l2 s3))
+    with l1, l2 from the model's kinematics.yaml, at 500 seeded postures inside its stops (1e-12 m)."""
+    lengths = yaml.safe_load((MODELS[name].config / "kinematics.yaml").read_text())
+    l1, l2 = lengths["l1"], lengths["l2"]
+    robot = load(name)
+    data = robot.model.createData()
+    thetas = sample_postures(config.read(name).limits, 500, np.random.default_rng(3), draws=2000)
+    assert len(thetas) == 500
+    for theta in thetas:
+        pin.framesForwardKinematics(robot.model, data, theta)
+        tip = data.oMf[robot.model.getFrameId("tip")]
+        s = data.oMf[robot.model.getFrameId("report_s")]
+        position = (s.actInv(tip)).translation
+        t1, t2, t3 = theta
+        reach = l1 * np.cos(t2) + l2 * np.sin(t3)
+        expected = [np.sin(t1) * reach, l2 - l2 * np.cos(t3) + l1 * np.sin(t2), -l1 + np.cos(t1) * reach]
+        np.testing.assert_allclose(position, expected, rtol=0, atol=1e-12)

@@ -1,0 +1,193 @@
+"""The model touch: its ESTIMATED inertias against the stated geometry (tests/touch_reference.py),
+its torque limits against CHAI3D's force, what a model without public motor data does and
+refuses, and the identification of a simulated Touch through OpenHaptics' joint torques."""
+
+import dataclasses
+import json
+import shutil
+from contextlib import redirect_stdout
+from io import StringIO
+
+import numpy as np
+import pytest
+import yaml
+
+from phantom_pin import (Device, MissingDataError, ParameterFileError, Phantom, closed_form, config, describe,
+                         drivers, simulate)
+from phantom_pin.cli import main
+from phantom_pin.config import MODELS, read_overrides
+from phantom_pin.config.sampling import sample_postures
+from phantom_pin.identification import io, simulation
+from touch_reference import REFERENCE
+
+FOLDER = MODELS["touch"].config
+MAX_FORCE = 3.3          # N, CHAI3D 3.3.0 src/devices/CPhantomDevices.cpp, "Touch"
+L1 = L2 = 0.13335        # m, Ubitrack's PhantomForwardKinematics
+
+
+def _yaml(name: str) -> dict:
+    return yaml.safe_load((FOLDER / name).read_text())
+
+
+def four_digits(value: float) -> float:
+    return float(f"{value:.4g}")
+
+
+def test_estimated_segments_are_the_stated_geometry_to_four_digits():
+    """Each number of physical_parameters.yaml is the SymPy integral over its stated shape,
+    rounded to four significant digits, exactly."""
+    physical = _yaml("physical_parameters.yaml")
+    for segment in ("segment_a", "segment_c", "segment_be", "segment_df"):
+        reference = REFERENCE[segment]
+        assert physical[segment]["mass"] == four_digits(reference["mass"]), segment
+        for axis in ("xx", "yy", "zz"):
+            assert physical[segment]["inertia"][axis] == four_digits(reference["inertia"][axis]), (segment, axis)
+        if reference["com"] is not None:
+            assert physical[segment]["com"] == four_digits(reference["com"]), segment
+    turret = REFERENCE["segment_g"]
+    assert physical["segment_g"]["mass"] == four_digits(turret["mass"])
+    for key, axis in (("inertia_yy", "yy"), ("inertia_xx", "xx"), ("inertia_zz", "zz")):
+        assert physical["segment_g"][key] == four_digits(turret["inertia"][axis])
+
+
+def test_torque_limits_render_chai3ds_force_along_each_joints_longest_lever():
+    """joint_torque_limit = 3.3 N x (l1 + l2, l1, l2) to four digits: the largest norm of each
+    column of the tip Jacobian (m/rad) over the whole joint space."""
+    limits = _yaml("actuation.yaml")["joint_torque_limit"]
+    levers = (L1 + L2, L1, L2)
+    for joint, lever in zip(("joint1", "joint2", "joint3"), levers):
+        assert limits[joint] == four_digits(MAX_FORCE * lever)
+    theta = np.random.default_rng(4).uniform(-np.pi, np.pi, (20000, 3))
+    columns = np.linalg.norm(Device("touch").tip_jacobian(theta), axis=-2).max(axis=0)
+    assert np.all(columns <= np.array(levers) + 1e-12) and np.all(columns > np.array(levers) * 0.999)
+
+
+def test_the_touch_is_the_reports_arm_at_its_size():
+    phantom = Phantom("touch")
+    kinematics = phantom.config.kinematics
+    assert (kinematics.l1, kinematics.l2) == (L1, L2)
+    theta = sample_postures(phantom.config.limits, 200, np.random.default_rng(5), draws=800)
+    report = phantom.config.report
+    np.testing.assert_allclose(phantom.mass_matrix(theta), closed_form.mass_matrix(theta, report), rtol=1e-12)
+    np.testing.assert_allclose(phantom.gravity(theta), closed_form.gravity(theta, report), rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(phantom.model.armature, np.zeros(3))  # no public rotor data
+
+
+@pytest.fixture(scope="module")
+def touch() -> Device:
+    return Device("touch")
+
+
+def test_a_device_without_motor_data_says_what_it_lacks(touch):
+    assert touch.ratios is None
+    np.testing.assert_array_equal(touch.peak_torque, [0.8801, 0.4401, 0.4401])
+    for call, name in ((lambda: touch.motor_currents([0.1, 0.2, 0.3]), "motor_currents"),
+                       (lambda: touch.joint_torques([0.1, 0.2, 0.3]), "joint_torques"),
+                       (lambda: touch.continuous_torque, "continuous_torque"),
+                       (lambda: touch.encoder_counts([0.1, 0.2, 0.3]), "encoder_counts"),
+                       (lambda: touch.encoder_theta([1, 2, 3]), "encoder_theta"),
+                       (lambda: touch.encoder_resolution, "encoder_resolution"),
+                       (lambda: touch.available_torque([0.1, 0.2, 0.3]), "continuous_torque")):
+        with pytest.raises(MissingDataError, match=f"^{name}: model touch has no (motor|encoder) data \\(not public"):
+            call()
+    assert isinstance(MissingDataError("x"), ValueError)
+    lower, upper = touch.available_torque([0.1, 0.2, 0.3], continuous=False)  # the joint limits still hold
+    np.testing.assert_allclose(upper - lower, 2 * touch.peak_torque, rtol=1e-15)
+
+
+def test_simulating_a_touch_saturates_at_its_limits_and_has_no_currents(touch):
+    """A hold at 10x the torque limits: the applied torque is the limit; no currents; and the
+    encoders the model lacks cannot quantize."""
+    result = simulate([0.2, 0.6, 0.8], 0.01, lambda t, q, v: 10 * touch.peak_torque, device=touch)
+    np.testing.assert_array_equal(result.tau[:-1], np.tile(touch.peak_torque, (len(result.t) - 1, 1)))
+    assert result.current is None
+    with pytest.raises(MissingDataError, match="^quantization: model touch has no encoder data"):
+        simulate([0.2, 0.6, 0.8], 0.01, device=touch, quantization=True)
+
+
+def test_the_cli_simulates_and_describes_a_touch(capsys, tmp_path):
+    assert main(["--model", "touch", "simulate", "--theta0", "0.2", "0.6", "0.8", "--duration", "0.01",
+                 "--format", "csv", "-o", str(tmp_path / "run.csv")]) == 0
+    header = (tmp_path / "run.csv").read_text().splitlines()[0]
+    assert header.startswith("t [s],theta1 [rad]") and "current" not in header
+    capsys.readouterr()
+    assert main(["--model", "touch", "info", "--json"]) == 0
+    device = json.loads(capsys.readouterr().out)["device"]
+    assert device["motor"]["public"] is False and device["encoder"]["public"] is False
+    assert device["transmission_ratio"]["public"] is False
+    assert "not public" in device["motor"]["source"]
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda a: a.update(transmission_ratio={"joint1": 10, "joint2": 10, "joint3": 10}),
+     "transmission_ratio and motor are either both given or both null"),
+    (lambda a: a.pop("joint_torque_limit"), "missing key joint_torque_limit"),
+    (lambda a: a.update(encoder={"cycles_per_revolution": 1024, "counts_per_cycle": 4}),
+     "encoder needs the transmission_ratio and the motor"),
+    (lambda a: a["joint_velocity_limit"].update(joint2=0), "joint_velocity_limit.joint2 must be positive"),
+    (lambda a: a.pop("motor"), "missing key motor"),
+])
+def test_bad_actuation_without_motor_data_is_refused_naming_the_key(tmp_path, edit, message):
+    folder = tmp_path / "touch"
+    shutil.copytree(FOLDER, folder)
+    actuation = yaml.safe_load((folder / "actuation.yaml").read_text())
+    edit(actuation)
+    (folder / "actuation.yaml").write_text(yaml.safe_dump(actuation))
+    with pytest.raises(ParameterFileError, match=f"actuation.yaml: {message}"):
+        config.read(folder)
+
+
+def test_a_motor_with_joint_limits_is_refused(tmp_path):
+    folder = tmp_path / "p"
+    shutil.copytree(MODELS["premium_1_5"].config, folder)
+    actuation = yaml.safe_load((folder / "actuation.yaml").read_text())
+    actuation["joint_torque_limit"] = {"joint1": 1.0, "joint2": 1.0, "joint3": 1.0}
+    (folder / "actuation.yaml").write_text(yaml.safe_dump(actuation))
+    with pytest.raises(ParameterFileError, match="joint_torque_limit is for a model without motor data"):
+        config.read(folder)
+
+
+#: The simulated Touch: the estimate's report parameters moved by 10-30 %.
+FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
+           "Iczz": 0.85, "mbe": 1.25, "l5": 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3,
+           "mdf": 1.3, "l6": 0.9, "Idfxx": 1.2, "Idfyy": 1.1, "Idfzz": 1.25, "Ibaseyy": 1.15}
+VISCOUS, COULOMB, TORQUE_NOISE = 8e-4, 0.015, 0.001      # N m s/rad, N m, N m (1 sigma)
+
+
+def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_path):
+    """docs/touch.md end to end: excite (OpenHaptics' convention) -> the device tracks it (here a
+    simulated Touch, 10-30 % off the estimate, with friction and torque noise) -> its log in
+    OpenHaptics' angles and mN m -> identify -> a --params overlay, judged on held-out torques."""
+    estimate = config.read("touch")
+    truth = dataclasses.replace(estimate.report, **{k: getattr(estimate.report, k) * f for k, f in FACTORS.items()})
+    with redirect_stdout(StringIO()):
+        assert main(["--model", "touch", "excite", "-o", str(tmp_path / "traj.csv"), "--duration", "10",
+                     "--iterations", "15", "--restarts", "1", "--convention", "openhaptics"]) == 0
+    table = np.loadtxt(tmp_path / "traj.csv", delimiter=",", skiprows=1)
+    reference = tuple(drivers.theta_from_openhaptics(table[:, k:k + 3]) for k in (1, 4, 7))
+    friction = dataclasses.replace(estimate.actuation.friction, viscous=VISCOUS, coulomb=COULOMB)
+    log = simulation.simulate(lambda _: reference, table[-1, 0], truth, estimate.report, friction,
+                              torque_noise=TORQUE_NOISE, seed=1)
+    io.write_csv(tmp_path / "log.csv", io.LOG_COLUMNS,
+                 np.column_stack([log.t, drivers.openhaptics_from_theta(log.theta),
+                                  drivers.openhaptics_torque_from_tau(log.tau)]))
+    with redirect_stdout(StringIO()):
+        assert main(["--model", "touch", "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"),
+                     "--convention", "openhaptics"]) == 0
+    overlay = read_overrides(tmp_path / "id.yaml")
+    assert not any("rotor" in key for key in overlay)           # the Touch has no public motor
+    identified = Phantom(describe("touch", overrides=overlay))
+    rng = np.random.default_rng(21)
+    theta = sample_postures(estimate.limits, 300, rng, draws=1200)
+    dtheta, ddtheta = rng.uniform(-2, 2, theta.shape), rng.uniform(-20, 20, theta.shape)
+    truth_tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, truth)
+
+    def error(tau):
+        return float(np.sqrt(((tau - truth_tau) ** 2).mean()) / np.sqrt((truth_tau ** 2).mean()))
+    before, after = error(closed_form.inverse_dynamics(theta, dtheta, ddtheta, estimate.report)), \
+        error(identified.inverse_dynamics(theta, dtheta, ddtheta))
+    assert before > 0.1 and after < 0.01, (before, after)
+    # the viscous estimate is 12 % high here: the filtered rates bias it (the open issue
+    # "unbiased friction"); the torques it predicts are within the 1 % above all the same
+    assert identified.config.actuation.friction.viscous == pytest.approx(VISCOUS, rel=0.15)
+    assert identified.config.actuation.friction.coulomb == pytest.approx(COULOMB, rel=0.05)
