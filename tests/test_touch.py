@@ -11,6 +11,7 @@ from io import StringIO
 import numpy as np
 import pytest
 import yaml
+import yourdfpy
 
 from phantom_pin import (Device, MissingDataError, ParameterFileError, Phantom, closed_form, config, describe,
                          drivers, simulate)
@@ -191,3 +192,40 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     # "unbiased friction"); the torques it predicts are within the 1 % above all the same
     assert identified.config.actuation.friction.viscous == pytest.approx(VISCOUS, rel=0.15)
     assert identified.config.actuation.friction.coulomb == pytest.approx(COULOMB, rel=0.05)
+
+
+def test_the_command_line_serves_the_touch(capsys, tmp_path):
+    """fk and ik against Ubitrack's forward kinematics (OpenHaptics' angles: angle 1 = -theta1),
+    the gravity torque against the gradient of the potential energy (yourdfpy's placement of the
+    URDF's masses, central differences), check,
+    the generated files and the viewer."""
+    theta = np.array([0.1, 0.5, 0.7])
+
+    def run(*arguments):
+        assert main(["--model", "touch", *arguments]) == 0
+        return json.loads(capsys.readouterr().out)
+
+    a = -theta[0], theta[1], theta[2]
+    ubitrack = [-(L1 * np.cos(a[1]) + L2 * np.sin(a[2])) * np.sin(a[0]),
+                L1 * np.sin(a[1]) - L2 * np.cos(a[2]) + L2, -L1 + (L1 * np.cos(a[1]) + L2 * np.sin(a[2])) * np.cos(a[0])]
+    tip = np.array(run("fk", *map(str, theta), "--json")["g_st"])[:3, 3]
+    np.testing.assert_allclose(tip, ubitrack, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(run("ik", *map(str, ubitrack), "--json")["theta"], theta, rtol=0, atol=1e-12)
+    n = np.array(run("dynamics", "--theta", *map(str, theta), "--json")["N"])
+    urdf = yourdfpy.URDF.load(str(MODELS["touch"].urdf))  # V = g sum m z_com, placed by yourdfpy
+    masses = {name: link.inertial for name, link in urdf.link_map.items() if link.inertial is not None}
+
+    def energy(q):
+        urdf.update_cfg(q)
+        return 9.80665 * sum(i.mass * (urdf.get_transform(name) @ i.origin)[2, 3] for name, i in masses.items())
+    h = 1e-6
+    gradient = [(energy(theta + h * e) - energy(theta - h * e)) / (2 * h) for e in np.eye(3)]
+    np.testing.assert_allclose(n, gradient, rtol=0, atol=1e-9 * np.abs(n).max())
+    assert n[0] == 0.0  # axis 1 is vertical: gravity does no work on it
+    assert run("check", "-n", "50", "--json")["checks"][0]["max_error"] < 1e-12
+    capsys.readouterr()
+    for kind in ("urdf", "srdf"):
+        assert main(["--model", "touch", kind, "-o", str(tmp_path / f"t.{kind}")]) == 0
+        assert (tmp_path / f"t.{kind}").read_text() == getattr(MODELS["touch"], kind).read_text()
+    assert main(["--model", "touch", "show", "--html", str(tmp_path / "t.html")]) == 0
+    assert (tmp_path / "t.html").stat().st_size > 100_000
