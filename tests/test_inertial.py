@@ -45,7 +45,7 @@ def test_the_report_as_five_bodies_in_full_gives_the_report_adapters_links(tmp_p
         "forearm_link": _diagonal(p.ma, (0, 0, p.l3 - p.l2 / 2), p.Iazz, p.Iaxx, p.Iayy),
     }
     (folder / "physical_parameters.yaml").write_text(
-        yaml.safe_dump({"gravity": 9.81, "links": bodies, "hinge_pin": raw["hinge_pin"]}))
+        yaml.safe_dump({"gravity": 9.81, "links": bodies, "housing": raw["housing"], "hinge_pin": raw["hinge_pin"]}))
     full = config.read(folder)
     assert full.report is None
     for name, link in c.links.items():

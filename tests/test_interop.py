@@ -276,3 +276,50 @@ def test_drake_sap_free_swing_follows_the_closed_form(case, drake_plant, couplin
     viscous = yaml.safe_load((case.config_dir / "actuation.yaml").read_text())["friction"]["viscous"]
     assert np.abs(theta - rk4_closed_form(THETA0, 0.15, 1e-4, case.report, damping=viscous)).max() < 1e-3
     assert np.abs(theta - THETA0).max() > 0.3  # it did swing
+
+
+#: The README's one line that silences Drake's two known warnings on our URDFs (and no other).
+SILENCE_DRAKE = ('logging.getLogger("drake").addFilter(lambda record: not any(known in record.getMessage() '
+                 'for known in ("joint friction", "mechanical reductions")))')
+
+
+def test_drake_warns_only_what_it_ignores_and_the_readmes_line_silences_it(case):
+    """Drake ignores the URDF's Coulomb friction (one warning per actuated joint) and a
+    mechanicalReduction other than 1 (one per transmission; it uses drake:gear_ratio); the
+    README's line drops exactly those."""
+    import logging
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    assert SILENCE_DRAKE in readme
+
+    class Records(logging.Handler):
+        def __init__(self):
+            super().__init__()
+            self.messages = []
+
+        def emit(self, record):
+            self.messages.append(record.getMessage())
+
+    def load():
+        records = Records()
+        logger.addHandler(records)
+        try:
+            builder = drake.DiagramBuilder()
+            plant, _ = drake.AddMultibodyPlantSceneGraph(builder, time_step=1e-4)
+            drake.Parser(plant).AddModels(str(case.urdf))
+        finally:
+            logger.removeHandler(records)
+        return records.messages
+
+    logger = logging.getLogger("drake")
+    filters = list(logger.filters)
+    messages = load()
+    reductions = 0 if case.config.actuation.motor is None else 3
+    assert sum("joint friction" in m for m in messages) == 3
+    assert sum("mechanical reductions" in m for m in messages) == reductions
+    assert len(messages) == 3 + reductions
+    try:
+        exec(SILENCE_DRAKE, {"logging": logging})
+        assert load() == []
+    finally:
+        logger.filters[:] = filters

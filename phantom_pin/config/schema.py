@@ -241,7 +241,8 @@ class Config:
     ``name``: the model's name (phantom_pin.models()) or the folder's path; ``folder``;
     ``overridden``: whether overrides were applied; ``kinematics`` (m); ``gravity`` (m/s^2,
     along base_link's -z); ``links``: the seven URDF links in full (Inertial by link name,
-    without prefix); ``report``: the report's numbers where the configuration is written
+    without prefix); ``housing``: the fixed housing, base_link's inertial (an ESTIMATE, for
+    the tools that drop a root link without one: Gazebo's sdformat); ``report``: the report's numbers where the configuration is written
     in the report's terms (else None: closed_form does not apply), and ``unprinted``, what
     its links need beyond them (report.parameters.Unprinted, or None); ``actuation``,
     ``limits`` (box and stops), ``mujoco``, ``visual`` (the primitive geometry, read-only
@@ -254,6 +255,7 @@ class Config:
     kinematics: Kinematics
     gravity: float
     links: Mapping[str, Inertial]
+    housing: Inertial
     report: ReportParameters | None
     unprinted: Unprinted | None
     actuation: Actuation
@@ -433,6 +435,23 @@ def _report(r: _Reader, kinematics: Kinematics,
     return report, unprinted, report_links(report, unprinted, *actuation.rotor)
 
 
+def _inertial(r: _Reader, *keys: str) -> Inertial:
+    """A body in full at ``keys`` of physical_parameters.yaml: mass, com, inertia."""
+    arg = "physical_parameters_file"
+    return Inertial(r.number(arg, *keys, "mass", positive=True), r.vector(arg, *keys, "com", length=3),
+                    tuple(r.number(arg, *keys, "inertia", k) for k in INERTIA_KEYS))
+
+
+def _housing(r: _Reader) -> Inertial:
+    """The fixed housing under the turret, base_link's inertial (physical_parameters.yaml's
+    ``housing``): it moves with nothing, so it enters no joint's dynamics."""
+    housing = _inertial(r, "housing")
+    trouble = problem(housing)
+    if trouble:
+        raise r.error("physical_parameters_file", f"housing: {trouble}")
+    return housing
+
+
 def _links(r: _Reader, kinematics: Kinematics) -> dict[str, Inertial]:
     """The seven links of physical_parameters.yaml in the URDF's form: the five bodies in
     full (``links``) with the hinge pins (``hinge_pin``) carved out of their neighbours,
@@ -444,10 +463,7 @@ def _links(r: _Reader, kinematics: Kinematics) -> dict[str, Inertial]:
     if not isinstance(listed, dict) or set(listed) != set(BODIES):
         raise r.error(arg, f"links must name exactly the bodies {', '.join(BODIES)}, got "
                            f"{sorted(listed) if isinstance(listed, dict) else listed!r}")
-    bodies = {name: Inertial(r.number(arg, "links", name, "mass", positive=True),
-                             r.vector(arg, "links", name, "com", length=3),
-                             tuple(r.number(arg, "links", name, "inertia", k) for k in INERTIA_KEYS))
-              for name in BODIES}
+    bodies = {name: _inertial(r, "links", name) for name in BODIES}
     for name, body in bodies.items():  # before the carving, so that the error names the body's own keys
         trouble = problem(body)
         if trouble:
@@ -488,7 +504,7 @@ def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool)
             keys = f"links.{link}, hinge_pin" if report is None else REPORT_KEYS[link]
             raise r.error("physical_parameters_file", f"link {link}: {trouble} (from {keys})")
     return Config(name, folder, overridden, kinematics, r.number("physical_parameters_file", "gravity", positive=True),
-                  types.MappingProxyType(links), report, unprinted, actuation, _limits(r), _mujoco(r),
+                  types.MappingProxyType(links), _housing(r), report, unprinted, actuation, _limits(r), _mujoco(r),
                   _freeze(documents["visual_parameters_file"]), types.MappingProxyType(_sources(r)))
 
 

@@ -47,11 +47,13 @@ def _process(source: Path, mappings: dict[str, str]) -> str:
 
 
 def links_yaml(config: Config, robot: str = "phantom_1_5") -> str:
-    """The YAML text of ``config.links`` (links_file of the xacro), with its header. Numbers
+    """The YAML text of ``config.links`` and of base_link's ``config.housing`` (links_file of
+    the xacro), with its header. Numbers
     keep their type, so that xacro prints an exact zero given as an integer as ``0``."""
+    every = {"base_link": config.housing, **config.links}
     document = {"links": {name: {"mass": link.mass, "com": list(link.com),
                                  "inertia": dict(zip(INERTIA_KEYS, link.inertia))}
-                          for name, link in config.links.items()}}
+                          for name, link in every.items()}}
     return (_LINKS_HEADER.format(name=config.name, robot=robot)
             + yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=110))
 
