@@ -173,18 +173,33 @@ def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, ca
     assert code == 2 and "--force" in err
 
 
-def test_show_serves_on_loopback_until_interrupted(tmp_path):
-    process = subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "show"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+@pytest.mark.parametrize("stop, parent_ignores_sigint", [
+    (signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, True)])
+def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
+    """Ctrl-C or SIGTERM stops `show` and its server, also when the parent started it with
+    SIGINT ignored (as background jobs and some CI shells do: Python then ignores SIGINT).
+    Whatever happens, the command's whole session is killed at the end: nothing leaks."""
+    def ignore_sigint():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    process = subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "show"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True,
+                               preexec_fn=ignore_sigint if parent_ignores_sigint else None)
+    url = None
     try:
         line = process.stdout.readline()
         url = line.split(" at ")[1].split()[0]
         assert url.startswith("http://127.0.0.1:")
         with urllib.request.urlopen(url, timeout=10) as response:
             assert response.status == 200
-    finally:
-        process.send_signal(signal.SIGINT)
+        process.send_signal(stop)
         assert process.wait(30) == 0
+    finally:
+        if process.poll() is None:  # never leak the command or its server (same session)
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+        process.stdout.close()
+        process.stderr.close()
     with pytest.raises(urllib.error.URLError):  # the server went with the command
         urllib.request.urlopen(url, timeout=5)
 

@@ -7,6 +7,8 @@ import contextlib
 import io
 import json
 import re
+import signal
+import threading
 import time
 from pathlib import Path
 
@@ -206,13 +208,26 @@ class Viewer:
         return output
 
     def wait(self) -> None:
-        """Block until Ctrl-C (KeyboardInterrupt), keeping the live viewer served; raise
-        PhantomPinError if the server process ends first."""
+        """Block until Ctrl-C (SIGINT) or SIGTERM, keeping the live viewer served; raise
+        PhantomPinError if the server process ends first.
+
+        In the main thread it listens to both signals itself while it waits, even where the
+        parent started it with SIGINT ignored (as background jobs and some CI shells do, and
+        as Python then leaves it), and restores the previous handlers afterwards."""
+        def interrupt(*_: object) -> None:
+            raise KeyboardInterrupt
+
+        handlers = {}
+        if threading.current_thread() is threading.main_thread():
+            handlers = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
         try:
             while self.server.running:
                 time.sleep(0.5)
         except KeyboardInterrupt:
             return
+        finally:
+            for sig, handler in handlers.items():
+                signal.signal(sig, handler)
         raise PhantomPinError(f"the meshcat server stopped (exit code {self.server.process.returncode})")
 
     def close(self) -> None:
