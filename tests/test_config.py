@@ -9,6 +9,7 @@ import importlib
 from pathlib import Path
 
 import numpy as np
+import yaml
 import pytest
 
 import phantom_pin
@@ -233,3 +234,50 @@ def test_malformed_override_file_raises_naming_the_file(tmp_path):
     bad.write_text("- l1\n- 0.2\n")
     with pytest.raises(ParameterFileError, match="bad.yaml: expected a mapping"):
         read_overrides(bad)
+
+
+@pytest.mark.parametrize("name", config.models())
+def test_sampled_postures_fill_exactly_the_yamls_limits(name):
+    """20000 seeded postures against joint_limits.yaml read here: inside the box, the stops and
+    both coupled stops, and reaching each coupled stop to 0.02 rad (so a swapped or tightened
+    coupled limit is seen)."""
+    data = yaml.safe_load((config.MODELS[name].config / "joint_limits.yaml").read_text())
+    joints = ("joint1", "joint2", "joint3")
+    lower = np.maximum([data[j]["lower"] for j in joints], [data["stops"][j]["lower"] for j in joints])
+    upper = np.minimum([data[j]["upper"] for j in joints], [data["stops"][j]["upper"] for j in joints])
+    forward, backward = data["stops"]["theta2_minus_theta3_max"], data["stops"]["theta3_minus_theta2_max"]
+    theta = random_states(config.read(name).limits, 20000, seed=5)[0]
+    assert (theta >= lower).all() and (theta <= upper).all()
+    difference = theta[:, 1] - theta[:, 2]
+    assert difference.max() <= forward and -difference.max() >= -forward
+    assert (-difference).max() <= backward
+    assert difference.max() > forward - 0.02 and (-difference).max() > backward - 0.02
+
+
+@pytest.mark.parametrize("value, accepted", [(2 * np.pi - 0.1, True), (2 * np.pi + 0.1, False)])
+def test_a_joint_limit_is_within_one_turn(value, accepted):
+    overrides = {"joint_limits.joint3.upper": value, "joint_limits.stops.joint3.upper": value}
+    if accepted:
+        assert config.read("premium_1_5", overrides).limits.upper[2] == value
+    else:
+        with pytest.raises(ParameterFileError, match=r"joint3.upper must be within one turn"):
+            config.read("premium_1_5", overrides)
+
+
+def test_shipped_checks_the_committed_urdf(tmp_path, monkeypatch):
+    """shipped() reads the committed files: a committed URDF with a non-physical link is
+    refused, naming the file."""
+    from phantom_pin.description.build import shipped
+
+    model = config.MODELS["premium_1_5"]
+    text = model.urdf.read_text()
+    bad = tmp_path / "phantom_1_5.urdf"
+    bad.write_text(text.replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>', 1))
+    assert bad.read_text() != text
+    monkeypatch.setitem(config.MODELS, "premium_1_5", dataclasses.replace(model, urdf=bad))
+    shipped.cache_clear()
+    try:
+        with pytest.raises(ParameterFileError, match=str(bad)):
+            shipped("premium_1_5")
+    finally:
+        shipped.cache_clear()

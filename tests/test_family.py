@@ -15,7 +15,7 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from phantom_pin import load
+from phantom_pin import describe, load
 from phantom_pin.config import MODELS, models
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin import config
@@ -104,3 +104,18 @@ def test_every_tip_follows_eq10_with_its_own_lengths(name):
         reach = l1 * np.cos(t2) + l2 * np.sin(t3)
         expected = [np.sin(t1) * reach, l2 - l2 * np.cos(t3) + l1 * np.sin(t2), -l1 + np.cos(t1) * reach]
         np.testing.assert_allclose(position, expected, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", models())
+def test_the_mjcfs_contact_excludes_are_the_srdfs_disabled_pairs(name):
+    """MuJoCo excludes only parent-child pairs by itself: every pair the SRDF disables
+    ("Adjacent" and "Never") must be an MJCF exclude, and no other."""
+    import xml.etree.ElementTree as ET
+
+    fresh = describe(name)  # generated now: the committed files are compared with it elsewhere
+    srdf = ET.fromstring(fresh.srdf)
+    disabled = {frozenset((p.get("link1"), p.get("link2"))) for p in srdf.iter("disable_collisions")}
+    mjcf = ET.fromstring(fresh.mjcf)
+    excluded = [frozenset((e.get("body1"), e.get("body2"))) for e in mjcf.iter("exclude")]
+    assert len(excluded) == len(set(excluded)) and set(excluded) == disabled
+    assert {reason.get("reason") for reason in srdf.iter("disable_collisions")} == {"Adjacent", "Never"}

@@ -7,7 +7,7 @@ import yaml
 
 from phantom_pin.cli import main
 from phantom_pin.identification import io
-from phantom_pin import describe
+from phantom_pin import closed_form, describe
 from phantom_pin.identification.excitation import continuous_effort
 from conftest import CONFIG, CONFIG_DIR, REPORT
 
@@ -130,3 +130,34 @@ def test_excitation_respects_a_tight_torque_limit():
     tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + 5e-4 * dtheta + 0.01 * np.tanh(dtheta / 0.1)
     share = np.abs(tau).max(axis=0) / EFFORT
     assert share.max() <= 0.2 * 1.02 and share.max() >= 0.15, share
+
+
+def test_excite_writes_whole_periods_and_consistent_columns(tmp_path, capsys):
+    """--duration 7 --period 5 rounds up to two whole periods (10 s); over the whole file the
+    accelerations are the rates' derivatives (central differences) and the torques are the
+    report's inverse dynamics (closed form) plus the configuration's friction law, written out
+    here: viscous dtheta + coulomb tanh(dtheta / smoothing_speed)."""
+    path = tmp_path / "traj.csv"
+    code, _, _ = run(capsys, "excite", "-o", path, "--duration", "7", "--period", "5", "--rate", "500",
+                     "--iterations", "3", "--restarts", "1")
+    assert code == 0
+    table = np.loadtxt(path, delimiter=",", skiprows=1)
+    t, theta, dtheta, ddtheta, tau = table[:, 0], table[:, 1:4], table[:, 4:7], table[:, 7:10], table[:, 10:13]
+    assert t[-1] == pytest.approx(10.0, abs=1e-12) and len(t) == 5001
+    derivative = np.gradient(dtheta, t, axis=0)[1:-1]
+    np.testing.assert_allclose(ddtheta[1:-1], derivative, rtol=0, atol=2e-3 * np.abs(ddtheta).max())
+    friction = CONFIG.actuation.friction
+    expected = (closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + friction.viscous * dtheta
+                + friction.coulomb * np.tanh(dtheta / friction.smoothing_speed))
+    np.testing.assert_allclose(tau, expected, rtol=0, atol=1e-12 * np.abs(expected).max() + 1e-15)
+
+
+def test_one_friction_value_is_written_only_when_the_joints_agree():
+    """friction_overlay: the inverse-variance mean when every joint lies within max(3 sigma,
+    20 % of the mean) of it, else None. Joint 3 here lies 0.27 from the mean of 1.033: 27 of its
+    sigmas, and 26 % of the mean, so no common value."""
+    mean = io.friction_overlay(np.array([1.0, 1.01, 0.99]), np.array([0.01, 0.01, 0.01]))
+    assert mean == pytest.approx(1.0, abs=1e-12)
+    assert io.friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.01])) is None
+    # within 3 sigma though 26 % apart: one value
+    assert io.friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.1])) is not None

@@ -17,6 +17,7 @@ from phantom_pin.identification import constants, io, simulation
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
+from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.loader import PhantomLoader
 from phantom_pin.description.physical import check_urdf
 from conftest import CONFIG, REPORT
@@ -75,19 +76,26 @@ def identified(tmp_path_factory):
 
 
 def test_overlay_is_accepted_by_phantom_and_mujoco(identified, tmp_path):
+    """The overlay's written files, each against the closed form of the overlay's report
+    numbers (read from id.yaml): Pinocchio on id.urdf + id.srdf, and MuJoCo on id.mjcf
+    (mass matrix with the rotors, and gravity, through the mimic coupling)."""
     import mujoco
 
-    phantom = Phantom(overlaid(identified / "id.yaml"))
+    from test_interop import MujocoArm
+
+    report = overlaid(identified / "id.yaml").config.report
     loader = type("Identified", (PhantomLoader,), {"urdf_path": identified / "id.urdf",
                                                    "srdf_path": identified / "id.srdf"})
     robot = load(loader)
-    theta = sample(20, 13)
-    for q in theta:
-        np.testing.assert_allclose(phantom.mass_matrix(q), pin.crba(robot.model, robot.data, q), atol=1e-15)
-    model = mujoco.MjModel.from_xml_path(str(identified / "id.mjcf"))
-    np.testing.assert_allclose(model.body_mass[model.body("upper_arm_link").id],
-                               phantom.coupling.tree.inertias[phantom.coupling.tree.getJointId("joint2")].mass,
-                               rtol=1e-12)
+    arm = MujocoArm(mujoco.MjModel.from_xml_path(str(identified / "id.mjcf")),
+                    Coupling((identified / "id.urdf").read_text()))
+    for q in sample(20, 13):
+        mass = closed_form.mass_matrix(q, report)
+        np.testing.assert_allclose(pin.crba(robot.model, robot.data, q), mass, rtol=0, atol=1e-12 * np.abs(mass).max())
+        mujoco_mass, mujoco_gravity = arm.reduced_mass_and_gravity(q)
+        np.testing.assert_allclose(mujoco_mass, mass, rtol=0, atol=1e-9 * np.abs(mass).max())
+        gravity = closed_form.gravity(q, report)
+        np.testing.assert_allclose(mujoco_gravity, gravity, rtol=0, atol=1e-9 * np.abs(gravity).max())
 
 
 def test_identified_urdf_predicts_held_out_torques(identified):

@@ -53,3 +53,20 @@ def test_nearest_consistent_parameters_keep_the_reachable_constants():
     check_urdf(_urdf(x), "the nearest consistent parameters' URDF")
     # M33 = Iaxx + Idfxx + ...: the fit moves Idfxx instead of making the forearm non-physical
     np.testing.assert_allclose(c @ x, target, rtol=1e-6)
+
+
+def test_nearest_keeps_the_rotor_inertia_positive():
+    """An estimate whose I_bexx is 0.3 times the report's (less than joint 2's rotor alone,
+    J r2^2): the nearest consistent parameters must not buy it with a negative rotor inertia,
+    and a negative J is never consistent."""
+    affine, offset = pz.affine_map(DESCRIPTION, BODIES)
+    x0 = pz.report_vector(CONFIG)
+    c = constants.constants_matrix(DESCRIPTION)
+    bad = x0.copy()
+    bad[pz.NAMES.index("segment_be.inertia.xx")] *= 0.3
+    target = c @ bad
+    x = physical.nearest(target, 1.0 / np.abs(target), c, x0, affine, offset, CONFIG)
+    assert x[pz.ROTOR] > 0 and physical.consistent(x, CONFIG)
+    negative = x0.copy()
+    negative[pz.ROTOR] = -1e-7
+    assert not physical.consistent(negative, CONFIG)
