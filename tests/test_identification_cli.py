@@ -161,3 +161,33 @@ def test_one_friction_value_is_written_only_when_the_joints_agree():
     assert io.friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.01])) is None
     # within 3 sigma though 26 % apart: one value
     assert io.friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.1])) is not None
+
+
+@pytest.mark.parametrize("option, message", [
+    (["--duration", "inf"], "--duration: expected a finite positive number"),
+    (["--rate", "inf"], "--rate: expected a finite positive number"),
+    (["--period", "nan"], "--period: expected a finite positive number"),
+    (["--rate", "1e9"], "--duration, --rate: 20 s at 1e+09 Hz is more than 2000000 rows"),
+    (["--duration", "1e300"], "--duration, --rate: 1e+300 s at 1000 Hz is more than 2000000 rows"),
+    (["--period", "1e-300"], "--period: 1e-300 s is outside 0.5..600 s"),
+    (["--rate", "1"], "--rate: 1 Hz samples the highest harmonic (5 / 5 s) fewer than 20 times per cycle"),
+    (["-o", "/nonexistent-folder/traj.csv"], "--output: cannot write in /nonexistent-folder"),
+])
+def test_excite_checks_its_options_before_any_work(tmp_path, capsys, option, message):
+    """One line, exit 2, nothing written, within a second: before the optimisation."""
+    import time
+
+    path = tmp_path / "traj.csv"
+    start = time.monotonic()
+    code, out, err = run(capsys, "excite", "-o", path, *option)
+    assert time.monotonic() - start < 1.0
+    assert code == 2 and err.count("\n") == 1 and message in err, err
+    assert not path.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_excite_writes_at_least_one_period(tmp_path, capsys):
+    path = tmp_path / "traj.csv"
+    code, _, _ = run(capsys, "excite", "-o", path, "--duration", "1e-9", "--rate", "100", "--iterations", "2",
+                     "--restarts", "1")
+    t = np.loadtxt(path, delimiter=",", skiprows=1)[:, 0]
+    assert code == 0 and len(t) == 501 and t[-1] == pytest.approx(5.0)

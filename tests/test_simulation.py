@@ -208,3 +208,19 @@ def test_the_plant_is_phantom_forward_dynamics_with_friction_and_stops():
         result = simulate(theta, h, dtheta0=dtheta, rate=1 / h, substeps=1)
         np.testing.assert_allclose(result.theta[-1], expected[:3], atol=1e-15)
         np.testing.assert_allclose(result.dtheta[-1], expected[3:], rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("duration, rate, stiffness, argument", [
+    (1e300, 1e-300, None, "rate"), (2000.0, 0.001, None, "duration"), (0.1, 1000.0, 1e12, "duration")])
+def test_work_beyond_a_few_minutes_is_refused_at_once(duration, rate, stiffness, argument):
+    """The bound counts RK4 steps (periods x substeps), not samples: a huge period or a
+    stiff stop is refused within a second, naming the argument and the stiffest term."""
+    import time
+
+    from phantom_pin import Device, describe
+
+    device = Device(describe(overrides={"stops.stiffness": stiffness})) if stiffness else None
+    start = time.monotonic()
+    with pytest.raises(InvalidInputError, match=f"^{argument}: .* RK4 steps .* more than 4e\\+06"):
+        simulate(START, duration, rate=rate, device=device)
+    assert time.monotonic() - start < 1.0

@@ -19,6 +19,9 @@ from phantom_pin.validation import as_state
 
 #: Most samples one call may produce (duration * rate + 1).
 MAX_SAMPLES = 1_000_000
+#: Most RK4 steps one call may take (sample periods x substeps): about 4 minutes at the
+#: measured 60 microseconds per step with friction and stops (README, "Speed").
+MAX_STEPS = 4_000_000
 #: RK4 substep h is chosen so that h * LAMBDA <= STEP_SCALE, LAMBDA the fastest rate (1/s)
 #: of the plant's linearised stiff terms (see _substeps).
 STEP_SCALE = 0.25
@@ -137,6 +140,14 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     elif isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
         raise InvalidInputError(f"substeps: expected an integer >= 1, got {substeps!r}")
     substeps = int(substeps)
+    steps = (samples - 1) * substeps
+    if steps > MAX_STEPS:
+        argument = "rate" if substeps > MAX_STEPS else "duration"
+        raise InvalidInputError(
+            f"{argument}: {duration:g} s at {rate:g} Hz needs {steps:.3g} RK4 steps ({samples - 1} periods x "
+            f"{substeps:.3g} substeps of {period / substeps:.2g} s, the step the stiffest term allows: the stops' "
+            f"{device.config.limits.stops.stiffness:g} N m/rad and the friction), more than {MAX_STEPS:.0e} "
+            f"(about 4 minutes)")
 
     model = device.phantom.model
     data = model.createData()

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -12,6 +14,17 @@ from phantom_pin.exceptions import PhantomPinError
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
 CONVENTIONS = ("report", "openhaptics")
+#: Fewest samples per cycle of the excitation's highest harmonic that excite writes.
+MIN_SAMPLES_PER_HARMONIC = 20
+#: Most rows excite writes (13 columns of 8 bytes each in memory: 0.2 GB).
+MAX_ROWS = 2_000_000
+#: The excitation periods excite accepts (s).
+PERIOD_RANGE = (0.5, 600.0)
+
+
+def _periods(duration: float, period: float) -> int:
+    """Whole periods covering ``duration`` (s), at least one."""
+    return max(1, math.ceil(duration / period - 1e-9))
 
 
 def _refuse(path: Path, force: bool) -> None:
@@ -54,17 +67,33 @@ def excite(args: argparse.Namespace, phantom) -> int:
     description = phantom.description
     _refuse(args.output, args.force)
     for name in ("duration", "rate", "period"):
-        if not getattr(args, name) > 0:
-            raise PhantomPinError(f"--{name}: expected a positive number")
+        value = getattr(args, name)
+        if not (math.isfinite(value) and value > 0):
+            raise PhantomPinError(f"--{name}: expected a finite positive number, got {value!r}")
     if args.harmonics < 2 or args.iterations < 1 or args.restarts < 1:
         raise PhantomPinError("--harmonics must be at least 2, --iterations and --restarts at least 1")
+    if not PERIOD_RANGE[0] <= args.period <= PERIOD_RANGE[1]:
+        raise PhantomPinError(f"--period: {args.period:g} s is outside {PERIOD_RANGE[0]:g}..{PERIOD_RANGE[1]:g} s "
+                              "(shorter periods ask more torque than the arm has; longer ones excite nothing)")
+    if args.rate < MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:
+        raise PhantomPinError(f"--rate: {args.rate:g} Hz samples the highest harmonic ({args.harmonics} / "
+                              f"{args.period:g} s) fewer than {MIN_SAMPLES_PER_HARMONIC} times per cycle; use at least "
+                              f"{MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:g} Hz")
+    rows = args.rate * args.period * math.ceil(min(args.duration, MAX_ROWS * args.period) / args.period) + 1
+    if rows > MAX_ROWS:
+        raise PhantomPinError(f"--duration, --rate: {args.duration:g} s at {args.rate:g} Hz is more than {MAX_ROWS} rows "
+                              f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
+    periods = _periods(args.duration, args.period)
+    rows = int(round(periods * args.period * args.rate)) + 1
+    folder = args.output.resolve().parent
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise PhantomPinError(f"--output: cannot write in {folder}")
     try:
         result = excitation.optimise(description, args.period, args.harmonics,
                                      iterations=args.iterations, restarts=args.restarts, seed=args.seed)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
-    periods = int(np.ceil(args.duration / args.period - 1e-9))
-    t = np.arange(int(round(periods * args.period * args.rate)) + 1) / args.rate
+    t = np.arange(rows) / args.rate
     theta, dtheta, ddtheta = result.trajectory(t)
     beta = constants.nominal(description)
     tau = constants.regressor(theta, dtheta, ddtheta, description) @ beta
