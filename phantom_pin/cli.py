@@ -90,8 +90,9 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
     lines += [f"{j['name']:8} {j['lower']:10.3f} {j['upper']:10.3f} {j['velocity']:10.2f} "
               f"{j['effort']:10.3f} {j['armature']:15.4e} "
               f"{'-' if j['ratio'] is None else format(j['ratio'], '5.1f'):>5}" for j in joints]
-    lines += ["", "link            mass[kg]  com[m] (link frame)       inertia xx xy xz yy yz zz at the COM [kg m2]"]
-    lines += [f"{lk['name']:15} {lk['mass']:8.4f}  {_vector(lk['com'], '{:7.4f}'):26}"
+    width = max(len("link"), *(len(lk["name"]) for lk in links))
+    lines += ["", f"{'link':{width}} mass[kg]  com[m] (link frame)       inertia xx xy xz yy yz zz at the COM [kg m2]"]
+    lines += [f"{lk['name']:{width}} {lk['mass']:8.4f}  {_vector(lk['com'], '{:7.4f}'):26}"
               f"{_vector(lk['inertia'], '{:.3e}')}" for lk in links]
     lines += ["", "rotor inertia: not public (no armature; the links carry the rotors)" if actuation.motor is None
               else f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
@@ -195,12 +196,16 @@ def _write(args: argparse.Namespace) -> int:
     """urdf, srdf, mjcf, links: the files of describe(--model or --config, --prefix, --params and --set)."""
     output = output_path(args.output, args.force, "--output", "--force")
     scene = output_path(args.scene, args.force, "--scene", "--force") if getattr(args, "scene", None) else None
+    if scene is not None and scene.resolve() == output.resolve():
+        raise PhantomPinError(f"--scene: {scene} is the --output file; the scene includes the model, give it its own file")
+    # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
+    robot_file = output.name if scene is None else os.path.relpath(output.resolve(), scene.resolve().parent)
     try:
         overrides = read_overrides(args.params) if args.params else {}
     except PhantomPinError as error:
         raise PhantomPinError(f"--params: {error}") from None
     overrides.update(_parse_set(args.set))
-    description = describe(_source(args), prefix=args.prefix, overrides=overrides, robot_file=output.name)
+    description = describe(_source(args), prefix=args.prefix, overrides=overrides, robot_file=robot_file)
     robot = (description.model or MODELS[DEFAULT]).robot_name
     texts = {"urdf": description.urdf, "srdf": description.srdf, "mjcf": description.mjcf,
              "links": links_yaml(description.config, robot)}

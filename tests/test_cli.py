@@ -340,3 +340,24 @@ def test_huge_check_runs_in_bounded_memory_and_ctrl_c_gives_one_line():
     finally:
         process.kill()
     assert process.stderr.read() == "phantom-pin: interrupted\n"
+
+
+def test_mjcf_scene_includes_the_model_from_its_own_folder(tmp_path, capsys, monkeypatch):
+    """-o sub/m.xml --scene s.xml: the scene includes sub/m.xml, and MuJoCo loads it; the scene
+    may not be the model's own file."""
+    import mujoco
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "sub").mkdir()
+    code, _, _ = run(capsys, "mjcf", "-o", "sub/m.xml", "--scene", "s.xml")
+    assert code == 0 and '<include file="sub/m.xml"' in (tmp_path / "s.xml").read_text()
+    assert mujoco.MjModel.from_xml_path(str(tmp_path / "s.xml")).njnt == 7
+    code, _, err = run(capsys, "mjcf", "-o", "m.xml", "--scene", "m.xml")
+    assert code == 2 and err.count("\n") == 1 and "--scene: m.xml is the --output file" in err
+    assert not (tmp_path / "m.xml").exists()
+
+
+def test_info_aligns_every_link_name(capsys):
+    code, out, _ = run(capsys, "info")
+    rows = [line for line in out.splitlines() if line.split(" ")[0].endswith("_link") and "[" in line]
+    assert code == 0 and len(rows) == 7 and len({row.index("[") for row in rows}) == 1

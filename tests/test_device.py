@@ -254,3 +254,27 @@ def test_reachable_is_forward_kinematics_inside_the_stops(device):
     assert device.reachable(shoulder + [0.0, 0.0, 0.3])        # 0.3 m in front, at shoulder height
     assert not device.reachable(shoulder + [0.0, 0.0, -0.3])   # 0.3 m behind: needs theta2 >= 146 deg
     assert device.reachable(shoulder + [[0.0, 0.0, 0.3], [0.0, 0.0, -0.3]]).tolist() == [True, False]
+
+
+@pytest.mark.parametrize("call, argument", [
+    (lambda d: d.encoder_counts([1e16, 0, 0]), "theta"),       # int64 overflow, before: -2**63
+    (lambda d: d.motor_currents([1e308, 0, 0]), "tau"),         # before: inf
+    (lambda d: d.joint_torques([1e308, 0, 0]), "currents"),
+    (lambda d: d.stop_energy([1e200, 0, 0]), "theta"),
+    (lambda d: d.tip_force_capacity([[0.1, 0.3, 0.4]] * 2, [[0.0, 1.0, 0.0]] * 3), "theta"),  # before: NumPy's broadcast error
+])
+def test_huge_or_mismatched_input_is_refused_naming_the_argument(device, call, argument):
+    with pytest.raises(InvalidInputError, match=f"^{argument}"):
+        call(device)
+
+
+def test_tip_force_capacity_of_a_huge_direction_and_along_the_straight_arm(device):
+    """The direction is normalised without overflow (1e308 components: before, inf N); a force
+    along the straight arm (theta3 - theta2 = 90 deg, through the shoulder) loads no joint and
+    is carried by the structure: inf (before: 4.4e15 N from rounding)."""
+    theta = np.array([0.3, 0.2, 0.2 + np.pi / 2])
+    assert device.tip_force_capacity(theta, [1e308, 1e308, 0.0]) == device.tip_force_capacity(theta, [1.0, 1.0, 0.0])
+    shoulder = np.array([0.0, REPORT.l2, -REPORT.l1])          # in frame s (eqs 4-5)
+    along = closed_form.forward_kinematics(theta, REPORT)[:3, 3] - shoulder
+    assert device.tip_force_capacity(theta, along) == np.inf
+    assert np.isfinite(device.tip_force_capacity(theta, [0.0, 1.0, 0.0]))

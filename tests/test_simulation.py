@@ -224,3 +224,16 @@ def test_work_beyond_a_few_minutes_is_refused_at_once(duration, rate, stiffness,
     with pytest.raises(InvalidInputError, match=f"^{argument}: .* RK4 steps .* more than 4e\\+06"):
         simulate(START, duration, rate=rate, device=device)
     assert time.monotonic() - start < 1.0
+
+
+@pytest.mark.parametrize("flag", ["friction", "hard_stops", "saturation", "quantization"])
+def test_flags_are_booleans(flag):
+    """Before, friction="no" kept friction on (a truthy string)."""
+    with pytest.raises(InvalidInputError, match=f"^{flag}: expected True or False, got 'no'"):
+        simulate(START, 0.01, **{flag: "no"})
+
+
+def test_a_complex_torque_is_refused():
+    """Before, NumPy dropped the imaginary part with a ComplexWarning."""
+    with pytest.raises(InvalidInputError, match="^controller: returned"):
+        simulate(START, 0.01, lambda t, theta, dtheta: np.array([1j, 0.0, 0.0]))

@@ -14,7 +14,7 @@ import numpy as np
 from phantom_pin.report import closed_form
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.validation import as_states, same_batch
+from phantom_pin.validation import as_states, finite_result, same_batch
 
 
 
@@ -109,7 +109,9 @@ class Device:
         """Potential energy of the stop springs (J): K/2 * sum of squared penetrations of
         theta1, theta2, theta3 and theta2 - theta3 beyond their stops; zero inside."""
         q, _ = as_states(theta, "theta")
-        return 0.5 * self.config.limits.stops.stiffness * np.sum(self.config.limits.stops.penetration(q) ** 2, axis=-1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            energy = 0.5 * self.config.limits.stops.stiffness * np.sum(self.config.limits.stops.penetration(q) ** 2, axis=-1)
+        return finite_result(energy, "theta")
 
     def stop_torque(self, theta: object, dtheta: object) -> np.ndarray:
         """Torque of the hard stops on the joints (N m): (..., 3).
@@ -171,14 +173,18 @@ class Device:
         MissingDataError without public motor data."""
         self._require("motor", "motor_currents")
         t, _ = as_states(tau, "tau")
-        return t / (self.ratios * self.config.actuation.motor.torque_constant)
+        with np.errstate(over="ignore"):
+            currents = t / (self.ratios * self.config.actuation.motor.torque_constant)
+        return finite_result(currents, "tau")
 
     def joint_torques(self, currents: object) -> np.ndarray:
         """Joint torques (N m) of winding currents (A): ratio * torque_constant * currents.
         MissingDataError without public motor data."""
         self._require("motor", "joint_torques")
         i, _ = as_states(currents, "currents")
-        return i * self.ratios * self.config.actuation.motor.torque_constant
+        with np.errstate(over="ignore"):
+            torques = i * self.ratios * self.config.actuation.motor.torque_constant
+        return finite_result(torques, "currents")
 
     def available_torque(self, theta: object, continuous: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """Joint torques (N m) left for rendering forces at theta after holding gravity.
@@ -205,18 +211,27 @@ class Device:
 
         The force F = f u needs the joint torques J_p^T F (J_p the tip's position Jacobian
         in s); f is the largest f >= 0 within available_torque(theta, continuous); 0 where
-        gravity alone exceeds a limit.
+        gravity alone exceeds a limit. Joints the force does not load (to 1e-12 of the
+        Jacobian's norm) set no bound: inf where none does (a force along the straight arm is
+        carried by the structure).
         """
         q, _ = as_states(theta, "theta")
         u, _ = as_states(direction, "direction")
-        norm = np.linalg.norm(u, axis=-1, keepdims=True)
-        if np.any(norm == 0):
+        if q.ndim > 1 and u.ndim > 1 and q.shape != u.shape:
+            raise InvalidInputError(f"theta {q.shape} and direction {u.shape}: a batch of each must have the same shape")
+        scale = np.abs(u).max(axis=-1, keepdims=True)
+        if np.any(scale == 0):
             raise InvalidInputError("direction: must not be the zero vector")
+        u = u / scale                                         # no overflow in the norm
+        u = u / np.linalg.norm(u, axis=-1, keepdims=True)
         lower, upper = self.available_torque(q, continuous)
-        per_force = np.einsum("...ji,...j->...i", self.tip_jacobian(q), u / norm)  # N m per N
+        jacobian = self.tip_jacobian(q)
+        per_force = np.einsum("...ji,...j->...i", jacobian, u)  # N m per N
+        # a joint the force does not load (to rounding: along the straight arm) sets no bound
+        tiny = 1e-12 * np.linalg.norm(jacobian, axis=(-2, -1))[..., None]
         with np.errstate(divide="ignore", invalid="ignore"):
-            bound = np.where(per_force > 0, upper / per_force,
-                             np.where(per_force < 0, lower / per_force, np.inf))
+            bound = np.where(per_force > tiny, upper / per_force,
+                             np.where(per_force < -tiny, lower / per_force, np.inf))
         return np.clip(bound.min(axis=-1), 0.0, None)
 
     # -- encoders --------------------------------------------------------------------
@@ -233,7 +248,10 @@ class Device:
         from wherever it was switched on and needs a calibration offset."""
         self._require("encoder", "encoder_counts")
         q, _ = as_states(theta, "theta")
-        return np.rint(q * self._counts_per_radian).astype(np.int64)
+        counts = np.rint(q * self._counts_per_radian)
+        if np.abs(counts).max() >= 2.0**62:
+            raise InvalidInputError("theta: too large, its encoder counts overflow a 64-bit integer")
+        return counts.astype(np.int64)
 
     def encoder_theta(self, counts: object) -> np.ndarray:
         """Joint angles (rad) of encoder counts: counts * encoder_resolution."""

@@ -117,6 +117,10 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     Raises InvalidInputError naming the bad argument, or the controller's bad return;
     MissingDataError for ``quantization`` on a model without public encoder data.
     """
+    for name, flag in (("friction", friction), ("hard_stops", hard_stops), ("saturation", saturation),
+                       ("quantization", quantization)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise InvalidInputError(f"{name}: expected True or False, got {flag!r}")
     theta = as_state(theta0, "theta0").copy()
     velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
     duration, rate = _positive(duration, "duration"), _positive(rate, "rate")
@@ -234,9 +238,10 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
 
 
 def _checked(tau: object, t: float) -> np.ndarray:
-    """The controller's torque as a fresh (3,) float array; InvalidInputError otherwise."""
+    """The controller's torque as a fresh (3,) float array; InvalidInputError otherwise (complex
+    values included: NumPy would drop their imaginary part with a warning)."""
     try:
-        array = np.array(tau, dtype=float)
+        array = None if np.iscomplexobj(tau) else np.array(tau, dtype=float)
     except (TypeError, ValueError):
         array = None
     if array is None or array.shape != (3,) or not np.isfinite(array).all():
