@@ -17,7 +17,8 @@ import timeit
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin import Phantom, closed_form as cf
+from phantom_pin import Phantom
+from phantom_pin import closed_form as cf
 from phantom_pin.config.sampling import random_states
 
 

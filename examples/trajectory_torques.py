@@ -16,7 +16,6 @@ import numpy as np
 import common
 from phantom_pin import Phantom, PhantomPinError
 
-
 #: Default start and end postures (rad); the reach is between their tip positions.
 START, END = [-0.5, 0.2, 0.3], [0.5, 0.5, 0.6]
 

@@ -15,15 +15,15 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin.report import appendix, closed_form
 from phantom_pin.config import DEFAULT, FILES, MODELS, models, read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.description.build import Description, describe, description_of, links_yaml
 from phantom_pin.device import cli as device_cli
-from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import commands as identification
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.identification import commands as identification
+from phantom_pin.report import appendix, closed_form
 from phantom_pin.validation import output_path, within_box
 
 #: States evaluated at a time by check: memory stays bounded (tens of MB) whatever -n is.
@@ -197,7 +197,8 @@ def _write(args: argparse.Namespace) -> int:
     output = output_path(args.output, args.force, "--output", "--force")
     scene = output_path(args.scene, args.force, "--scene", "--force") if getattr(args, "scene", None) else None
     if scene is not None and scene.resolve() == output.resolve():
-        raise PhantomPinError(f"--scene: {scene} is the --output file; the scene includes the model, give it its own file")
+        raise PhantomPinError(f"--scene: {scene} is the --output file; the scene includes the model, "
+                              "give it its own file")
     # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
     robot_file = output.name if scene is None else os.path.relpath(output.resolve(), scene.resolve().parent)
     try:

@@ -122,8 +122,9 @@ def gravity(theta) -> np.ndarray:
 # link's COM. It reads the YAML only to be compared with; the reference above never does.
 
 def _numeric_model(folder):
-    import yaml
     from pathlib import Path
+
+    import yaml
 
     folder = Path(folder)
     phys = yaml.safe_load((folder / "physical_parameters.yaml").read_text())
@@ -182,6 +183,7 @@ def _numeric_model(folder):
 
 def _self_check(n: int = 200, seed: int = 20261122) -> tuple[float, float]:
     from pathlib import Path
+
     import yaml
 
     folder = Path(__file__).resolve().parent.parent / "robots/phantom_description/config/premium_1_5_cad"

@@ -17,7 +17,8 @@ import pinocchio as pin
 import pytest
 
 from conftest import CONFIG, RAISED, REPORT, dark, frame_pose, patch, render
-from phantom_pin import closed_form as cf, describe
+from phantom_pin import closed_form as cf
+from phantom_pin import describe
 from phantom_pin.cli import main
 from phantom_pin.config import MODELS
 from phantom_pin.config.sampling import random_states
@@ -254,7 +255,8 @@ def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, capsys, argv
 
 
 @pytest.mark.parametrize("file, old, new, message", [
-    ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369, upper: 2.076941809873252}", "joint2: {lower: -1e308, upper: 1e308}",
+    ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369, upper: 2.076941809873252}",
+     "joint2: {lower: -1e308, upper: 1e308}",
      "joint2.lower must be within one turn"),
     ("actuation.yaml", "motor:", "motor: [", "not valid YAML at line"),
     ("physical_parameters.yaml", "segment_a:", "segment_a: {", "not valid YAML at line"),

@@ -5,9 +5,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from phantom_pin.report import appendix
-from phantom_pin import InvalidInputError, UnreachableTargetError, closed_form as cf
 from conftest import REPORT
+from phantom_pin import InvalidInputError, UnreachableTargetError
+from phantom_pin import closed_form as cf
+from phantom_pin.report import appendix
 
 
 def _hat(v):
@@ -48,7 +49,8 @@ def test_mdot_minus_2c_is_skew_symmetric(states):
 def test_gravity_is_the_gradient_of_the_potential(states):
     theta = states[0]
     h = 1e-6
-    gradient = np.stack([(cf.potential_energy(theta + h * e, REPORT) - cf.potential_energy(theta - h * e, REPORT)) / (2 * h)
+    gradient = np.stack([(cf.potential_energy(theta + h * e, REPORT)
+                          - cf.potential_energy(theta - h * e, REPORT)) / (2 * h)
                          for e in np.eye(3)], axis=-1)
     np.testing.assert_allclose(cf.gravity(theta, REPORT), gradient, atol=1e-10)
 
@@ -61,7 +63,8 @@ def test_jacobians_follow_their_definitions_eqs_21_and_23(states):
     g_inv = np.linalg.inv(g)
     for i, e in enumerate(np.eye(3)):
         dg = (cf.forward_kinematics(theta + h * e, REPORT) - cf.forward_kinematics(theta - h * e, REPORT)) / (2 * h)
-        for twist, jacobian in ((dg @ g_inv, cf.spatial_jacobian(theta, REPORT)), (g_inv @ dg, cf.body_jacobian(theta, REPORT))):
+        for twist, jacobian in ((dg @ g_inv, cf.spatial_jacobian(theta, REPORT)),
+                                (g_inv @ dg, cf.body_jacobian(theta, REPORT))):
             vee = np.concatenate([twist[:, :3, 3], np.stack([twist[:, 2, 1], twist[:, 0, 2], twist[:, 1, 0]], -1)], -1)
             np.testing.assert_allclose(jacobian[:, :, i], vee, atol=1e-9)
 
@@ -99,7 +102,8 @@ def test_forward_kinematics_of_workspace_points_round_trips():
     radius = rng.uniform(abs(p.l1 - p.l2) * 1.01, (p.l1 + p.l2) * 0.99, (1000, 1))
     target = np.array([0, p.l2, -p.l1]) + radius * direction
     for branch in ("report", "other"):
-        np.testing.assert_allclose(cf.forward_kinematics(cf.inverse_kinematics(target, REPORT, branch), REPORT)[:, :3, 3],
+        solution = cf.inverse_kinematics(target, REPORT, branch)
+        np.testing.assert_allclose(cf.forward_kinematics(solution, REPORT)[:, :3, 3],
                                    target, atol=1e-12)
 
 

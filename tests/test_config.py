@@ -2,15 +2,15 @@
 files raise ParameterFileError naming the file and the key; named models."""
 
 import dataclasses
+import importlib
 import inspect
 import pkgutil
 import shutil
-import importlib
 from pathlib import Path
 
 import numpy as np
-import yaml
 import pytest
+import yaml
 
 import phantom_pin
 from phantom_pin import Device, InvalidInputError, ParameterFileError, Phantom, config, describe
@@ -159,7 +159,8 @@ def test_coupled_stops_that_leave_no_posture_are_refused(folder, forward, backwa
         with pytest.raises(ParameterFileError, match=f"joint_limits.yaml: .*{message}"):
             call(folder)
     with pytest.raises(ParameterFileError, match=f"after the overrides, .*{message}"):  # as overrides
-        config.read("premium_1_5", {"stops.theta2_minus_theta3_max": forward, "stops.theta3_minus_theta2_max": backward})
+        config.read("premium_1_5", {"stops.theta2_minus_theta3_max": forward,
+                                    "stops.theta3_minus_theta2_max": backward})
 
 
 def test_random_states_refuses_a_sliver_instead_of_looping():
@@ -205,7 +206,8 @@ def test_malformed_files_are_named(folder, file, old, new, message):
 def test_negative_friction_is_refused_as_an_override_before_any_model():
     """Before, Phantom(describe(overrides={"actuation.friction.viscous": -5e-4})) raised
     Pinocchio's raw "min_dry_friction" traceback and `urdf --set` wrote damping="-1"."""
-    with pytest.raises(ParameterFileError, match="after the overrides, .*actuation.yaml: friction.viscous must not be negative"):
+    with pytest.raises(ParameterFileError,
+                       match="after the overrides, .*actuation.yaml: friction.viscous must not be negative"):
         describe(overrides={"actuation.friction.viscous": -5e-4})
 
 

@@ -7,8 +7,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from phantom_pin.dynamics.coupling import Coupling, read_mimic_tags
 from conftest import URDF_PATH
+from phantom_pin.dynamics.coupling import Coupling, read_mimic_tags
 
 
 def _robots_dir() -> Path:
@@ -39,7 +39,8 @@ def test_projection_equals_pinocchio_mimic_model(relative):
         mt = pin.crba(tree, td, qt)
         np.testing.assert_allclose(np.triu(m), np.triu(coupling.project(np.triu(mt) + np.triu(mt, 1).T)), atol=1e-12)
         np.testing.assert_allclose(pin.rnea(reduced, rd, q, v, a),
-                                   coupling.project_force(pin.rnea(tree, td, qt, coupling.tangent(v), coupling.tangent(a))),
+                                   coupling.project_force(pin.rnea(tree, td, qt, coupling.tangent(v),
+                                                                   coupling.tangent(a))),
                                    atol=1e-10)
         pin.computeJointJacobians(reduced, rd, q)
         pin.framesForwardKinematics(reduced, rd, q)
@@ -59,4 +60,5 @@ def test_phantom_coupling_matrix_comes_from_the_mimic_tags():
     assert list(coupling.tree.names[1:]) == ["joint1", "joint2", "joint3", "crank_pin_a", "crank_pin_b",
                                              "forearm_pin_a", "forearm_pin_b"]
     np.testing.assert_array_equal(coupling.matrix, expected)
-    assert set(read_mimic_tags(URDF_PATH.read_text())) == {"crank_pin_a", "crank_pin_b", "forearm_pin_a", "forearm_pin_b"}
+    assert set(read_mimic_tags(URDF_PATH.read_text())) == {"crank_pin_a", "crank_pin_b", "forearm_pin_a",
+                                                           "forearm_pin_b"}

@@ -109,7 +109,8 @@ def test_joints_are_the_report_thetas_and_the_parallelogram_mimics(urdf_root):
         assert joints[name].find("axis").get("xyz") == axis
     for name, primary, multiplier in PASSIVE:
         mimic = joints[name].find("mimic")
-        assert (mimic.get("joint"), float(mimic.get("multiplier")), float(mimic.get("offset"))) == (primary, multiplier, 0.0)
+        assert (mimic.get("joint"), float(mimic.get("multiplier")), float(mimic.get("offset"))) \
+            == (primary, multiplier, 0.0)
     urdf = yourdfpy.URDF.load(str(URDF_PATH))
     assert urdf.actuated_joint_names == ACTUATED
 
@@ -170,7 +171,7 @@ def test_link_inertias_give_back_the_report_values(urdf_root):
         pin_inertia = links.pop(pin_link)
         vertical += pin_inertia.inertia[2, 2]
         links[donor] = links[donor] + pin.Inertia(pin_inertia.mass, pivots[pin_link], np.zeros((3, 3)))
-    links.pop("base_link")  # the fixed housing: not a segment of the report (tests/test_gazebo.py checks it against the YAML)
+    links.pop("base_link")  # the fixed housing, not a segment of the report (test_gazebo.py checks it)
     turret = links.pop("turret_link")
     assert turret.inertia[2, 2] + vertical + armature[0] == pytest.approx(p.Ibaseyy, rel=1e-12)
     for name, inertia in links.items():

@@ -261,7 +261,7 @@ def test_reachable_is_forward_kinematics_inside_the_stops(device):
     (lambda d: d.motor_currents([1e308, 0, 0]), "tau"),         # before: inf
     (lambda d: d.joint_torques([1e308, 0, 0]), "currents"),
     (lambda d: d.stop_energy([1e200, 0, 0]), "theta"),
-    (lambda d: d.tip_force_capacity([[0.1, 0.3, 0.4]] * 2, [[0.0, 1.0, 0.0]] * 3), "theta"),  # before: NumPy's broadcast error
+    (lambda d: d.tip_force_capacity([[0.1, 0.3, 0.4]] * 2, [[0.0, 1.0, 0.0]] * 3), "theta"),  # before: NumPy's error
 ])
 def test_huge_or_mismatched_input_is_refused_naming_the_argument(device, call, argument):
     with pytest.raises(InvalidInputError, match=f"^{argument}"):

@@ -14,7 +14,8 @@ import pytest
 from PIL import Image
 
 from conftest import CONFIG, REPORT, dark, frame_pose, light_grey, patch, render
-from phantom_pin import Device, Phantom, closed_form as cf, load
+from phantom_pin import Device, Phantom, load
+from phantom_pin import closed_form as cf
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

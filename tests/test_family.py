@@ -15,10 +15,9 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from phantom_pin import describe, load
+from phantom_pin import config, describe, load
 from phantom_pin.config import MODELS, models
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin import config
 
 PREFIXES = ("", "left_")
 

@@ -8,7 +8,8 @@ import pinocchio as pin
 import pytest
 
 from conftest import REPORT, URDF_PATH, relative_error
-from phantom_pin import InvalidInputError, closed_form as cf
+from phantom_pin import InvalidInputError
+from phantom_pin import closed_form as cf
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.model import solve_spd
 
@@ -125,7 +126,8 @@ def test_batches_still_check_shapes_and_overflow(phantom):
     for call in (lambda: phantom.forward_dynamics(np.zeros((4, 3)), big, np.zeros((4, 3))),
                  lambda: phantom.inverse_dynamics_derivatives(np.zeros((4, 3)), big, np.zeros((4, 3))),
                  lambda: phantom.inverse_dynamics(np.zeros((4, 3)), big, np.zeros((4, 3))),
-                 lambda: phantom.inverse_dynamics_derivatives(np.array([0.2, 0.4, 0.5]), np.full(3, 1e308), np.zeros(3)),
+                 lambda: phantom.inverse_dynamics_derivatives(np.array([0.2, 0.4, 0.5]), np.full(3, 1e308),
+                                                              np.zeros(3)),
                  lambda: phantom.forward_dynamics(np.zeros(3), np.zeros(3), np.full(3, 1e307))):
         with warnings.catch_warnings():
             warnings.simplefilter("error")  # the error says it; no RuntimeWarning on the way

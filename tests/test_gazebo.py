@@ -99,7 +99,8 @@ def test_every_joint_survives_with_its_axis_limits_and_dynamics(probe, name):
         limit, dynamics = joint.find("limit"), joint.find("dynamics")
         expected = [*(float(v) for v in joint.find("axis").get("xyz").split()),
                     *(float(limit.get(k)) for k in ("lower", "upper", "effort", "velocity")),
-                    *((float(dynamics.get(k)) for k in ("damping", "friction")) if dynamics is not None else (0.0, 0.0))]
+                    *((float(dynamics.get(k)) for k in ("damping", "friction"))
+                      if dynamics is not None else (0.0, 0.0))]
         np.testing.assert_allclose(numbers, expected, rtol=1e-15, atol=0, err_msg=joint.get("name"))
 
 

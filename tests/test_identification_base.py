@@ -6,14 +6,15 @@ import dataclasses
 import numpy as np
 import pytest
 
+from conftest import CONFIG, REPORT
 from phantom_pin import Phantom, describe
-from phantom_pin.report import closed_form
-from phantom_pin.identification import base, constants, parameterization as pz
+from phantom_pin.identification import base, constants
+from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.base import Structured, base_parameters
 from phantom_pin.identification.estimation import base_regressor
 from phantom_pin.identification.regressor import Regressor
+from phantom_pin.report import closed_form
 from test_identification_regressor import states as _states
-from conftest import CONFIG, REPORT
 
 REGRESSOR = Regressor(Phantom())
 DESCRIPTION = REGRESSOR.phantom.description

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 import yaml
 
+from conftest import CONFIG, CONFIG_DIR, REPORT
+from phantom_pin import closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.identification import io
-from phantom_pin import closed_form, describe
 from phantom_pin.identification.excitation import continuous_effort
-from conftest import CONFIG, CONFIG_DIR, REPORT
 
 DESCRIPTION = describe()
 EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
@@ -121,8 +121,8 @@ def test_excitation_respects_a_tight_torque_limit():
     """With 20 % of the continuous torque allowed the constraint is active; the torques,
     computed independently (closed form + the friction law), stay below it between the
     optimiser's samples too (2 % slack)."""
-    from phantom_pin.report import closed_form
     from phantom_pin.identification import excitation
+    from phantom_pin.report import closed_form
 
     result = excitation.optimise(DESCRIPTION, torque_share=0.2, iterations=10, restarts=1)
     t = np.linspace(0, result.trajectory.period, 2001)

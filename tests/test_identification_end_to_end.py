@@ -11,16 +11,16 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from phantom_pin import Phantom, closed_form, load
+from conftest import CONFIG, REPORT
+from phantom_pin import closed_form, load
 from phantom_pin.cli import main
-from phantom_pin.identification import constants, io, simulation
-from phantom_pin.identification import parameterization as pz
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
+from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.loader import PhantomLoader
-from phantom_pin.description.physical import check_urdf
-from conftest import CONFIG, REPORT
+from phantom_pin.identification import constants, io, simulation
+from phantom_pin.identification import parameterization as pz
 
 
 def sample(n, seed):

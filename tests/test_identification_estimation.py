@@ -7,10 +7,10 @@ import re
 import numpy as np
 import pytest
 
+from conftest import CONFIG, REPORT
 from phantom_pin import Phantom, closed_form
 from phantom_pin.cli import main
 from phantom_pin.identification import constants, estimation, io
-from conftest import CONFIG, REPORT
 
 PHANTOM = Phantom()
 RATE = 1000.0

@@ -4,11 +4,12 @@ parameters to an inconsistent estimate generate a URDF that passes it."""
 import numpy as np
 import pytest
 
-from phantom_pin import ParameterFileError, Phantom, describe
-from phantom_pin.identification import constants, parameterization as pz, physical
-from phantom_pin.identification.regressor import Regressor
-from phantom_pin.description.physical import check_urdf
 from conftest import CONFIG, URDF_PATH
+from phantom_pin import ParameterFileError, Phantom, describe
+from phantom_pin.description.physical import check_urdf
+from phantom_pin.identification import constants, physical
+from phantom_pin.identification import parameterization as pz
+from phantom_pin.identification.regressor import Regressor
 
 DESCRIPTION = describe()
 BODIES = Regressor(Phantom(DESCRIPTION)).bodies
@@ -30,7 +31,8 @@ def test_non_physical_links_are_found():
     rotor2 = x[pz.ROTOR] * 11.6**2
     lumped = x.copy()
     lumped[pz.NAMES.index("segment_be.inertia.xx")] = 0.5 * rotor2     # less than the rotor alone
-    with pytest.raises(ParameterFileError, match="upper_arm_link: inertia at the centre of mass is not positive definite"):
+    with pytest.raises(ParameterFileError,
+                       match="upper_arm_link: inertia at the centre of mass is not positive definite"):
         _urdf(lumped)
     rod = x.copy()
     yy, zz = rod[pz.NAMES.index("segment_a.inertia.yy")], rod[pz.NAMES.index("segment_a.inertia.zz")]

@@ -5,12 +5,12 @@ describe() generates through xacro and Pinocchio reads."""
 import numpy as np
 import pytest
 
+from conftest import CONFIG
 from phantom_pin import Phantom, closed_form, describe
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.regressor import Regressor
-from conftest import CONFIG
 
 
 @pytest.fixture(scope="module")

@@ -22,8 +22,9 @@ def _diagonal(mass, com, xx, yy, zz, about_origin=False):
     origin moved to the COM by the parallel-axis theorem."""
     c = np.array(com, dtype=float)
     tensor = np.diag([xx, yy, zz]) - (mass * (c @ c * np.eye(3) - np.outer(c, c)) if about_origin else 0.0)
-    return {"mass": mass, "com": list(com), "inertia": {"xx": float(tensor[0, 0]), "xy": 0.0, "xz": 0.0,
-                                                        "yy": float(tensor[1, 1]), "yz": 0.0, "zz": float(tensor[2, 2])}}
+    inertia = {"xx": float(tensor[0, 0]), "xy": 0.0, "xz": 0.0, "yy": float(tensor[1, 1]), "yz": 0.0,
+               "zz": float(tensor[2, 2])}
+    return {"mass": mass, "com": list(com), "inertia": inertia}
 
 
 def test_the_report_as_five_bodies_in_full_gives_the_report_adapters_links(tmp_path):

@@ -10,9 +10,6 @@ limits: the URDF's joint box and the coupled stops of the configuration's joint_
 """
 
 import dataclasses
-import shutil
-import subprocess
-import sys
 import warnings
 from pathlib import Path
 
@@ -24,9 +21,8 @@ import yaml
 
 from conftest import CONFIG_DIR, relative_error
 from phantom_pin import config
-from phantom_pin.report import closed_form
 from phantom_pin.dynamics.coupling import Coupling
-
+from phantom_pin.report import closed_form
 
 ACTUATED = ("joint1", "joint2", "joint3")
 THETA0 = np.array([0.3, 0.8, 0.4])  # rad, the free swing's rest state (inside every model's stops)

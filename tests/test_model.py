@@ -8,7 +8,8 @@ import pinocchio as pin
 import pytest
 
 from conftest import CONFIG_DIR, REPORT, relative_error
-from phantom_pin import InvalidInputError, Phantom, UnreachableTargetError, closed_form as cf
+from phantom_pin import InvalidInputError, Phantom, UnreachableTargetError
+from phantom_pin import closed_form as cf
 
 TOLERANCE = 1e-9  # relative, both sides exact
 
@@ -68,8 +69,10 @@ def test_inverse_dynamics_derivatives_match_finite_differences(phantom, states):
     d_theta, d_dtheta = phantom.inverse_dynamics_derivatives(theta, dtheta, ddtheta)
     h = 1e-6  # central differences of the closed form: truncation ~h^2, rounding ~1e-16/h
     for i, e in enumerate(np.eye(3)):
-        fd_theta = (cf.inverse_dynamics(theta + h * e, dtheta, ddtheta, REPORT) - cf.inverse_dynamics(theta - h * e, dtheta, ddtheta, REPORT)) / (2 * h)
-        fd_dtheta = (cf.inverse_dynamics(theta, dtheta + h * e, ddtheta, REPORT) - cf.inverse_dynamics(theta, dtheta - h * e, ddtheta, REPORT)) / (2 * h)
+        fd_theta = (cf.inverse_dynamics(theta + h * e, dtheta, ddtheta, REPORT)
+                    - cf.inverse_dynamics(theta - h * e, dtheta, ddtheta, REPORT)) / (2 * h)
+        fd_dtheta = (cf.inverse_dynamics(theta, dtheta + h * e, ddtheta, REPORT)
+                     - cf.inverse_dynamics(theta, dtheta - h * e, ddtheta, REPORT)) / (2 * h)
         np.testing.assert_allclose(d_theta[:, :, i], fd_theta, atol=1e-8)
         np.testing.assert_allclose(d_dtheta[:, :, i], fd_dtheta, atol=1e-8)
 
@@ -150,12 +153,14 @@ def test_modified_parameter_file_is_used(tmp_path, states):
     theta = states[0][:50]
     assert relative_error(modified.inverse_dynamics(*(s[:50] for s in states)),
                           cf.inverse_dynamics(*(s[:50] for s in states), modified.config.report)) < TOLERANCE
-    assert relative_error(modified.forward_kinematics(theta), cf.forward_kinematics(theta, modified.config.report)) < TOLERANCE
+    expected = cf.forward_kinematics(theta, modified.config.report)
+    assert relative_error(modified.forward_kinematics(theta), expected) < TOLERANCE
 
 
 @pytest.mark.parametrize("bad, message", [
     ("abc", "expected numbers"), ({"a": 1}, "expected numbers"), ([[0, 1], [2]], "expected numbers"),
-    ([1j, 0, 0], "expected real numbers"), (np.array([0.1, 0.2, 0.3 + 1e-3j]), "expected real numbers"), (["1", "2", "3"], "expected numbers"),
+    ([1j, 0, 0], "expected real numbers"), (np.array([0.1, 0.2, 0.3 + 1e-3j]), "expected real numbers"),
+    (["1", "2", "3"], "expected numbers"),
 ])
 @pytest.mark.parametrize("argument", [0, 1, 2])
 def test_inverse_dynamics_single_state_names_every_bad_argument(phantom, bad, message, argument):
@@ -167,7 +172,8 @@ def test_inverse_dynamics_single_state_names_every_bad_argument(phantom, bad, me
         phantom.inverse_dynamics(*values)
 
 
-@pytest.mark.parametrize("function", [lambda p, x: cf.mass_matrix(x, REPORT), lambda p, x: cf.forward_kinematics(x, REPORT),
+@pytest.mark.parametrize("function", [lambda p, x: cf.mass_matrix(x, REPORT),
+                                      lambda p, x: cf.forward_kinematics(x, REPORT),
                                       lambda p, x: cf.inverse_dynamics(x, x.real, x.real, REPORT),
                                       lambda p, x: p.within_limits(x), lambda p, x: p.gravity(x)])
 def test_complex_input_is_refused_not_truncated(phantom, function):

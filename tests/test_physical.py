@@ -7,13 +7,13 @@ from pathlib import Path
 import pytest
 import yaml
 
+from conftest import CONFIG_DIR, SRDF_PATH, URDF_PATH
 from phantom_pin import ParameterFileError, Phantom
 from phantom_pin.cli import main
-from phantom_pin.dynamics.loader import PhantomLoader, load
 from phantom_pin.config.files import FILES, apply_overrides, read_documents
-from phantom_pin.inertial import TRIANGLE_SLACK
 from phantom_pin.description.physical import check_urdf
-from conftest import CONFIG_DIR, SRDF_PATH, URDF_PATH
+from phantom_pin.dynamics.loader import PhantomLoader, load
+from phantom_pin.inertial import TRIANGLE_SLACK
 
 #: Overrides that write a non-physical link (the issue's list), and the link they break.
 NON_PHYSICAL = [

@@ -13,8 +13,17 @@ import pytest
 import yaml
 import yourdfpy
 
-from phantom_pin import (Device, MissingDataError, ParameterFileError, Phantom, closed_form, config, describe,
-                         drivers, simulate)
+from phantom_pin import (
+    Device,
+    MissingDataError,
+    ParameterFileError,
+    Phantom,
+    closed_form,
+    config,
+    describe,
+    drivers,
+    simulate,
+)
 from phantom_pin.cli import main
 from phantom_pin.config import MODELS, read_overrides
 from phantom_pin.config.sampling import sample_postures
@@ -207,7 +216,8 @@ def test_the_command_line_serves_the_touch(capsys, tmp_path):
 
     a = -theta[0], theta[1], theta[2]
     ubitrack = [-(L1 * np.cos(a[1]) + L2 * np.sin(a[2])) * np.sin(a[0]),
-                L1 * np.sin(a[1]) - L2 * np.cos(a[2]) + L2, -L1 + (L1 * np.cos(a[1]) + L2 * np.sin(a[2])) * np.cos(a[0])]
+                L1 * np.sin(a[1]) - L2 * np.cos(a[2]) + L2,
+                -L1 + (L1 * np.cos(a[1]) + L2 * np.sin(a[2])) * np.cos(a[0])]
     tip = np.array(run("fk", *map(str, theta), "--json")["g_st"])[:3, 3]
     np.testing.assert_allclose(tip, ubitrack, rtol=0, atol=1e-12)
     np.testing.assert_allclose(run("ik", *map(str, ubitrack), "--json")["theta"], theta, rtol=0, atol=1e-12)

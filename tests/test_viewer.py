@@ -14,6 +14,7 @@ from conftest import RAISED, RESTING, dark, frame_pose, patch, red, render
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.viewer import FORCE_SCALE, Viewer
 
+
 @pytest.fixture(scope="module")
 def viewer():
     with Viewer() as v:

@@ -6,10 +6,22 @@ from __future__ import annotations
 from pathlib import Path
 
 from phantom_pin.config.files import FILES, apply_overrides, read_documents, read_overrides
-from phantom_pin.inertial import Inertial
 from phantom_pin.config.models import DEFAULT, MODELS, Model, models, resolve
-from phantom_pin.config.schema import (Actuation, Config, CoupledStops, Encoder, Friction, Kinematics, Limits,
-                                       Motor, MujocoSettings, Scene, Stops, build)
+from phantom_pin.config.schema import (
+    Actuation,
+    Config,
+    CoupledStops,
+    Encoder,
+    Friction,
+    Kinematics,
+    Limits,
+    Motor,
+    MujocoSettings,
+    Scene,
+    Stops,
+    build,
+)
+from phantom_pin.inertial import Inertial
 
 __all__ = ["read", "Config", "Inertial", "models", "Model", "MODELS", "DEFAULT", "FILES", "read_overrides",
            "Actuation", "CoupledStops", "Encoder", "Friction", "Kinematics", "Limits", "Motor",

@@ -17,9 +17,10 @@ from typing import Mapping
 import numpy as np
 
 from phantom_pin.config.files import FILES, is_number
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, without_point_mass
 from phantom_pin.exceptions import ParameterFileError
-from phantom_pin.report.parameters import ReportParameters, Unprinted, links as report_links
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, without_point_mass
+from phantom_pin.report.parameters import ReportParameters, Unprinted
+from phantom_pin.report.parameters import links as report_links
 
 JOINTS = ("joint1", "joint2", "joint3")
 #: The links of the URDF that carry mass, in the order of the kinematic tree.
@@ -242,7 +243,8 @@ class Config:
     ``overridden``: whether overrides were applied; ``kinematics`` (m); ``gravity`` (m/s^2,
     along base_link's -z); ``links``: the seven URDF links in full (Inertial by link name,
     without prefix); ``housing``: the fixed housing, base_link's inertial (an ESTIMATE, for
-    the tools that drop a root link without one: Gazebo's sdformat); ``report``: the report's numbers where the configuration is written
+    the tools that drop a root link without one: Gazebo's sdformat); ``report``: the report's
+    numbers where the configuration is written
     in the report's terms (else None: closed_form does not apply), and ``unprinted``, what
     its links need beyond them (report.parameters.Unprinted, or None); ``actuation``,
     ``limits`` (box and stops), ``mujoco``, ``visual`` (the primitive geometry, read-only
@@ -376,7 +378,8 @@ def _limits(r: _Reader) -> Limits:
         low, high = lo[1] - hi[2], hi[1] - lo[2]
         if forward <= low or -backward >= high:
             raise r.error(arg, f"the coupled stops {-backward:.4f} <= theta2 - theta3 <= {forward:.4f} rad "
-                               f"leave no posture in the {name}, where theta2 - theta3 spans {low:.4f} .. {high:.4f} rad")
+                               f"leave no posture in the {name}, where theta2 - theta3 spans "
+                               f"{low:.4f} .. {high:.4f} rad")
     listed = r.node(arg, "postures")
     if not isinstance(listed, dict) or set(listed) != set(POSTURES):
         raise r.error(arg, f"postures must give exactly {' and '.join(POSTURES)} (the SRDF's named postures, "

@@ -28,9 +28,8 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from phantom_pin.dynamics.coupling import read_mimic_tags
-from phantom_pin.exceptions import ParameterFileError
 from phantom_pin.config import Config, Scene
+from phantom_pin.dynamics.coupling import read_mimic_tags
 
 # (the header names the module as it was when the shipped files were first generated:
 # they stay byte for byte the same)
@@ -187,7 +186,8 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     # the parallelogram's coupled stops, which a URDF cannot express, as a fixed tendon
     # theta2 - theta3 limited to [-(theta3 - theta2)_max, (theta2 - theta3)_max]
     tendon = ET.SubElement(ET.SubElement(mujoco, "tendon"), "fixed", {
-        "name": f"{prefix}parallelogram", "range": _vec([-stops.theta3_minus_theta2_max, stops.theta2_minus_theta3_max])})
+        "name": f"{prefix}parallelogram",
+        "range": _vec([-stops.theta3_minus_theta2_max, stops.theta2_minus_theta3_max])})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint2", "coef": "1"})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint3", "coef": "-1"})
 

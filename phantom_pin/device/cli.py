@@ -15,8 +15,8 @@ import numpy as np
 
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
-from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import PhantomPinError
 
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",

@@ -6,16 +6,15 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
 from phantom_pin.config import Config
 from phantom_pin.config.schema import STOP_COORDINATES
 from phantom_pin.description.build import Description
-import numpy as np
-
-from phantom_pin.report import closed_form
-from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import InvalidInputError, MissingDataError
+from phantom_pin.report import closed_form
 from phantom_pin.validation import as_states, finite_result, same_batch
-
 
 
 class Device:
@@ -110,7 +109,8 @@ class Device:
         theta1, theta2, theta3 and theta2 - theta3 beyond their stops; zero inside."""
         q, _ = as_states(theta, "theta")
         with np.errstate(over="ignore", invalid="ignore"):
-            energy = 0.5 * self.config.limits.stops.stiffness * np.sum(self.config.limits.stops.penetration(q) ** 2, axis=-1)
+            stops = self.config.limits.stops
+            energy = 0.5 * stops.stiffness * np.sum(stops.penetration(q) ** 2, axis=-1)
         return finite_result(energy, "theta")
 
     def stop_torque(self, theta: object, dtheta: object) -> np.ndarray:
@@ -218,7 +218,8 @@ class Device:
         q, _ = as_states(theta, "theta")
         u, _ = as_states(direction, "direction")
         if q.ndim > 1 and u.ndim > 1 and q.shape != u.shape:
-            raise InvalidInputError(f"theta {q.shape} and direction {u.shape}: a batch of each must have the same shape")
+            raise InvalidInputError(f"theta {q.shape} and direction {u.shape}: a batch of each must have "
+                                    "the same shape")
         scale = np.abs(u).max(axis=-1, keepdims=True)
         if np.any(scale == 0):
             raise InvalidInputError("direction: must not be the zero vector")

@@ -12,9 +12,9 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.device.device import Device
+from phantom_pin.dynamics.model import solve_spd
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.integration import rk4_step
-from phantom_pin.dynamics.model import solve_spd
 from phantom_pin.validation import as_state
 
 #: Most samples one call may produce (duration * rate + 1).
@@ -44,7 +44,8 @@ class SimulationResult:
     rad/s: the plant's true state (not quantized). ``tau_commanded`` (K, 3) N m: what the
     controller returned at t[k]; ``tau`` (K, 3) N m: the motor torque applied over
     [t[k], t[k+1]) after saturation (the last row is never applied); ``current`` (K, 3) A:
-    the winding currents of ``tau`` (None for a model without public motor data). ``tip`` (K, 3) m: the tip position in the report's
+    the winding currents of ``tau`` (None for a model without public motor data). ``tip``
+    (K, 3) m: the tip position in the report's
     frame s. ``rate`` Hz and ``substeps`` (RK4 steps per sample period) describe the run.
     """
 
@@ -108,7 +109,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     on the Phantom's mimic model, the computation of Phantom.forward_dynamics),
     ``friction`` Device.friction, ``hard_stops`` Device.stop_torque, and with
     ``saturation`` tau_motor = the command clipped to +-Device.peak_torque (the motors'
-    stall torque, or the configuration's joint_torque_limit). Between samples: fixed-step RK4 with ``substeps`` steps per period
+    stall torque, or the configuration's joint_torque_limit). Between samples: fixed-step RK4
+    with ``substeps`` steps per period
     (default from the stiffest term, see _substeps: 4 at 1 kHz with the shipped numbers),
     and a step in which a stop engages or releases is bisected around the event
     (EVENT_BISECTIONS halvings).
@@ -233,7 +235,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             raise InvalidInputError(f"the state diverged at t = {t + period:.6g} s (torques too large?)")
     return SimulationResult(
         t=np.arange(samples) * period, theta=out_theta, dtheta=out_dtheta, tau=applied,
-        tau_commanded=commanded, current=None if device.config.actuation.motor is None else device.motor_currents(applied),
+        tau_commanded=commanded,
+        current=None if device.config.actuation.motor is None else device.motor_currents(applied),
         tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=substeps)
 
 

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pinocchio as pin
 
-from phantom_pin.description.build import Description, description_of
-from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.config import DEFAULT, MODELS
-from phantom_pin.paths import DESCRIPTION_DIR
+from phantom_pin.description.build import Description, description_of
 from phantom_pin.description.physical import check_urdf
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError
+from phantom_pin.paths import DESCRIPTION_DIR
 
 
 class PhantomLoader:

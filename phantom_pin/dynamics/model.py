@@ -11,11 +11,11 @@ from typing import Callable, Sequence
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.config import Config
 from phantom_pin.description.build import Description, description_of
-from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
+from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.loader import load_rotor_parameters
+from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
 from phantom_pin.validation import as_states, finite_result, same_batch, within_box, wrap_angle
 
 #: Newton iterations and position tolerance (m) of inverse_kinematics.
@@ -296,11 +296,13 @@ class Phantom:
             theta = np.array([t0 + scale * step[0], t1 + scale * step[1], t2 + scale * step[2]])
         return None
 
-    spatial_jacobian = _frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3), twist (v, omega) in frame s.
+    spatial_jacobian = _frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3),
+        twist (v, omega) in frame s.
 
         Pinocchio's WORLD frame Jacobian of ``tip`` in the model rooted at frame s.
         """)
-    body_jacobian = _frame_jacobian("body_jacobian", pin.LOCAL, """Body Jacobian J^b (eq. 24): (..., 6, 3), twist (v, omega) in the tool frame t.""")
+    body_jacobian = _frame_jacobian("body_jacobian", pin.LOCAL, """Body Jacobian J^b (eq. 24): (..., 6, 3),
+        twist (v, omega) in the tool frame t.""")
 
     # -- dynamics --------------------------------------------------------------------
     def mass_matrix(self, theta: object) -> np.ndarray:

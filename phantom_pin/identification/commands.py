@@ -11,7 +11,6 @@ import numpy as np
 
 from phantom_pin.exceptions import PhantomPinError
 
-
 #: The conventions of the CSV columns (phantom_pin.drivers).
 CONVENTIONS = ("report", "openhaptics")
 #: Fewest samples per cycle of the excitation's highest harmonic that excite writes.
@@ -81,7 +80,8 @@ def excite(args: argparse.Namespace, phantom) -> int:
                               f"{MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:g} Hz")
     rows = args.rate * args.period * math.ceil(min(args.duration, MAX_ROWS * args.period) / args.period) + 1
     if rows > MAX_ROWS:
-        raise PhantomPinError(f"--duration, --rate: {args.duration:g} s at {args.rate:g} Hz is more than {MAX_ROWS} rows "
+        raise PhantomPinError(f"--duration, --rate: {args.duration:g} s at {args.rate:g} Hz is more than "
+                              f"{MAX_ROWS} rows "
                               f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1

@@ -13,10 +13,10 @@ from typing import Callable
 
 import numpy as np
 
-from phantom_pin.report import closed_form
 from phantom_pin.config import Friction
 from phantom_pin.identification.io import Log
 from phantom_pin.integration import rk4_step
+from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
 
 

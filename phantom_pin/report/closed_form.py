@@ -10,7 +10,6 @@ contain typos; the corrections, and their evidence, are listed in docs/errata.md
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError

@@ -20,10 +20,10 @@ import umsgpack
 from meshcat.animation import Animation
 from pinocchio.visualize import MeshcatVisualizer
 
-from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.dynamics.loader import load
-from phantom_pin.viewer.server import MeshcatServer
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.validation import as_state, as_states, output_path
+from phantom_pin.viewer.server import MeshcatServer
 
 #: Camera position (m, base_link) from which the whole workspace is in view. meshcat
 #: 0.3's orbit controls always look at the world origin, here the shoulder.
