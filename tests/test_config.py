@@ -283,3 +283,15 @@ def test_shipped_checks_the_committed_urdf(tmp_path, monkeypatch):
             shipped("premium_1_5")
     finally:
         shipped.cache_clear()
+
+
+@pytest.mark.parametrize("overrides, message", [
+    ({"joint_limits.joint1.lower": 0.5, "joint_limits.joint1.upper": 0.5}, "joint1.lower must be below joint1.upper"),
+    ({"joint_limits.stops.joint2.lower": 1.0, "joint_limits.stops.joint2.upper": 1.0},
+     "stops.joint2.lower must be below stops.joint2.upper"),
+    ({"stops.damping": -0.1}, "stops.damping must not be negative"),
+    ({"actuation.friction.coulomb": -0.01}, "friction.coulomb must not be negative"),
+])
+def test_empty_intervals_and_negative_dissipation_are_refused(overrides, message):
+    with pytest.raises(ParameterFileError, match=message):
+        config.read("premium_1_5", overrides)

@@ -77,3 +77,9 @@ def test_info_lists_the_device_data_with_sources(capsys):
     np.testing.assert_allclose(device["stops"]["upper"], np.radians([90, 119, 214]))
     code, out, _ = run(capsys, "info")
     assert "theta3 - theta2 <= 55.0" in out and "118743" in out and "HEDM-5500" in out
+
+
+def test_simulate_warns_once_when_it_starts_inside_a_stop(capsys):
+    assert main(["simulate", "--theta0", "3", "0", "0", "--duration", "0.01"]) == 0
+    err = capsys.readouterr().err
+    assert err == "phantom-pin: warning: --theta0 [3.0, 0.0, 0.0] rad starts beyond the stops, which push it back\n"

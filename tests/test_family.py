@@ -118,3 +118,21 @@ def test_the_mjcfs_contact_excludes_are_the_srdfs_disabled_pairs(name):
     excluded = [frozenset((e.get("body1"), e.get("body2"))) for e in mjcf.iter("exclude")]
     assert len(excluded) == len(set(excluded)) and set(excluded) == disabled
     assert {reason.get("reason") for reason in srdf.iter("disable_collisions")} == {"Adjacent", "Never"}
+
+
+@pytest.mark.parametrize("name", models())
+def test_the_fresh_mjcfs_motors_are_limited_to_the_yamls_torque(name):
+    """Each motor of the generated MJCF limits both its control and its force to ± the
+    actuator torque of actuation.yaml (the motor's continuous torque at its shaft, or the
+    joint_torque_limit without motor data), and the options follow mjcf.yaml."""
+    actuation = yaml.safe_load((MODELS[name].config / "actuation.yaml").read_text())
+    settings = yaml.safe_load((MODELS[name].config / "mjcf.yaml").read_text())
+    model = mujoco.MjModel.from_xml_string(describe(name, robot_file="phantom.xml").mjcf)
+    for i, joint in enumerate(("joint1", "joint2", "joint3")):
+        torque = (actuation["joint_torque_limit"][joint] if actuation["motor"] is None
+                  else actuation["motor"]["max_continuous_torque"])
+        np.testing.assert_array_equal(model.actuator_ctrlrange[i], [-torque, torque])
+        np.testing.assert_array_equal(model.actuator_forcerange[i], [-torque, torque])
+        assert model.actuator_forcelimited[i] and model.actuator_ctrllimited[i]
+    assert model.opt.timestep == settings["timestep"]
+    assert model.opt.integrator == getattr(mujoco.mjtIntegrator, f"mjINT_{settings['integrator'].upper()}")

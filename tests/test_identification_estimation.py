@@ -106,3 +106,22 @@ def test_a_log_of_phantom_pins_own_simulator_gives_the_true_constants():
     assert np.abs(result.theta - reference.theta).max() < 0.01             # it tracked
     fit = estimation.estimate(io.Log(result.t, result.theta, result.tau), PHANTOM)
     assert np.abs(fit.beta - TRUTH).max() < 5e-3 * np.abs(TRUTH).max(), (fit.beta - TRUTH) / np.abs(TRUTH).max()
+
+
+def test_identify_writes_nothing_when_the_overlay_is_not_physical(tmp_path, capsys, monkeypatch):
+    """The overlay is checked (describe() and its physical check of every link) before it is
+    written: here that check refuses it, and no file appears."""
+    from phantom_pin.description import build
+    from phantom_pin.exceptions import ParameterFileError
+
+    def refuse(*args, **kwargs):
+        raise ParameterFileError("link forearm_link: mass must be positive (kg), got -1.0")
+
+    path = tmp_path / "log.csv"
+    data = log()
+    io.write_log(path, data.t, data.theta, data.tau)
+    monkeypatch.setattr(build, "describe", refuse)
+    assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "identified parameters not physically valid" in err
+    assert not (tmp_path / "id.yaml").exists()

@@ -135,3 +135,18 @@ def test_dynamic_parameters_are_pinocchios():
     np.testing.assert_allclose([back.mass, *back.com, *back.inertia], [link.mass, *link.com, *link.inertia],
                                rtol=1e-10, atol=1e-18)
     assert slack(link.tensor) > 0
+
+
+def test_the_triangle_margin_is_relative_to_the_largest_moment():
+    """a + b - c = 2e-12 c at the scale of a hinge pin's moments (1e-6 kg m^2): physical (an
+    absolute margin of 1e-12 kg m^2 would refuse it); 0.5e-12 c is not."""
+    a, b = 0.4e-6, 0.6e-6
+    for share, physical in ((2e-12, True), (0.5e-12, False)):
+        c = (a + b) / (1 + share)
+        link = Inertial(0.01, (0.0, 0.0, 0.0), (a, 0.0, 0.0, b, 0.0, c))
+        assert (problem(link) is None) == physical, (share, problem(link))
+
+
+def test_a_zero_principal_moment_is_not_physical():
+    link = Inertial(0.01, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1e-6, 0.0, 1e-6))   # a rod: a = 0, b = c
+    assert "not positive definite" in problem(link)

@@ -106,3 +106,14 @@ def test_sizes_must_be_positive(geometry):
 def test_malformed_xml_is_a_parameter_file_error():
     with pytest.raises(ParameterFileError, match="mine.urdf: not well-formed XML"):
         check_urdf("<robot", str(Path("mine.urdf")))
+
+
+def test_check_urdf_reads_each_product_of_inertia_into_its_place():
+    """ixx 1, iyy 2, izz 1.5 with ixz 0.6: principal moments 0.6, 1.9, 2 (physical); read with
+    ixz and iyz exchanged they would be 1, 1.1, 2.4, which break the triangle inequality."""
+    link = ('<link name="l"><inertial><origin xyz="0 0 0" rpy="0 0 0"/><mass value="1"/>'
+            '<inertia ixx="1" ixy="0" ixz="0.6" iyy="2" iyz="0" izz="1.5"/></inertial></link>')
+    check_urdf(f'<robot name="r">{link}</robot>', "test")
+    swapped = link.replace('ixz="0.6"', 'ixz="0"').replace('iyz="0"', 'iyz="0.6"')
+    with pytest.raises(ParameterFileError, match="triangle inequality"):
+        check_urdf(f'<robot name="r">{swapped}</robot>', "test")

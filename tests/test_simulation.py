@@ -237,3 +237,17 @@ def test_a_complex_torque_is_refused():
     """Before, NumPy dropped the imaginary part with a ComplexWarning."""
     with pytest.raises(InvalidInputError, match="^controller: returned"):
         simulate(START, 0.01, lambda t, theta, dtheta: np.array([1j, 0.0, 0.0]))
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"dtheta0": [1e6, 0.0, 0.0]},
+     "^dtheta0: 1e\\+06 rad/s is far beyond any joint speed of the arm; the state diverged"),
+    ({"controller": lambda t, theta, dtheta: np.array([1e300, 0.0, 0.0]), "saturation": False},
+     "^controller: it applied up to 1e\\+300 N m with saturation off; the state diverged"),
+    ({"theta0": [0.0, 1e6, 0.0]}, "^theta0: .* beyond the stops, more than a turn"),
+])
+def test_a_diverging_run_names_its_cause(kwargs, message):
+    """Before: "theta: the mass matrix at [nan nan nan] is not positive definite"."""
+    arguments = {"theta0": START, **kwargs}
+    with pytest.raises(InvalidInputError, match=message):
+        simulate(arguments.pop("theta0"), 0.05, arguments.pop("controller", None), **arguments)

@@ -58,6 +58,9 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     result = simulate(args.theta0, args.duration, controller, dtheta0=args.dtheta0, rate=args.rate,
                       friction=not args.no_friction, hard_stops=not args.no_hard_stops,
                       saturation=not args.no_saturation, quantization=args.quantization, device=device)
+    if not device.within_limits(args.theta0):  # after the run: a refused one prints its error alone
+        print(f"phantom-pin: warning: --theta0 {args.theta0} rad starts beyond the stops, which push it back",
+              file=sys.stderr)
     settings = {key: getattr(args, key) for key in ("theta0", "dtheta0", "duration", "rate", "controller",
                                                     "no_friction", "no_hard_stops", "no_saturation",
                                                     "quantization")}

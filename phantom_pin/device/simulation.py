@@ -134,6 +134,10 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         raise InvalidInputError(f"device: expected a phantom_pin.Device or None, got {device!r}")
     if quantization:
         device._require("encoder", "quantization")
+    beyond = float(np.abs(device.config.limits.stops.penetration(theta)).max())
+    if beyond > 2 * math.pi:
+        raise InvalidInputError(f"theta0: {theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a "
+                                "turn: no posture of the arm")
     samples = math.floor(duration * rate * (1 + 1e-12)) + 1
     if samples < 2:
         raise InvalidInputError(f"duration: {duration} s is shorter than one sample period (1 / rate = {1 / rate} s)")
@@ -185,8 +189,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         bias = pin.nonLinearEffects(model, data, q, v).tolist()
         solution = solve_spd(pin.crba(model, data, q).tolist(),
                              (total[0] - bias[0], total[1] - bias[1], total[2] - bias[2]))
-        if solution is None:  # M(theta) includes the rotors: positive definite everywhere
-            raise InvalidInputError(f"theta: the mass matrix at {q} is not positive definite")
+        if solution is None:  # M(theta) includes the rotors: positive definite at every finite theta
+            raise _Diverged
         return np.array(solution)
 
     def contacts(q: np.ndarray) -> list[bool]:
@@ -229,15 +233,35 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         tau = tau.tolist()
         if k == samples - 1:
             break
-        for _ in range(substeps):
-            theta, velocity = advance(theta, velocity, tau, h, 0)
-        if not (np.isfinite(theta).all() and np.isfinite(velocity).all()):
-            raise InvalidInputError(f"the state diverged at t = {t + period:.6g} s (torques too large?)")
+        try:
+            for _ in range(substeps):
+                theta, velocity = advance(theta, velocity, tau, h, 0)
+            if not (np.isfinite(theta).all() and np.isfinite(velocity).all()):
+                raise _Diverged
+        except _Diverged:
+            raise InvalidInputError(_divergence(t, out_dtheta[0], applied[:k + 1], saturation)) from None
     return SimulationResult(
         t=np.arange(samples) * period, theta=out_theta, dtheta=out_dtheta, tau=applied,
         tau_commanded=commanded,
         current=None if device.config.actuation.motor is None else device.motor_currents(applied),
         tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=substeps)
+
+
+class _Diverged(Exception):
+    """The integrated state left the finite numbers (inside simulate)."""
+
+
+def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool) -> str:
+    """One line naming the likely cause of a state that diverged during the period from ``t``:
+    the largest initial rate or applied torque (what the plant was given)."""
+    rate, torque = float(np.abs(dtheta0).max()), float(np.abs(applied).max())
+    if rate >= 1e3:
+        cause = f"dtheta0: {rate:.3g} rad/s is far beyond any joint speed of the arm"
+    elif not saturation and torque >= 1e3:
+        cause = f"controller: it applied up to {torque:.3g} N m with saturation off"
+    else:
+        cause = f"controller or dtheta0: up to {torque:.3g} N m and {rate:.3g} rad/s at the start"
+    return f"{cause}; the state diverged between t = {t:.6g} s and the next sample"
 
 
 def _checked(tau: object, t: float) -> np.ndarray:
