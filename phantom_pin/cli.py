@@ -23,6 +23,7 @@ from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import commands as identification
+from phantom_pin.progress import Progress
 from phantom_pin.report import appendix, closed_form
 from phantom_pin.validation import output_path, within_box
 
@@ -118,7 +119,9 @@ def _check(args: argparse.Namespace, phantom: Phantom) -> int:
     as_appendix = dataclasses.replace(p, Iayy=appendix.APPENDIX_IAYY)
     excess = 0.0
     generator = np.random.default_rng(args.seed)
+    bar = Progress("check", args.n, enabled=False if args.quiet else None)
     for start in range(0, args.n, CHECK_CHUNK):
+        bar.update(start)
         states = random_states(phantom.config.limits, min(CHECK_CHUNK, args.n - start), generator)
         for name, count in methods.items():
             ours = getattr(phantom, name)(*states[:count])
@@ -129,6 +132,7 @@ def _check(args: argparse.Namespace, phantom: Phantom) -> int:
             printed, bound = appendix.torques(*states)
             excess = max(excess, float((np.abs(closed_form.inverse_dynamics(*states, as_appendix)
                                                 - printed) / bound).max()))
+    bar.close()
     rows = [{"check": f"Phantom.{name} vs closed form (relative)", "max_error": error / (scale or 1.0),
              "tolerance": 1e-9} for name, (error, scale) in worst.items()]
     rows.append({"check": "closed form vs appendix Tau1-3 (error / printed rounding)",
@@ -246,6 +250,8 @@ def _parser() -> argparse.ArgumentParser:
                         help=f"a named configuration: {', '.join(models())} (default {DEFAULT})")
     parser.add_argument("--config", type=Path,
                         help=f"instead of --model, a folder with the parameter files {sorted(FILES.values())}")
+    parser.add_argument("--quiet", "-q", action="store_true",
+                        help="no progress bar on stderr (shown on a terminal when work takes over 2 s)")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     three = {"nargs": 3, "type": float}
     info = sub.add_parser("info", help="joints, limits, links with mass, COM and inertia, rotor data, "

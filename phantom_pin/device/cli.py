@@ -17,6 +17,7 @@ from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.progress import Progress
 
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
@@ -55,9 +56,14 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
             return phantom.gravity(theta)
-    result = simulate(args.theta0, args.duration, controller, dtheta0=args.dtheta0, rate=args.rate,
-                      friction=not args.no_friction, hard_stops=not args.no_hard_stops,
-                      saturation=not args.no_saturation, quantization=args.quantization, device=device)
+    bar = Progress("simulate", 1.0, enabled=False if args.quiet else None)
+    try:
+        result = simulate(args.theta0, args.duration, controller, dtheta0=args.dtheta0, rate=args.rate,
+                          friction=not args.no_friction, hard_stops=not args.no_hard_stops,
+                          saturation=not args.no_saturation, quantization=args.quantization, device=device,
+                          progress=bar.update)
+    finally:
+        bar.close()
     if not device.within_limits(args.theta0):  # after the run: a refused one prints its error alone
         print(f"phantom-pin: warning: --theta0 {args.theta0} rad starts beyond the stops, which push it back",
               file=sys.stderr)

@@ -95,7 +95,8 @@ def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool,
 def simulate(theta0: object, duration: float, controller: Controller | None = None, *,
              dtheta0: object = None, rate: float = 1000.0, friction: bool = True,
              hard_stops: bool = True, saturation: bool = True, quantization: bool = False,
-             device: Device | None = None, substeps: int | None = None) -> SimulationResult:
+             device: Device | None = None, substeps: int | None = None,
+             progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Run ``controller`` against the device from rest (or ``dtheta0``) at ``theta0``.
 
     ``controller(t, theta, dtheta) -> tau`` (s, rad, rad/s -> three joint torques, N m) is
@@ -115,7 +116,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     and a step in which a stop engages or releases is bisected around the event
     (EVENT_BISECTIONS halvings).
 
-    ``device``: the Device to simulate (default: the shipped one, built once).
+    ``device``: the Device to simulate (default: the shipped one, built once). ``progress``:
+    called with the share of the samples done (0..1), for a progress bar.
     Raises InvalidInputError naming the bad argument, or the controller's bad return;
     MissingDataError for ``quantization`` on a model without public encoder data.
     """
@@ -214,6 +216,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     commanded, applied = np.zeros((samples, 3)), np.zeros((samples, 3))
     zero = np.zeros(3)
     for k in range(samples):
+        if progress is not None:
+            progress(k / samples)
         out_theta[k], out_dtheta[k] = theta, velocity
         t = k * period
         if controller is None:

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
 CONVENTIONS = ("report", "openhaptics")
@@ -88,12 +89,16 @@ def excite(args: argparse.Namespace, phantom) -> int:
     folder = args.output.resolve().parent
     if not folder.is_dir() or not os.access(folder, os.W_OK):
         raise PhantomPinError(f"--output: cannot write in {folder}")
+    times = np.arange(rows) / args.rate
+    bar = Progress("excite", 1.0, enabled=False if args.quiet else None)
     try:
-        result = excitation.optimise(description, args.period, args.harmonics,
-                                     iterations=args.iterations, restarts=args.restarts, seed=args.seed)
+        result = excitation.optimise(description, args.period, args.harmonics, iterations=args.iterations,
+                                     restarts=args.restarts, seed=args.seed, times=times, progress=bar.update)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
-    t = np.arange(rows) / args.rate
+    finally:
+        bar.close()
+    t = times
     theta, dtheta, ddtheta = result.trajectory(t)
     beta = constants.nominal(description)
     tau = constants.regressor(theta, dtheta, ddtheta, description) @ beta

@@ -9,6 +9,7 @@ the trajectory starts and ends each period at rest (dtheta = ddtheta = 0 at t = 
 from __future__ import annotations
 
 import dataclasses
+from typing import Callable
 
 import numpy as np
 import scipy.optimize
@@ -70,14 +71,21 @@ class Excitation:
 
 def optimise(description: Description, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
-             restarts: int = 3, iterations: int = 150, seed: int = 0,
+             restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
+             progress: Callable[[float], None] | None = None,
              amplitude_weight: float = 3.0) -> Excitation:
     """Minimise log(condition number) - amplitude_weight x mean log(singular value) of the
     base regressor (columns scaled to unit norm for the first, weighted by the nominal beta
     for the second, so that the torques grow against the noise) over the Fourier
     coefficients, subject to: positions ``margin`` (rad) inside every stop, and the report model's torque (with the
     configuration's friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
-    ``restarts`` seeded random starts; the best feasible result is returned."""
+    ``restarts`` seeded random starts; the best feasible result is returned.
+
+    The optimiser samples a period at ``samples`` points; the result is then checked at
+    ``times`` (s, the file's samples; default: the same points), stepping back towards the
+    start until the stops' margin and the torque share hold there too, and its condition
+    number, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
+    called with the share of the SLSQP iterations done."""
     limits = description.config.limits
     effort = continuous_effort(description)
     beta = constants.nominal(description)
@@ -103,24 +111,45 @@ def optimise(description: Description, period: float = 5.0, harmonics: int = 5,
         return np.concatenate([limits.slack(states[0]).ravel() - margin,
                                (torque_share * effort - np.abs(torque)).ravel() * 10])
 
+    checked = t if times is None else np.unique(np.mod(np.asarray(times, float), period))
+
+    def feasible(free):
+        """The inequalities at the optimiser's points and at ``checked``."""
+        if inequalities(free).min() < -1e-9:
+            return False
+        states = Fourier.from_free(free, harmonics, period)(checked)
+        torque = constants.regressor(*states, description) @ beta
+        return bool(limits.slack(states[0]).min() >= margin - 1e-9
+                    and (torque_share * effort - np.abs(torque)).min() >= -1e-12)
+
     start_q0 = np.array([0.0, 0.35, 0.35])
     best, best_cost = None, np.inf
-    for _ in range(restarts):
+    done = [0]
+
+    def step(_):
+        done[0] += 1
+        if progress is not None:
+            progress(done[0] / (iterations * restarts))
+
+    for restart in range(restarts):
         free0 = np.concatenate([start_q0, rng.normal(0, 0.05, 2 * 3 * (harmonics - 1))])
-        result = scipy.optimize.minimize(cost, free0, method="SLSQP",
+        result = scipy.optimize.minimize(cost, free0, method="SLSQP", callback=step,
                                          constraints=[{"type": "ineq", "fun": inequalities}],
                                          options={"maxiter": iterations, "ftol": 1e-6})
-        # an unfinished run may end outside the limits: step back towards the (small) start
-        for alpha in (1.0, 0.8, 0.6, 0.4, 0.2, 0.0):
+        done[0] = (restart + 1) * iterations
+        # an unfinished run, or the points between the optimiser's, may leave the limits:
+        # step back towards the (small) start
+        for alpha in (1.0, 0.95, 0.9, 0.8, 0.6, 0.4, 0.2, 0.0):
             candidate = free0 + alpha * (result.x - free0)
-            if inequalities(candidate).min() >= -1e-9:
+            if feasible(candidate):
                 if cost(candidate) < best_cost:
                     best, best_cost = candidate, cost(candidate)
                 break
     if best is None:
         raise RuntimeError("excitation: no feasible trajectory found; raise --restarts")
     trajectory = Fourier.from_free(best, harmonics, period)
-    states, phi = evaluate(best)
+    states = trajectory(checked)
+    phi = constants.regressor(*states, description).reshape(-1, len(beta))
     torque = (phi @ beta).reshape(-1, 3)
     return Excitation(trajectory, condition_number(phi), np.abs(torque).max(axis=0),
                       float(limits.slack(states[0]).min()))
