@@ -45,3 +45,21 @@ def test_check_shows_progress_on_a_terminal_unless_quiet(capsys, monkeypatch):
     assert "all checks pass" in out and "\rcheck [" in err and err.endswith("\n")
     assert main(["--quiet", "check", "-n", "500"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_long_work_reports_its_share_done():
+    """simulate once per sample, excite's optimiser once per SLSQP iteration, estimate at its
+    stages: shares in [0, 1], never decreasing."""
+    import numpy as np
+
+    from phantom_pin import describe, simulate
+    from phantom_pin.identification import excitation
+
+    shares = []
+    result = simulate([0.0, 0.3, 0.4], 0.05, progress=shares.append)
+    assert len(shares) == len(result.t) and shares[0] == 0 and shares[-1] == (len(result.t) - 1) / len(result.t)
+    seen = []
+    excitation.optimise(describe(), 5.0, 3, samples=30, iterations=4, restarts=2, progress=seen.append)
+    for values in (shares, seen):
+        assert np.all(np.diff(values) >= 0) and 0 <= values[0] and values[-1] <= 1
+    assert len(seen) >= 2

@@ -125,10 +125,13 @@ def identify(args: argparse.Namespace, phantom) -> int:
 
     _refuse(args.output, args.force)
     log = io.read_log(args.log, args.convention)
+    bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
-        fit = estimation.estimate(log, phantom, args.cutoff)
+        fit = estimation.estimate(log, phantom, args.cutoff, progress=bar.update)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
+    finally:
+        bar.close()
     keys, notes = io.overlay(fit, phantom.config)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)

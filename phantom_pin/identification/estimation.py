@@ -16,6 +16,7 @@ friction, and the nearest physically consistent report parameters.
 from __future__ import annotations
 
 import dataclasses
+from typing import Callable
 
 import numpy as np
 import scipy.signal
@@ -78,15 +79,23 @@ def base_regressor(structured: Structured, theta, dtheta, ddtheta) -> tuple[np.n
     return np.concatenate([phi_x[..., :n] @ pseudo, phi_x[..., n:]], axis=-1), tau0
 
 
-def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: float = 1e-3) -> Fit:
+def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: float = 1e-3,
+             progress: Callable[[float], None] | None = None) -> Fit:
     """Identify beta and the nearest consistent report parameters from a device log, for the
     configuration of ``phantom`` (its report numbers are the prior, its friction law the
-    friction columns). Everything it needs is computed once per Description (cached on it)."""
+    friction columns). Everything it needs is computed once per Description (cached on it).
+    ``progress(share)`` is called as its stages end (filtering, the regressor, the fits)."""
+    def stage(share: float) -> None:
+        if progress is not None:
+            progress(share)
+
     theta, dtheta, ddtheta, tau = filtered(log, cutoff)
+    stage(0.1)
     if len(theta) < 50:
         raise LogError(f"too short: {len(theta)} samples after filtering (need 50)")
     structured = Structured(Regressor(phantom))
     phi, tau0 = base_regressor(structured, theta, dtheta, ddtheta)
+    stage(0.4)
     p = phi.shape[-1]
     stacked, y = phi.reshape(-1, p), (tau - tau0).reshape(-1)
     norms = np.linalg.norm(stacked, axis=0)
@@ -110,7 +119,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: flo
     root = np.linalg.cholesky(info).T                       # root^T root = covariance^-1
     affine, offset = structured.affine, structured.offset
     prior = parameterization.report_vector(phantom.config)
+    stage(0.5)
     x = physical.nearest(beta[:n], root, c, prior, affine, offset, phantom.config, prior_weight)
+    stage(0.7)
     general = structured.regressor.stacked(theta, dtheta, ddtheta)
     base = base_parameters(general, structured.regressor.names)
     independent = general[:, list(base.independent)]
