@@ -136,3 +136,36 @@ def test_the_fresh_mjcfs_motors_are_limited_to_the_yamls_torque(name):
         assert model.actuator_forcelimited[i] and model.actuator_ctrllimited[i]
     assert model.opt.timestep == settings["timestep"]
     assert model.opt.integrator == getattr(mujoco.mjtIntegrator, f"mjINT_{settings['integrator'].upper()}")
+
+
+def test_every_mjcf_describe_accepts_loads_in_mujoco():
+    """Seeded overrides (each segment's mass and inertias x 0.8..1.5 together, BE's centre of
+    mass x 0.8..1.2, the lengths x 0.9..1.1), and the triangle's boundary case that once passed our
+    check and not MuJoCo's: whatever describe() accepts, MuJoCo loads, and each refusal is the
+    physical check's."""
+    from phantom_pin import ParameterFileError
+
+    physical = yaml.safe_load((MODELS["premium_1_5"].config / "physical_parameters.yaml").read_text())
+    kinematics = yaml.safe_load((MODELS["premium_1_5"].config / "kinematics.yaml").read_text())
+    rng = np.random.default_rng(23)
+    cases = [{"segment_a.inertia.xx": 4.8824300001e-05}]
+    for _ in range(12):
+        case = {k: v * rng.uniform(0.9, 1.1) for k, v in kinematics.items()}
+        for segment in ("segment_a", "segment_c", "segment_be", "segment_df"):
+            factor = rng.uniform(0.8, 1.5)
+            case[f"{segment}.mass"] = physical[segment]["mass"] * factor
+            case.update({f"{segment}.inertia.{axis}": value * factor
+                         for axis, value in physical[segment]["inertia"].items()})
+            if segment == "segment_be":  # DF's inertia about the shoulder pins its centre of mass
+                case[f"{segment}.com"] = physical[segment]["com"] * rng.uniform(0.8, 1.2)
+        cases.append(case)
+    loaded = 0
+    for case in cases:
+        try:
+            text = describe("premium_1_5", overrides=case, robot_file="phantom.xml").mjcf
+        except ParameterFileError as error:
+            assert "inertia" in str(error) or "mass" in str(error), error
+            continue
+        mujoco.MjModel.from_xml_string(text)
+        loaded += 1
+    assert loaded >= 6, loaded
