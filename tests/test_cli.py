@@ -328,9 +328,10 @@ def _peak_rss_mb(pid: int) -> float:
 
 
 def test_huge_check_runs_in_bounded_memory_and_ctrl_c_gives_one_line():
-    """check -n 1e11 (2 TiB of states at once before): after 6 s of CPU its peak memory
-    is below 400 MB; Ctrl-C then ends it with one line and exit 130 (128 + SIGINT)."""
-    process = _popen("check", "-n", "100000000000")
+    """check -n 2e7, the most it takes (2 TiB of states at once before, for 1e11): after 6 s of
+    CPU its peak memory is below 400 MB; Ctrl-C then ends it with one line and exit 130
+    (128 + SIGINT). More states are refused at once."""
+    process = _popen("check", "-n", "20000000")
     try:
         deadline = time.monotonic() + 120
         while _cpu_seconds(process.pid) < 6.0 and process.poll() is None and time.monotonic() < deadline:
@@ -363,3 +364,9 @@ def test_info_aligns_every_link_name(capsys):
     code, out, _ = run(capsys, "info")
     rows = [line for line in out.splitlines() if line.split(" ")[0].endswith("_link") and "[" in line]
     assert code == 0 and len(rows) == 7 and len({row.index("[") for row in rows}) == 1
+
+
+def test_check_refuses_more_states_than_a_few_minutes_take(capsys):
+    code, out, err = run(capsys, "check", "-n", "100000000000")
+    assert code == 2 and out == "" and err == ("phantom-pin: error: -n: 100000000000 states is more than 2e+07 "
+                                               "(about 4 minutes); check fewer\n")
