@@ -219,7 +219,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         if progress is not None:
             progress(k / samples)
         out_theta[k], out_dtheta[k] = theta, velocity
-        t = k * period
+        t = k / rate  # as result.t: 9 / 1000 is 0.009, 9 * 0.001 is 0.009000000000000001
         if controller is None:
             tau = zero
         else:
@@ -245,7 +245,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         except _Diverged:
             raise InvalidInputError(_divergence(t, out_dtheta[0], applied[:k + 1], saturation)) from None
     return SimulationResult(
-        t=np.arange(samples) * period, theta=out_theta, dtheta=out_dtheta, tau=applied,
+        t=np.arange(samples) / rate, theta=out_theta, dtheta=out_dtheta, tau=applied,
         tau_commanded=commanded,
         current=None if device.config.actuation.motor is None else device.motor_currents(applied),
         tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=substeps)
