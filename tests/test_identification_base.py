@@ -97,3 +97,18 @@ def test_sample_stays_inside_the_regressors_own_limits():
     assert theta[:, 0].max() <= 0.2 and (narrow.phantom.config.limits.slack(theta) >= 0).all()
     wide = base.sample(REGRESSOR, 300, seed=3)[0]
     assert wide[:, 0].max() > 0.2  # the shipped limits reach beyond: the test can tell them apart
+
+
+def test_a_smooth_excitation_shows_all_26_base_parameters():
+    """On a three-frequency trajectory (tests/test_identification_estimation.py's, sampled at
+    50 Hz) the weakest of the 26 base parameters pivots at about 1e-5 of the strongest: the
+    rank keeps it (a tolerance of 1e-4 would give 25)."""
+    from test_identification_estimation import log
+
+    data = log()
+    rates = np.gradient(data.theta, data.t, axis=0)
+    accelerations = np.gradient(rates, data.t, axis=0)
+    keep = slice(0, None, 20)
+    regressor = Regressor(Phantom())
+    stacked = regressor.stacked(data.theta[keep], rates[keep], accelerations[keep])
+    assert base_parameters(stacked, regressor.names).rank == 26

@@ -99,3 +99,17 @@ def test_affine_map_times_the_regressor_is_the_closed_form_at_other_parameters(r
     tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, pz.report_parameters(x, description.config))
     predicted = regressor(theta, dtheta, ddtheta) @ pi
     assert np.abs(predicted - tau).max() <= 1e-11 * np.abs(tau).max()
+
+
+def test_every_column_is_what_its_name_says(regressor):
+    """rotor_j is ddtheta_j on joint j, viscous_j is dtheta_j, coulomb_j is the law's tanh with
+    unit Coulomb (dtheta_j / smoothing_speed), each on joint j only."""
+    theta, dtheta, ddtheta = states(regressor, 20, 9)
+    y = regressor(theta, dtheta, ddtheta)
+    speed = regressor.phantom.config.actuation.friction.smoothing_speed
+    for j in range(3):
+        for name, expected in ((f"rotor{j + 1}", ddtheta[:, j]), (f"viscous{j + 1}", dtheta[:, j]),
+                               (f"coulomb{j + 1}", np.tanh(dtheta[:, j] / speed))):
+            column = y[:, :, regressor.names.index(name)]
+            np.testing.assert_allclose(column[:, j], expected, rtol=1e-15, atol=0)
+            assert not np.delete(column, j, axis=1).any()
