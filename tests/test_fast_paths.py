@@ -1,4 +1,4 @@
-"""The fast paths of issue 11 against the slow ones: single-state float64 shortcuts, batches
+"""The fast paths against the slow ones: single-state float64 shortcuts, batches
 checked once, closed_form's chunked batches; and the Pinocchio facts they rely on."""
 
 import warnings
