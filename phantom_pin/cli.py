@@ -189,6 +189,16 @@ def _source(args: argparse.Namespace) -> str | Path:
     return args.config if args.config is not None else args.model
 
 
+def _overrides(args: argparse.Namespace) -> dict[str, float]:
+    """The overrides of --params (a YAML file) and then --set KEY=VALUE."""
+    try:
+        overrides = read_overrides(args.params) if args.params else {}
+    except PhantomPinError as error:
+        raise PhantomPinError(f"--params: {error}") from None
+    overrides.update(_parse_set(args.set))
+    return overrides
+
+
 def _parse_set(items: list[str]) -> dict[str, float]:
     out = {}
     for item in items:
@@ -209,12 +219,7 @@ def _write(args: argparse.Namespace) -> int:
                               "give it its own file")
     # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
     robot_file = output.name if scene is None else os.path.relpath(output.resolve(), scene.resolve().parent)
-    try:
-        overrides = read_overrides(args.params) if args.params else {}
-    except PhantomPinError as error:
-        raise PhantomPinError(f"--params: {error}") from None
-    overrides.update(_parse_set(args.set))
-    description = describe(_source(args), prefix=args.prefix, overrides=overrides, robot_file=robot_file)
+    description = describe(_source(args), prefix=args.prefix, overrides=_overrides(args), robot_file=robot_file)
     robot = (description.model or MODELS[DEFAULT]).robot_name
     texts = {"urdf": description.urdf, "srdf": description.srdf, "mjcf": description.mjcf,
              "links": links_yaml(description.config, robot)}
@@ -281,10 +286,6 @@ def _parser() -> argparse.ArgumentParser:
         gen.add_argument("--output", "-o", required=True)
         gen.add_argument("--prefix", default="")
         gen.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
-        gen.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                         help="override one number of the parameter files, e.g. l1=0.2096 or "
-                              "segment_a.mass=0.03 (SI units, rad); repeatable")
-        gen.add_argument("--params", type=Path, help="a YAML file of such overrides (applied before --set)")
         gen.set_defaults(kind=kind)
         if kind == "mjcf":
             gen.add_argument("--scene", help="also write a scene (floor, light, table) that "
@@ -298,6 +299,12 @@ def _parser() -> argparse.ArgumentParser:
     show.add_argument("--open", action="store_true", help="open the live viewer in a browser")
     device_cli.add_parser(sub)
     identification.add_parsers(sub)
+    for command in sub.choices.values():  # every command works on the model with overrides
+        command.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                             help="override one number of the parameter files, e.g. l1=0.2096 or "
+                                  "segment_a.mass=0.03 (SI units, rad); repeatable")
+        command.add_argument("--params", type=Path,
+                             help="a YAML file of such overrides, e.g. identify's (applied before --set)")
     for command in (info, check, fk, ik, dyn):
         command.add_argument("--json", action="store_true", help="print JSON")
     return parser
@@ -314,8 +321,10 @@ def main(argv: list[str] | None = None) -> int:
         args = _parser().parse_args(argv)
         if args.command in ("urdf", "srdf", "mjcf", "links"):
             code = _write(args)
-        else:  # one Description of --model or --config for every other command
-            description = description_of(_source(args), "--config" if args.config else "--model")
+        else:  # one Description of --model or --config (and the overrides) for every other command
+            overrides = _overrides(args)
+            description = (describe(_source(args), overrides=overrides) if overrides
+                           else description_of(_source(args), "--config" if args.config else "--model"))
             code = (_show(args, description) if args.command == "show"
                     else handlers[args.command](args, Phantom(description)))
         sys.stdout.flush()  # a closed pipe raises here, not at exit

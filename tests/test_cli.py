@@ -370,3 +370,23 @@ def test_check_refuses_more_states_than_a_few_minutes_take(capsys):
     code, out, err = run(capsys, "check", "-n", "100000000000")
     assert code == 2 and out == "" and err == ("phantom-pin: error: -n: 100000000000 states is more than 2e+07 "
                                                "(about 4 minutes); check fewer\n")
+
+
+def test_every_command_takes_the_overrides(capsys, tmp_path):
+    """--set and --params reach every command's model: fk with l1, l2 changed follows eq. 10
+    with them (written here); info reports the changed mass; check passes on the changed model."""
+    params = tmp_path / "p.yaml"
+    params.write_text("l1: 0.2\nsegment_a.mass: 0.03\n")
+    code, out, _ = run(capsys, "fk", "0.3", "0.5", "0.7", "--params", str(params), "--set", "l2=0.15", "--json")
+    tip = np.array(json.loads(out)["g_st"])[:3, 3]
+    l1, l2, (t1, t2, t3) = 0.2, 0.15, (0.3, 0.5, 0.7)
+    reach = l1 * np.cos(t2) + l2 * np.sin(t3)
+    np.testing.assert_allclose(tip, [np.sin(t1) * reach, l2 - l2 * np.cos(t3) + l1 * np.sin(t2),
+                                     -l1 + np.cos(t1) * reach], rtol=0, atol=1e-12)
+    code, out, _ = run(capsys, "info", "--params", str(params), "--json")
+    masses = {link["name"]: link["mass"] for link in json.loads(out)["links"]}
+    assert code == 0 and masses["forearm_link"] == pytest.approx(0.03, rel=1e-12)
+    code, out, _ = run(capsys, "check", "-n", "50", "--set", "l1=0.2")
+    assert code == 0 and "all checks pass" in out
+    code, _, err = run(capsys, "dynamics", "--theta", "0", "0", "0", "--set", "foo=1")
+    assert code == 2 and err.count("\n") == 1 and "foo" in err
