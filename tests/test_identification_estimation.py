@@ -125,3 +125,42 @@ def test_identify_writes_nothing_when_the_overlay_is_not_physical(tmp_path, caps
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "identified parameters not physically valid" in err
     assert not (tmp_path / "id.yaml").exists()
+
+
+def test_the_log_reader_takes_the_dialects_users_write(tmp_path):
+    """The same log as comma-separated plain CSV, and with a UTF-8 byte order mark, semicolons,
+    quoted upper-case headers and comment lines, and with tabs and units in the header: the
+    same numbers. A bad row is named by its line."""
+    data = log(end=3.0)
+    plain = tmp_path / "plain.csv"
+    io.write_log(plain, data.t, data.theta, data.tau)
+    table = np.loadtxt(plain, delimiter=",", skiprows=1)
+    rows = [";".join(repr(float(v)) for v in row) for row in table]
+    spreadsheet = tmp_path / "spreadsheet.csv"
+    spreadsheet.write_text("\ufeff# exported by a spreadsheet\n" + ";".join(f'"{c.upper()}"' for c in io.LOG_COLUMNS)
+                           + "\n" + "\n# a pause\n".join(rows[:5]) + "\n" + "\n".join(rows[5:]) + "\n",
+                           encoding="utf-8")
+    tabs = tmp_path / "tabs.tsv"
+    units = ("s",) + ("rad",) * 3 + ("N m",) * 3
+    tabs.write_text("\t".join(f"{c} [{u}]" for c, u in zip(io.LOG_COLUMNS, units)) + "\n"
+                    + "\n".join("\t".join(repr(float(v)) for v in row) for row in table) + "\n")
+    reference = io.read_log(plain)
+    for path in (spreadsheet, tabs):
+        other = io.read_log(path)
+        for name in ("t", "theta", "tau"):
+            np.testing.assert_array_equal(getattr(other, name), getattr(reference, name))
+    broken = tmp_path / "broken.csv"
+    lines = plain.read_text().splitlines()
+    lines[7] = lines[7].replace(",", ",x", 1)
+    broken.write_text("\n".join(lines) + "\n")
+    with pytest.raises(io.LogError, match="line 8 holds a value that is not a number"):
+        io.read_log(broken)
+
+
+def test_the_log_reader_reads_simulates_own_csv(tmp_path, capsys):
+    """phantom-pin simulate --format csv writes t, theta and the applied tau with units in its
+    header, among other columns: the log reader takes it as it is."""
+    assert main(["simulate", "--theta0", "0.2", "0.5", "0.8", "--duration", "3", "--format", "csv",
+                 "-o", str(tmp_path / "run.csv")]) == 0
+    log_ = io.read_log(tmp_path / "run.csv")
+    assert log_.t.shape == (3001,) and log_.theta.shape == (3001, 3)

@@ -1,6 +1,8 @@
 """CSV files of identification: the excitation trajectory and the device log.
 
-Log: header ``t,theta1,theta2,theta3,tau1,tau2,tau3`` (more columns allowed, any order): time
+Log: header ``t,theta1,theta2,theta3,tau1,tau2,tau3`` (more columns allowed, any order, any case,
+quoted or with units in [] as simulate writes them; separated by commas, semicolons or tabs;
+a UTF-8 byte order mark, blank lines and # comment lines are skipped): time
 (s) at a fixed rate, joint angles (rad, the report's theta, as measured) and joint torques
 (N m, as commanded); or, in OpenHaptics' convention (``read_log(path, "openhaptics")``), its
 joint angles (rad) and joint torques (mN m), converted by phantom_pin.drivers. ``read_log``
@@ -55,31 +57,40 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
         raise LogError(f"convention: expected 'report' or 'openhaptics', got {convention!r}")
     path = Path(path)
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        text = path.read_text(encoding="utf-8-sig")           # a UTF-8 byte order mark is dropped
     except (OSError, UnicodeDecodeError) as error:
         raise LogError(f"{path}: cannot read ({error})") from None
+    # (line number, text) of the lines that hold data: blank lines and # comments are skipped
+    lines = [(number, line) for number, line in enumerate(text.splitlines(), start=1)
+             if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
         raise LogError(f"{path}: empty file")
-    header = [name.strip() for name in lines[0].split(",")]
+    first = lines[0][1]
+    separator = max((",", ";", "\t"), key=first.count)        # the dialects spreadsheets write
+    header = [_column_name(name) for name in first.split(separator)]
     missing = [c for c in LOG_COLUMNS if c not in header]
     if missing:
         raise LogError(f"{path}: missing column(s) {', '.join(missing)} (header must name "
-                       f"{','.join(LOG_COLUMNS)})")
-    try:
-        table = np.array([[float(v) for v in line.split(",")] for line in lines[1:] if line.strip()])
-    except ValueError as error:
-        raise LogError(f"{path}: not a number ({error})") from None
-    if table.ndim != 2 or table.shape[1] != len(header):
-        raise LogError(f"{path}: every row must have {len(header)} values")
+                       f"{','.join(LOG_COLUMNS)}, in any order, case or quotes, with or without units in [])")
+    rows = []
+    for number, line in lines[1:]:
+        values = line.split(separator)
+        if len(values) != len(header):
+            raise LogError(f"{path}: line {number} has {len(values)} values, the header {len(header)}")
+        try:
+            rows.append([float(v.strip().strip('"').strip("'")) for v in values])
+        except ValueError:
+            raise LogError(f"{path}: line {number} holds a value that is not a number: {line.strip()[:60]!r}") from None
+    table = np.array(rows, dtype=float).reshape(-1, len(header))
     if not np.isfinite(table).all():
-        row = int(np.where(~np.isfinite(table).all(axis=1))[0][0]) + 2
+        row = lines[1 + int(np.where(~np.isfinite(table).all(axis=1))[0][0])][0]
         raise LogError(f"{path}: NaN or inf on line {row}")
     column = {name: table[:, header.index(name)] for name in LOG_COLUMNS}
     t = column["t"]
     step = np.diff(t)
     if len(t) < 2 or not (step > 0).all():
         raise LogError(f"{path}: time is not strictly increasing"
-                       + (f" (line {int(np.argmin(step > 0)) + 3})" if len(t) >= 2 else ""))
+                       + (f" (line {lines[2 + int(np.argmin(step > 0))][0]})" if len(t) >= 2 else ""))
     if t[-1] - t[0] < MIN_DURATION:
         raise LogError(f"{path}: too short ({t[-1] - t[0]:.3g} s; at least {MIN_DURATION} s)")
     if np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
@@ -89,6 +100,13 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     if convention == "openhaptics":
         theta, tau = drivers.theta_from_openhaptics(theta), drivers.tau_from_openhaptics_torque(tau)
     return Log(t, theta, tau)
+
+
+def _column_name(text: str) -> str:
+    """A header field as a column name: quotes, case, spaces and a unit in [] dropped
+    ("Theta1", '"tau2"', "t [s]" as simulate writes it)."""
+    name = text.strip().strip('"').strip("'").strip()
+    return name.split("[")[0].strip().lower()
 
 
 def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2) -> float | None:
