@@ -207,3 +207,23 @@ def test_the_excitation_holds_its_bounds_at_every_written_sample():
     assert CONFIG.limits.slack(states[0]).min() >= 0.05 - 1e-9
     assert (np.abs(torque) <= 0.8 * EFFORT + 1e-12).all()
     assert result.min_slack == pytest.approx(CONFIG.limits.slack(states[0]).min(), abs=1e-12)
+
+
+def test_excite_simulate_identify_without_code(tmp_path, capsys):
+    """excite -> simulate --trajectory (feed-forward plus PD on the shipped device: Pinocchio,
+    rotors, friction, stops, saturation) -> identify: the eight constants of the written overlay
+    are the shipped model's within 0.5 %."""
+    from phantom_pin.config import read_overrides
+    from phantom_pin.identification import constants
+    from phantom_pin.identification import parameterization as pz
+
+    traj, log, overlay = tmp_path / "traj.csv", tmp_path / "log.csv", tmp_path / "id.yaml"
+    assert run(capsys, "excite", "-o", traj, "--duration", "10", "--iterations", "15", "--restarts", "1")[0] == 0
+    assert run(capsys, "simulate", "--trajectory", traj, "--format", "csv", "-o", log)[0] == 0
+    assert run(capsys, "identify", log, "-o", overlay)[0] == 0
+    identified = describe(overrides=read_overrides(overlay))
+    written = constants.report_constants(pz.report_vector(identified.config), identified)
+    truth = constants.report_constants(pz.report_vector(CONFIG), DESCRIPTION)
+    np.testing.assert_allclose(written, truth, rtol=5e-3)
+    code, _, err = run(capsys, "simulate", "--trajectory", traj, "--duration", "3")
+    assert code == 2 and "--duration: --trajectory sets it" in err

@@ -19,6 +19,9 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.progress import Progress
 
+#: The PD gains of --trajectory's tracking controller (N m/rad, N m s/rad), as the
+#: identification's simulated devices use (phantom_pin.identification.simulation).
+TRACKING_KP, TRACKING_KD = 5.0, 0.05
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}
@@ -29,10 +32,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     three = {"nargs": 3, "type": float}
     command = sub.add_parser("simulate", help="a controller sampled at --rate driving the device "
                                               "(friction, stops, saturation), as JSON or CSV")
-    command.add_argument("--theta0", required=True, metavar="T", help="initial posture (rad)", **three)
+    command.add_argument("--theta0", metavar="T", help="initial posture (rad); required without --trajectory",
+                         **three)
     command.add_argument("--dtheta0", default=[0.0, 0.0, 0.0], metavar="W", help="initial rates (rad/s)",
                          **three)
-    command.add_argument("--duration", required=True, type=float, help="simulated time (s)")
+    command.add_argument("--duration", type=float, help="simulated time (s); required without --trajectory")
+    command.add_argument("--trajectory", type=Path,
+                         help="track excite's CSV: its torque as feed-forward plus PD "
+                              f"({TRACKING_KP:g} N m/rad, {TRACKING_KD:g} N m s/rad), from its first state, "
+                              "at its rate, for its duration; the CSV output is a log that identify reads")
     command.add_argument("--rate", type=float, default=1000.0, help="controller rate (Hz, default 1000)")
     command.add_argument("--controller", choices=["none", "gravity"], default="none",
                          help="zero torque (default), or gravity compensation N(theta) from the Phantom")
@@ -46,6 +54,24 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
 
 
+def _tracking(args: argparse.Namespace):
+    """The controller, start and timing that follow --trajectory: feed-forward plus PD."""
+    from phantom_pin.identification import io
+
+    for name in ("theta0", "duration"):
+        if getattr(args, name) is not None:
+            raise PhantomPinError(f"--{name}: --trajectory sets it (its first state and its duration)")
+    if args.controller != "none":
+        raise PhantomPinError("--controller: --trajectory is the controller")
+    t, theta, dtheta, _, tau = io.read_trajectory(args.trajectory)
+    rate = (len(t) - 1) / (t[-1] - t[0])
+
+    def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        k = min(int(round(time * rate)), len(t) - 1)
+        return tau[k] + TRACKING_KP * (theta[k] - q) + TRACKING_KD * (dtheta[k] - v)
+    return controller, theta[0], dtheta[0], float(t[-1] - t[0]), rate
+
+
 def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     """Run ``phantom-pin simulate``: nothing is written unless the simulation succeeds."""
     output = Path(args.output) if args.output else None
@@ -53,6 +79,11 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
         raise PhantomPinError(f"--output: {output} exists; add --force to overwrite it")
     device = Device(phantom)
     controller = None
+    if args.trajectory is not None:
+        controller, theta0, dtheta0, duration, rate = _tracking(args)
+        args.theta0, args.dtheta0, args.duration, args.rate = theta0.tolist(), dtheta0.tolist(), duration, rate
+    elif args.theta0 is None or args.duration is None:
+        raise PhantomPinError("--theta0 and --duration are required (or --trajectory)")
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
             return phantom.gravity(theta)
@@ -71,6 +102,7 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
                                                     "no_friction", "no_hard_stops", "no_saturation",
                                                     "quantization")}
     settings["substeps"] = result.substeps
+    settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
     text = _json(result, settings) if args.format == "json" else _csv(result)
     if output is None:
         sys.stdout.write(text)

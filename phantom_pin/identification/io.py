@@ -49,13 +49,10 @@ def write_log(path: Path | str, t: np.ndarray, theta: np.ndarray, tau: np.ndarra
     write_csv(path, LOG_COLUMNS, np.column_stack([t, theta, tau]))
 
 
-def read_log(path: Path | str, convention: str = "report") -> Log:
-    """The log at ``path``, in the report's theta (rad) and N m: its columns are in the
-    ``convention`` "report" or "openhaptics" (HD_CURRENT_JOINT_ANGLES, rad, and joint torques,
-    mN m)."""
-    if convention not in ("report", "openhaptics"):
-        raise LogError(f"convention: expected 'report' or 'openhaptics', got {convention!r}")
-    path = Path(path)
+def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, str]], dict[str, np.ndarray]]:
+    """(data lines as (line number, text), {column: values}) of the CSV at ``path``, whose
+    header must name ``columns`` (module doc: the dialects it takes); LogError naming the line
+    of a bad row."""
     try:
         text = path.read_text(encoding="utf-8-sig")           # a UTF-8 byte order mark is dropped
     except (OSError, UnicodeDecodeError) as error:
@@ -68,10 +65,10 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     first = lines[0][1]
     separator = max((",", ";", "\t"), key=first.count)        # the dialects spreadsheets write
     header = [_column_name(name) for name in first.split(separator)]
-    missing = [c for c in LOG_COLUMNS if c not in header]
+    missing = [c for c in columns if c not in header]
     if missing:
         raise LogError(f"{path}: missing column(s) {', '.join(missing)} (header must name "
-                       f"{','.join(LOG_COLUMNS)}, in any order, case or quotes, with or without units in [])")
+                       f"{','.join(columns)}, in any order, case or quotes, with or without units in [])")
     rows = []
     for number, line in lines[1:]:
         values = line.split(separator)
@@ -85,7 +82,30 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     if not np.isfinite(table).all():
         row = lines[1 + int(np.where(~np.isfinite(table).all(axis=1))[0][0])][0]
         raise LogError(f"{path}: NaN or inf on line {row}")
-    column = {name: table[:, header.index(name)] for name in LOG_COLUMNS}
+    return lines, {name: table[:, header.index(name)] for name in columns}
+
+
+def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
+    """(t, theta, dtheta, ddtheta, tau) of an excitation trajectory (excite's CSV, the report's
+    convention: s, rad, rad/s, rad/s^2, N m), each (N,) or (N, 3), at a fixed rate."""
+    path = Path(path)
+    _, column = _read_table(path, TRAJECTORY_COLUMNS)
+    t = column["t"]
+    step = np.diff(t)
+    if len(t) < 2 or not (step > 0).all() or np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
+        raise LogError(f"{path}: the times must increase at a fixed rate")
+    return (t, *(np.column_stack([column[f"{name}{j}"] for j in (1, 2, 3)])
+                 for name in ("theta", "dtheta", "ddtheta", "tau")))
+
+
+def read_log(path: Path | str, convention: str = "report") -> Log:
+    """The log at ``path``, in the report's theta (rad) and N m: its columns are in the
+    ``convention`` "report" or "openhaptics" (HD_CURRENT_JOINT_ANGLES, rad, and joint torques,
+    mN m)."""
+    if convention not in ("report", "openhaptics"):
+        raise LogError(f"convention: expected 'report' or 'openhaptics', got {convention!r}")
+    path = Path(path)
+    lines, column = _read_table(path, LOG_COLUMNS)
     t = column["t"]
     step = np.diff(t)
     if len(t) < 2 or not (step > 0).all():
