@@ -61,6 +61,7 @@ def test_simulate_keeps_files_and_writes_nothing_on_failure(tmp_path, capsys):
     (["--theta0", *START, "--duration", "1", "--rate", "0"], "rate: expected a finite number > 0"),
     (["--theta0", *START, "--duration", "1", "--controller", "pd"], "invalid choice"),
     (["--theta0", *START], "required: --duration"),
+    (["--duration", "1"], "required: --theta0"),
 ])
 def test_simulate_bad_arguments_give_one_line_and_exit_code_2(capsys, argv, message):
     code, _, err = run(capsys, "simulate", *argv)

@@ -164,3 +164,28 @@ def test_the_log_reader_reads_simulates_own_csv(tmp_path, capsys):
                  "-o", str(tmp_path / "run.csv")]) == 0
     log_ = io.read_log(tmp_path / "run.csv")
     assert log_.t.shape == (3001,) and log_.theta.shape == (3001, 3)
+
+
+def test_the_identification_api_checks_its_input(tmp_path):
+    """One InvalidInputError or LogError naming the argument (before: LinAlgError, TypeError,
+    silent NaN, or write_log overwriting a file); the public names live in the package."""
+    import phantom_pin.identification as identification
+    from phantom_pin import InvalidInputError
+
+    assert identification.estimate is estimation.estimate and identification.write_log is io.write_log
+    data = log(end=3.0)
+    path = tmp_path / "log.csv"
+    identification.write_log(path, data.t, data.theta, data.tau)
+    with pytest.raises(io.LogError, match="^path: .* exists; pass force=True"):
+        identification.write_log(path, data.t, data.theta, data.tau)
+    identification.write_log(path, data.t, data.theta, data.tau, force=True)
+    with pytest.raises(InvalidInputError, match="^theta: "):
+        identification.write_log(tmp_path / "b.csv", data.t, data.theta[:, :2], data.tau)
+    with pytest.raises(io.LogError, match="^t, theta, tau: expected shapes"):
+        identification.write_log(tmp_path / "c.csv", data.t[:-1], data.theta, data.tau)
+    assert not (tmp_path / "b.csv").exists() and not (tmp_path / "c.csv").exists()
+    for kwargs, argument in (({"log": "log.csv"}, "log"), ({"phantom": "premium_1_5"}, "phantom"),
+                             ({"cutoff": float("nan")}, "cutoff"), ({"prior_weight": -1.0}, "prior_weight")):
+        arguments = {"log": data, "phantom": PHANTOM, **kwargs}
+        with pytest.raises(InvalidInputError, match=f"^{argument}: "):
+            identification.estimate(**arguments)

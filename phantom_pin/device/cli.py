@@ -82,8 +82,10 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     if args.trajectory is not None:
         controller, theta0, dtheta0, duration, rate = _tracking(args)
         args.theta0, args.dtheta0, args.duration, args.rate = theta0.tolist(), dtheta0.tolist(), duration, rate
-    elif args.theta0 is None or args.duration is None:
-        raise PhantomPinError("--theta0 and --duration are required (or --trajectory)")
+    else:
+        for name in ("theta0", "duration"):
+            if getattr(args, name) is None:
+                raise PhantomPinError(f"--{name}: required: --{name} (or --trajectory)")
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
             return phantom.gravity(theta)

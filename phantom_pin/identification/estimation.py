@@ -22,6 +22,7 @@ import numpy as np
 import scipy.signal
 
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import constants, parameterization, physical
 from phantom_pin.identification.base import Structured, base_parameters
 from phantom_pin.identification.io import Log, LogError
@@ -88,6 +89,14 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: flo
     def stage(share: float) -> None:
         if progress is not None:
             progress(share)
+
+    if not isinstance(log, Log):
+        raise InvalidInputError(f"log: expected a phantom_pin.identification.io.Log (read_log), got {log!r}")
+    if not isinstance(phantom, Phantom):
+        raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, got {phantom!r}")
+    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
+            raise InvalidInputError(f"{name}: expected a finite number > 0, got {value!r}")
 
     theta, dtheta, ddtheta, tau = filtered(log, cutoff)
     stage(0.1)

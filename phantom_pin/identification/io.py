@@ -18,6 +18,7 @@ import numpy as np
 
 from phantom_pin import drivers
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.validation import as_states
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
 TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3",
@@ -45,8 +46,21 @@ def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> 
     np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.17g")
 
 
-def write_log(path: Path | str, t: np.ndarray, theta: np.ndarray, tau: np.ndarray) -> None:
-    write_csv(path, LOG_COLUMNS, np.column_stack([t, theta, tau]))
+def write_log(path: Path | str, t: object, theta: object, tau: object, force: bool = False) -> None:
+    """Write a log: times ``t`` (N,) s, ``theta`` (N, 3) rad and ``tau`` (N, 3) N m, finite, as
+    read_log reads it. An existing file is kept unless ``force``: LogError naming the argument."""
+    path = Path(path)
+    if path.exists() and not force:
+        raise LogError(f"path: {path} exists; pass force=True to overwrite it")
+    times = np.asarray(t, dtype=float)
+    angles, _ = as_states(theta, "theta")
+    torques, _ = as_states(tau, "tau")
+    if times.ndim != 1 or angles.shape != (len(times), 3) or torques.shape != (len(times), 3):
+        raise LogError(f"t, theta, tau: expected shapes (N,), (N, 3), (N, 3), got {times.shape}, "
+                       f"{angles.shape}, {torques.shape}")
+    if not np.isfinite(times).all():
+        raise LogError("t: contains NaN or inf")
+    write_csv(path, LOG_COLUMNS, np.column_stack([times, angles, torques]))
 
 
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, str]], dict[str, np.ndarray]]:
