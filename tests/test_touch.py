@@ -240,3 +240,27 @@ def test_the_command_line_serves_the_touch(capsys, tmp_path):
         assert (tmp_path / f"t.{kind}").read_text() == getattr(MODELS["touch"], kind).read_text()
     assert main(["--model", "touch", "show", "--html", str(tmp_path / "t.html")]) == 0
     assert (tmp_path / "t.html").stat().st_size > 100_000
+
+
+def test_a_touch_trajectory_in_openhaptics_terms_is_tracked_and_identified(tmp_path, capsys):
+    """excite --convention openhaptics -> simulate --trajectory ... --convention openhaptics
+    (the estimate as the device) -> identify: the eight constants within 2 % of the estimate's
+    (the Touch's friction is large against its torques), and --convention alone is refused."""
+    from phantom_pin.identification import constants
+    from phantom_pin.identification import parameterization as pz
+
+    traj, log_, overlay = tmp_path / "traj.csv", tmp_path / "log.csv", tmp_path / "id.yaml"
+    with redirect_stdout(StringIO()):
+        assert main(["--model", "touch", "excite", "-o", str(traj), "--duration", "5", "--iterations", "15",
+                     "--restarts", "1", "--convention", "openhaptics"]) == 0
+        assert main(["--model", "touch", "simulate", "--trajectory", str(traj), "--convention", "openhaptics",
+                     "--format", "csv", "-o", str(log_)]) == 0
+        assert main(["--model", "touch", "identify", str(log_), "-o", str(overlay)]) == 0
+    estimate = describe("touch")
+    identified = describe("touch", overrides=read_overrides(overlay))
+    np.testing.assert_allclose(constants.report_constants(pz.report_vector(identified.config), identified),
+                               constants.report_constants(pz.report_vector(estimate.config), estimate), rtol=2e-2)
+    capsys.readouterr()
+    assert main(["--model", "touch", "simulate", "--theta0", "0", "0.3", "0.4", "--duration", "1",
+                 "--convention", "openhaptics"]) == 2
+    assert "--convention: it reads --trajectory" in capsys.readouterr().err

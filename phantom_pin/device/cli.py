@@ -41,6 +41,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                          help="track excite's CSV: its torque as feed-forward plus PD "
                               f"({TRACKING_KP:g} N m/rad, {TRACKING_KD:g} N m s/rad), from its first state, "
                               "at its rate, for its duration; the CSV output is a log that identify reads")
+    command.add_argument("--convention", choices=["report", "openhaptics"], default="report",
+                         help="the --trajectory file's columns: the report's theta (rad) and N m (default), or "
+                              "OpenHaptics' joint angles (rad) and joint torques (mN m), as excite writes "
+                              "them with --convention openhaptics; the output is in the report's terms")
     command.add_argument("--rate", type=float, default=1000.0, help="controller rate (Hz, default 1000)")
     command.add_argument("--controller", choices=["none", "gravity"], default="none",
                          help="zero torque (default), or gravity compensation N(theta) from the Phantom")
@@ -56,14 +60,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def _tracking(args: argparse.Namespace):
     """The controller, start and timing that follow --trajectory: feed-forward plus PD."""
+    from phantom_pin import drivers
     from phantom_pin.identification import io
 
+    if args.convention != "report" and args.trajectory is None:
+        raise PhantomPinError("--convention: it reads --trajectory; give one")
     for name in ("theta0", "duration"):
         if getattr(args, name) is not None:
             raise PhantomPinError(f"--{name}: --trajectory sets it (its first state and its duration)")
     if args.controller != "none":
         raise PhantomPinError("--controller: --trajectory is the controller")
     t, theta, dtheta, _, tau = io.read_trajectory(args.trajectory)
+    if args.convention == "openhaptics":  # a linear map: rates as angles
+        theta, dtheta = drivers.theta_from_openhaptics(theta), drivers.theta_from_openhaptics(dtheta)
+        tau = drivers.tau_from_openhaptics_torque(tau)
     rate = (len(t) - 1) / (t[-1] - t[0])
 
     def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -79,7 +89,7 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
         raise PhantomPinError(f"--output: {output} exists; add --force to overwrite it")
     device = Device(phantom)
     controller = None
-    if args.trajectory is not None:
+    if args.trajectory is not None or args.convention != "report":
         controller, theta0, dtheta0, duration, rate = _tracking(args)
         args.theta0, args.dtheta0, args.duration, args.rate = theta0.tolist(), dtheta0.tolist(), duration, rate
     else:
