@@ -22,6 +22,8 @@ from phantom_pin.progress import Progress
 #: The PD gains of --trajectory's tracking controller (N m/rad, N m s/rad), as the
 #: identification's simulated devices use (phantom_pin.identification.simulation).
 TRACKING_KP, TRACKING_KD = 5.0, 0.05
+#: simulate()'s arguments that are options of the command (its errors name them).
+OPTIONS = ("theta0", "dtheta0", "duration", "rate", "quantization")
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}
@@ -105,6 +107,11 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
                           friction=not args.no_friction, hard_stops=not args.no_hard_stops,
                           saturation=not args.no_saturation, quantization=args.quantization, device=device,
                           progress=bar.update)
+    except PhantomPinError as error:  # name the option, not simulate()'s argument
+        name, _, rest = str(error).partition(":")
+        if name in OPTIONS and rest:
+            raise PhantomPinError(f"--{name}:{rest}") from None
+        raise
     finally:
         bar.close()
     if not device.within_limits(args.theta0):  # after the run: a refused one prints its error alone
