@@ -1,79 +1,76 @@
-"""Identify a simulated PHANToM whose parameters differ from the report's by 10-30 %, and plot
-the measured torques of a held-out run against those predicted by the identified model and
-by the report's.
+"""Identify a simulated PHANToM Premium 1.5 built from the public CAD (mahilab/Phantom: products of
+inertia, centres of mass off the segments' axes; model premium_1_5_cad) starting from the
+report's model, and plot the torques of a held-out trajectory against those predicted by the
+general identification, by the report-structure identification and by the report's parameters.
 
-The pipeline is a real device's: an optimised excitation trajectory, a log of quantized
-positions and commanded torques (here from phantom_pin.identification.simulation, with
-friction and torque noise), phantom_pin.identification.estimation, and the written
-parameters. The held-out run follows another trajectory (a different seed).
+The pipeline is a real device's: an optimised excitation trajectory, the device tracking it
+(phantom_pin.identification.simulation.track: the device's own plant with friction, 2 mN m of
+torque noise and its encoders), a log of the encoder's angles and the commanded torques,
+phantom_pin.identification.estimate, and the written --params overlay. The held-out motion is
+another excitation (another seed), 5 s long.
 """
 
 from __future__ import annotations
-
-import dataclasses
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 import common
-from phantom_pin import Phantom, describe
-from phantom_pin.identification import constants, estimation, excitation, simulation
-from phantom_pin.identification.base import Structured
-from phantom_pin.identification.regressor import Regressor
+from phantom_pin import Device, Phantom, describe
+from phantom_pin.identification import estimate, optimise, simulation
+from phantom_pin.identification.io import overlay
 
-FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
-           "Iczz": 0.85, "mbe": 1.25, "l5": 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3,
-           "mdf": 1.3, "l6": 0.9, "Idfxx": 1.2, "Idfyy": 1.1, "Idfzz": 1.25, "Ibaseyy": 1.15}
+#: The simulated device's friction (N m s/rad, N m) and torque noise (N m, 1 sigma).
+VISCOUS, COULOMB, NOISE = 6e-4, 0.012, 0.002
 
 
-def run_device(phantom, trajectory, duration, truth, seed):
-    """A log of the simulated device ``truth`` (ReportParameters) with the friction of
-    phantom's law at other coefficients, fed forward with phantom's report model."""
-    config = phantom.config
-    resolution = 2 * np.pi / (1024 * 4 * np.array(config.actuation.ratios))
-    friction = dataclasses.replace(config.actuation.friction, viscous=8e-4, coulomb=0.015)
-    return simulation.simulate(trajectory, duration, truth, config.report, friction,
-                               torque_noise=0.005, resolution=resolution, seed=seed)
+def run_device(device: Device, design, duration: float, seed: int):
+    """The device's log along an excitation (Excitation) for ``duration`` s at 1 kHz."""
+    t = np.arange(int(round(duration * 1000)) + 1) / 1000
+    theta, dtheta, ddtheta = design.trajectory(t)
+    feedforward = Phantom(describe()).inverse_dynamics(theta, dtheta, ddtheta)   # the report's model
+    return simulation.track(device, t, theta, dtheta, feedforward, torque_noise=NOISE, seed=seed)
 
 
 def main(argv: list[str] | None) -> None:
     parser = common.parser(__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=10.0, help="seconds of identification log")
-    parser.add_argument("--iterations", type=int, default=15, help="excitation optimiser iterations")
+    parser.add_argument("--duration", type=float, default=20.0, help="seconds of identification log")
+    parser.add_argument("--iterations", type=int, default=30, help="excitation optimiser iterations")
     args = parser.parse_args(argv)
     path = common.output(args, "identify_simulated.png")
-    description = describe()                           # the report's model: the prior and the controller's
-    phantom = Phantom(description)
-    p = description.config.report
-    truth = dataclasses.replace(p, **{k: getattr(p, k) * f for k, f in FACTORS.items()})
-    design = excitation.optimise(description, iterations=args.iterations, restarts=1)
-    print(f"excitation: condition number {design.condition:.3g}")
-    fit = estimation.estimate(run_device(phantom, design.trajectory, args.duration, truth, 0), phantom)
-    print("residual RMS per joint [N m]: " + " ".join(f"{r:.3g}" for r in fit.rms))
-    held_out = excitation.optimise(description, iterations=1, restarts=1, seed=7).trajectory
-    log = run_device(phantom, held_out, 5.0, truth, 1)
-    theta, dtheta, ddtheta, tau = estimation.filtered(log, 20.0)
-    phi, _ = estimation.base_regressor(Structured(Regressor(phantom)), theta, dtheta, ddtheta)
-    identified = phi @ np.concatenate([fit.constants, fit.beta[8:]])
-    report = phi @ constants.nominal(description)
-    step = max(1, int(log.rate / (5 * 20.0)))          # estimation.filtered's decimation
-    t = estimation.EDGE + np.arange(len(tau)) * step / log.rate
-    errors = {}
+    model = Phantom(describe())                               # the report's model: the prior
+    device = Device(describe("premium_1_5_cad", overrides={"actuation.friction.viscous": VISCOUS,
+                                                           "actuation.friction.coulomb": COULOMB}))
+    design = optimise(model, iterations=args.iterations, restarts=1)
+    print(f"excitation: condition number {design.condition:.3g} (general), {design.report_condition:.3g} (report)")
+    log = run_device(device, design, args.duration, 0)
+    fits = {structure: estimate(log, model, structure=structure) for structure in ("general", "report")}
+    for structure, fit in fits.items():
+        print(f"{structure}: residual RMS per joint [N m] " + " ".join(f"{r:.3g}" for r in fit.rms)
+              + "".join(f"; problem: {p}" for p in fit.problems))
+    print(fits["general"].recommendation() or "the report's structure suffices")
+    # the held-out motion: each model's inverse dynamics and friction against the device's
+    t = np.arange(5001) / 1000
+    theta, dtheta, ddtheta = optimise(model, iterations=1, restarts=1, seed=7).trajectory(t)
+    truth = device.phantom.inverse_dynamics(theta, dtheta, ddtheta) + device.friction(dtheta)
+    predictions = {"report's parameters": model.inverse_dynamics(theta, dtheta, ddtheta)
+                   + model.config.actuation.friction.torque(dtheta)}
+    for structure, fit in fits.items():
+        identified = Device(describe(overrides=overlay(fit)[0]))
+        predictions[f"identified ({structure})"] = identified.phantom.inverse_dynamics(theta, dtheta, ddtheta) \
+            + identified.friction(dtheta)
+    errors = {name: float(np.sqrt(((p - truth) ** 2).mean() / (truth**2).mean())) for name, p in predictions.items()}
     figure, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     for j, axis in enumerate(axes):
-        axis.plot(t, tau[:, j], "k", lw=2, label="measured (commanded, filtered)")
-        axis.plot(t, identified[:, j], "C0", label="identified model")
-        axis.plot(t, report[:, j], "C3--", label="report's parameters")
+        axis.plot(t, truth[:, j], "k", lw=2, label="device (true torque of the motion)")
+        for (name, prediction), style in zip(predictions.items(), ("C3--", "C0", "C1:")):
+            axis.plot(t, prediction[:, j], style, label=f"{name}: {100 * errors[name]:.2f} % RMS")
         axis.set_ylabel(f"tau{j + 1} [N m]")
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("time [s]")
-    for name, prediction in (("identified", identified), ("report", report)):
-        errors[name] = np.sqrt(((prediction - tau) ** 2).mean() / (tau**2).mean())
-    figure.suptitle(f"held-out torques: RMS error identified {100 * errors['identified']:.1f} %, "
-                    f"report {100 * errors['report']:.1f} %")
+    figure.suptitle("held-out trajectory: torques of the CAD device and of the models")
     figure.savefig(path, dpi=100)
-    print(f"held-out RMS torque error: identified {100 * errors['identified']:.2f} %, "
-          f"report {100 * errors['report']:.2f} %")
+    print("held-out RMS torque error: " + ", ".join(f"{name} {100 * e:.2f} %" for name, e in errors.items()))
     print(f"wrote {path}")
 
 

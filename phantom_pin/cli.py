@@ -322,7 +322,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command in ("urdf", "srdf", "mjcf", "links"):
             code = _write(args)
         else:  # one Description of --model or --config (and the overrides) for every other command
-            overrides = _overrides(args)
+            overrides = args.overrides = _overrides(args)
             description = (describe(_source(args), overrides=overrides) if overrides
                            else description_of(_source(args), "--config" if args.config else "--model"))
             code = (_show(args, description) if args.command == "show"

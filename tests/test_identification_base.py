@@ -11,8 +11,8 @@ from phantom_pin import Phantom, describe
 from phantom_pin.identification import base, constants
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.base import Structured, base_parameters
-from phantom_pin.identification.estimation import base_regressor
 from phantom_pin.identification.regressor import Regressor
+from phantom_pin.identification.structures import Report
 from phantom_pin.report import closed_form
 from test_identification_regressor import states as _states
 
@@ -67,7 +67,7 @@ def test_constants_equal_the_report_equations_at_the_shipped_values():
 
 def test_pinocchio_base_regressor_equals_the_closed_form_one(structured):
     theta, dtheta, ddtheta = states(200, 7)
-    phi, tau0 = base_regressor(structured, theta, dtheta, ddtheta)
+    phi, tau0 = Report(REGRESSOR.phantom).regressor_of(theta, dtheta, ddtheta)
     closed = constants.regressor(theta, dtheta, ddtheta, DESCRIPTION)
     assert np.abs(phi - closed).max() <= 1e-11 * np.abs(closed).max()
     beta = constants.nominal(DESCRIPTION)
@@ -112,3 +112,21 @@ def test_a_smooth_excitation_shows_all_26_base_parameters():
     regressor = Regressor(Phantom())
     stacked = regressor.stacked(data.theta[keep], rates[keep], accelerations[keep])
     assert base_parameters(stacked, regressor.names).rank == 26
+
+
+def test_the_device_has_the_trees_base_parameters_but_the_hinge_pins():
+    """The general structure's base (x: the five bodies, the rotor inertia, friction; the pins
+    fixed) has 24 parameters: the tree's 26 less the pins' own first moments along their bars,
+    which the tree identifies separately and the device fixes (config: hinge_pin)."""
+    from phantom_pin.identification.structures import General
+
+    general = General(REGRESSOR.phantom)
+    tree = base_parameters(REGRESSOR.stacked(*states(300, 5)), REGRESSOR.names)
+    pins = [name for name in np.array(tree.names)[list(tree.independent)] if "pin_link" in name]
+    assert general.base.rank == 24 and tree.rank == 26
+    assert sorted(pins) == ["crank_pin_link.mx", "forearm_pin_link.mx"], pins
+    # the general base's columns span what the tree's span once the pins' columns are removed
+    y = REGRESSOR.stacked(*states(200, 9))
+    keep = [i for i in tree.independent if "pin_link" not in REGRESSOR.names[i]]
+    phi = (y @ general.affine)[:, general.independent]
+    assert np.linalg.matrix_rank(np.hstack([y[:, keep], phi]), tol=1e-9 * np.abs(y).max()) == 24

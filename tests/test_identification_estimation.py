@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import CONFIG, REPORT
-from phantom_pin import Phantom, closed_form
+from phantom_pin import Device, Phantom, closed_form
 from phantom_pin.cli import main
 from phantom_pin.identification import constants, estimation, io
 
@@ -38,15 +38,40 @@ def log(joint1_scale: float = 1.0, noise=(0.0, 0.0, 0.0), start: float = 0.0, en
 TRUTH = constants.nominal(PHANTOM.description)
 
 
+def report(data, **kwargs):
+    """The report structure's fit of a log whose torques are sampled (this module's)."""
+    return estimation.estimate(data, PHANTOM, structure="report", timing="sampled", **kwargs)
+
+
 def test_the_exact_log_gives_the_true_constants():
-    fit = estimation.estimate(log(), PHANTOM)
+    fit = report(log())
     np.testing.assert_allclose(fit.beta, TRUTH, rtol=0, atol=2e-4 * np.abs(TRUTH).max())
+
+
+def test_the_exact_log_gives_the_true_general_base_parameters():
+    """The general structure's 24 base parameters of an exact log along an optimised excitation
+    (15 iterations; the three-frequency trajectory above leaves the general base regressor's
+    condition number above 1e3) against those of the report's numbers (structures.General.matrix
+    at the shipped model's bodies), each within 2e-4 of its typical size (the base parameters mix
+    kg, kg m and kg m^2)."""
+    from phantom_pin.identification import excitation
+    from phantom_pin.identification.structures import General
+
+    model = General(PHANTOM)
+    t = np.arange(10001) / RATE
+    theta, dtheta, ddtheta = excitation.optimise(PHANTOM.description, iterations=15, restarts=1).trajectory(t)
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + CONFIG.actuation.friction.torque(dtheta)
+    fit = estimation.estimate(io.Log(t, theta, tau), PHANTOM, timing="sampled")
+    truth = model.matrix @ model.prior
+    assert fit.structure == "general" and len(fit.beta) == 24
+    np.testing.assert_array_less(np.abs(fit.beta - truth), 2e-4 * (np.abs(model.matrix) @ model.scale))
+    assert fit.problems == ()
 
 
 def test_a_log_cut_in_mid_motion_is_identified_without_the_filters_edge_transients():
     """From 1.3 s to 9.1 s: the log starts and ends moving, where the zero-phase filter rings;
     the cut edges keep every constant within 3e-4 of the largest (without the cut: 0.26)."""
-    fit = estimation.estimate(log(start=1.3, end=9.1), PHANTOM)
+    fit = report(log(start=1.3, end=9.1))
     assert np.abs(fit.beta - TRUTH).max() < 3e-4 * np.abs(TRUTH).max()
 
 
@@ -54,10 +79,10 @@ def test_a_weakly_excited_log_is_refused_at_the_condition_gate():
     """Joint 1 at 1 % of its amplitude: a condition number between 3e3 and 1e6, refused (the
     gate is 1e3); at 10 % it is below 1e3 and accepted."""
     with pytest.raises(io.LogError, match="not exciting enough: the base regressor's condition number is") as error:
-        estimation.estimate(log(joint1_scale=0.01), PHANTOM)
+        report(log(joint1_scale=0.01))
     condition = float(re.search(r"number is ([0-9.e+]+)", str(error.value)).group(1))
     assert 3e3 < condition < 1e6, condition
-    assert estimation.estimate(log(joint1_scale=0.1), PHANTOM).condition < 1e3
+    assert report(log(joint1_scale=0.1)).condition < 1e3
 
 
 def test_each_joint_is_weighted_by_its_own_noise():
@@ -65,7 +90,7 @@ def test_each_joint_is_weighted_by_its_own_noise():
     own residual, the constants that joints 2 and 3 see (L, M22, M33, N2, N3 and their
     friction) keep small standard deviations, and every estimate lies within 6 of its
     standard deviations of the truth (the covariance is honest)."""
-    fit = estimation.estimate(log(noise=(3e-3, 1e-5, 1e-5)), PHANTOM)
+    fit = report(log(noise=(3e-3, 1e-5, 1e-5)))
     relative = dict(zip(constants.NAMES + constants.FRICTION_NAMES, fit.sigma / np.abs(TRUTH)))
     assert relative["L"] < 1e-3 and relative["M22"] < 3e-4 and relative["M33"] < 2e-3, relative
     assert relative["N2"] < 1e-4 and relative["N3"] < 3e-4, relative
@@ -74,14 +99,18 @@ def test_each_joint_is_weighted_by_its_own_noise():
     assert (np.abs(fit.beta - TRUTH) < 6 * fit.sigma).all(), (fit.beta - TRUTH) / fit.sigma
 
 
-def test_identify_refuses_a_cutoff_above_half_the_rate(tmp_path, capsys):
+def test_identify_refuses_a_cutoff_the_rate_cannot_differentiate(tmp_path, capsys):
+    """At 1 kHz the cutoff may reach 50 Hz (RATE_PER_CUTOFF): 60 Hz is refused, naming the rate
+    it would need."""
     path = tmp_path / "log.csv"
     data = log()
     io.write_log(path, data.t, data.theta, data.tau)
-    assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml"), "--cutoff", "600"]) == 2
+    assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml"), "--cutoff", "60"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "cutoff: 600" in err and "half the rate" in err
+    assert err.count("\n") == 1 and "cutoff: 60 Hz needs a log at 1200 Hz or faster (this one: 1000 Hz" in err
     assert not (tmp_path / "id.yaml").exists()
+    assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml"), "--cutoff", "50", "--torque-timing", "sampled",
+                 "--structure", "report"]) == 0
 
 
 def test_a_log_of_phantom_pins_own_simulator_gives_the_true_constants():
@@ -104,7 +133,7 @@ def test_a_log_of_phantom_pins_own_simulator_gives_the_true_constants():
     dtheta0 = (np.cos(PHASE) * np.arange(1, 4) * W) @ AMPLITUDE.T          # the trajectory's rate at t = 0
     result = simulate(reference.theta[0], 10.0, controller, dtheta0=dtheta0)
     assert np.abs(result.theta - reference.theta).max() < 0.01             # it tracked
-    fit = estimation.estimate(io.Log(result.t, result.theta, result.tau), PHANTOM)
+    fit = estimation.estimate(io.Log(result.t, result.theta, result.tau), PHANTOM, structure="report")  # held
     assert np.abs(fit.beta - TRUTH).max() < 5e-3 * np.abs(TRUTH).max(), (fit.beta - TRUTH) / np.abs(TRUTH).max()
 
 
@@ -121,7 +150,8 @@ def test_identify_writes_nothing_when_the_overlay_is_not_physical(tmp_path, caps
     data = log()
     io.write_log(path, data.t, data.theta, data.tau)
     monkeypatch.setattr(build, "describe", refuse)
-    assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml")]) == 2
+    assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml"), "--torque-timing", "sampled",
+                 "--structure", "report"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "identified parameters not physically valid" in err
     assert not (tmp_path / "id.yaml").exists()
@@ -185,7 +215,14 @@ def test_the_identification_api_checks_its_input(tmp_path):
         identification.write_log(tmp_path / "c.csv", data.t[:-1], data.theta, data.tau)
     assert not (tmp_path / "b.csv").exists() and not (tmp_path / "c.csv").exists()
     for kwargs, argument in (({"log": "log.csv"}, "log"), ({"phantom": "premium_1_5"}, "phantom"),
-                             ({"cutoff": float("nan")}, "cutoff"), ({"prior_weight": -1.0}, "prior_weight")):
+                             ({"cutoff": float("nan")}, "cutoff"), ({"prior_weight": -1.0}, "prior_weight"),
+                             ({"structure": "full"}, "structure"), ({"timing": "late"}, "timing")):
         arguments = {"log": data, "phantom": PHANTOM, **kwargs}
         with pytest.raises(InvalidInputError, match=f"^{argument}: "):
             identification.estimate(**arguments)
+    with pytest.raises(InvalidInputError, match="^fit: "):
+        identification.overlay("fit.yaml")
+    with pytest.raises(InvalidInputError, match="^device: "):
+        identification.track("premium_1_5", data.t, data.theta, data.theta, data.tau)
+    with pytest.raises(InvalidInputError, match="^torque_noise: "):
+        identification.track(Device(), data.t, data.theta, data.theta, data.tau, torque_noise=-1.0)

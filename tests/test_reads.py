@@ -1,5 +1,5 @@
-"""One configuration is read once: after describe(), the excitation and the identification of a
-20 s log read no parameter file, run no xacro and parse no URDF (before: one estimate() read
+"""One configuration is read once: after describe() and Phantom(), the excitation and the
+identification of a 20 s log read no parameter file, run no xacro and parse no URDF (before: one estimate() read
 the YAML files 420 times, ran xacro 44 times and parsed the URDF 44 times)."""
 
 from collections import Counter
@@ -28,11 +28,11 @@ def test_excite_and_identify_read_nothing_after_describe(monkeypatch):
     monkeypatch.setattr(xacro, "process_file", counted("xacro", xacro.process_file))
     for name in ("buildModelFromXML", "buildModelFromUrdf"):
         monkeypatch.setattr(pin, name, counted(name, getattr(pin, name)))
-    result = excitation.optimise(description, iterations=3, restarts=1)
+    result = excitation.optimise(phantom, iterations=3, restarts=1)
     t = np.arange(20001) / 1000.0                                   # 20 s at 1 kHz
     theta, dtheta, ddtheta = result.trajectory(t)
     tau = constants.regressor(theta, dtheta, ddtheta, description) @ constants.nominal(description)
-    fit = estimation.estimate(io.Log(t, theta, tau), phantom)
+    fit = estimation.estimate(io.Log(t, theta, tau), phantom, structure="report", timing="sampled")
     assert counts == Counter()
     # the noise-free log of the configuration's own model gives back its constants, to the
     # error of estimate()'s central differences of the filtered angles (0.2 % on K2, K3)

@@ -473,18 +473,58 @@ def _links(r: _Reader, kinematics: Kinematics) -> dict[str, Inertial]:
             raise r.error(arg, f"link {name}: {trouble} (from links.{name})")
     pin_mass = r.number(arg, "hinge_pin", "mass", positive=True)
     xx, yy, zz = (r.number(arg, "hinge_pin", "inertia", k, positive=True) for k in ("xx", "yy", "zz"))
-    pin = Inertial(pin_mass, (0, 0, 0), (xx, 0, 0, yy, 0, zz))
+    return carve(bodies, Inertial(pin_mass, (0, 0, 0), (xx, 0, 0, yy, 0, zz)), kinematics)
+
+
+def carve(bodies: Mapping[str, Inertial], pin: Inertial, kinematics: Kinematics) -> dict[str, Inertial]:
+    """The seven links (LINKS) of the five bodies (BODIES) and a hinge pin (mass at its pivot,
+    inertia about it): the pin's mass at its pivot out of crank_link (0, 0, -l3) and
+    lower_bar_link (l1, 0, 0), the two pins' vertical moment out of turret_link; ``uncarve``
+    is its inverse."""
     turret = bodies["turret_link"]
-    inertia = turret.inertia
     return {
-        "turret_link": Inertial(turret.mass, turret.com, (*inertia[:5], inertia[5] - 2 * zz)),
+        "turret_link": Inertial(turret.mass, turret.com, (*turret.inertia[:5], turret.inertia[5] - 2 * pin.inertia[5])),
         "upper_arm_link": bodies["upper_arm_link"],
-        "crank_link": without_point_mass(bodies["crank_link"], pin_mass, (0.0, 0.0, -kinematics.l3)),
+        "crank_link": without_point_mass(bodies["crank_link"], pin.mass, (0.0, 0.0, -kinematics.l3)),
         "crank_pin_link": pin,
-        "lower_bar_link": without_point_mass(bodies["lower_bar_link"], pin_mass, (kinematics.l1, 0.0, 0.0)),
+        "lower_bar_link": without_point_mass(bodies["lower_bar_link"], pin.mass, (kinematics.l1, 0.0, 0.0)),
         "forearm_pin_link": pin,
         "forearm_link": bodies["forearm_link"],
     }
+
+
+def uncarve(links: Mapping[str, Inertial], kinematics: Kinematics) -> dict[str, Inertial]:
+    """The five bodies (BODIES) of seven links: ``carve`` undone (a point mass taken out with a
+    negative mass is put back), for a model in the report's form as for one in full."""
+    pin = links["crank_pin_link"]
+    turret = links["turret_link"]
+    return {
+        "turret_link": Inertial(turret.mass, turret.com, (*turret.inertia[:5], turret.inertia[5] + 2 * pin.inertia[5])),
+        "upper_arm_link": links["upper_arm_link"],
+        "crank_link": without_point_mass(links["crank_link"], -pin.mass, (0.0, 0.0, -kinematics.l3)),
+        "lower_bar_link": without_point_mass(links["lower_bar_link"], -pin.mass, (kinematics.l1, 0.0, 0.0)),
+        "forearm_link": links["forearm_link"],
+    }
+
+
+#: The report form's keys of physical_parameters.yaml that the links in full replace.
+REPORT_SEGMENTS = ("segment_a", "segment_c", "segment_be", "segment_df", "segment_g", "density")
+
+
+def in_full(documents: dict[str, dict], config: "Config") -> dict[str, dict]:
+    """``documents`` (of ``config``) with physical_parameters.yaml in the links' full form: a
+    model in the report's form gets its five bodies (``uncarve`` of its links, the rotors
+    staying in the armature) in place of the report's segments; its dynamics are unchanged.
+    The form that an overlay of ``links.*`` keys (phantom-pin identify's) applies to."""
+    physical = dict(documents["physical_parameters_file"])
+    if "links" in physical:
+        return documents
+    for key in REPORT_SEGMENTS:
+        physical.pop(key, None)
+    physical["links"] = {name: {"mass": body.mass, "com": list(body.com),
+                                "inertia": dict(zip(INERTIA_KEYS, body.inertia))}
+                         for name, body in uncarve(config.links, config.kinematics).items()}
+    return {**documents, "physical_parameters_file": physical}
 
 
 def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool) -> Config:

@@ -17,11 +17,9 @@ from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.identification.simulation import KD, KP
 from phantom_pin.progress import Progress
 
-#: The PD gains of --trajectory's tracking controller (N m/rad, N m s/rad), as the
-#: identification's simulated devices use (phantom_pin.identification.simulation).
-TRACKING_KP, TRACKING_KD = 5.0, 0.05
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = ("theta0", "dtheta0", "duration", "rate", "quantization")
 #: Columns of the result, with their units, as written to JSON and CSV.
@@ -41,7 +39,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--duration", type=float, help="simulated time (s); required without --trajectory")
     command.add_argument("--trajectory", type=Path,
                          help="track excite's CSV: its torque as feed-forward plus PD "
-                              f"({TRACKING_KP:g} N m/rad, {TRACKING_KD:g} N m s/rad), from its first state, "
+                              f"({KP:g} N m/rad, {KD:g} N m s/rad), from its first state, "
                               "at its rate, for its duration; the CSV output is a log that identify reads")
     command.add_argument("--convention", choices=["report", "openhaptics"], default="report",
                          help="the --trajectory file's columns: the report's theta (rad) and N m (default), or "
@@ -63,7 +61,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def _tracking(args: argparse.Namespace):
     """The controller, start and timing that follow --trajectory: feed-forward plus PD."""
     from phantom_pin import drivers
-    from phantom_pin.identification import io
+    from phantom_pin.identification import io, simulation
 
     if args.convention != "report" and args.trajectory is None:
         raise PhantomPinError("--convention: it reads --trajectory; give one")
@@ -77,11 +75,7 @@ def _tracking(args: argparse.Namespace):
         theta, dtheta = drivers.theta_from_openhaptics(theta), drivers.theta_from_openhaptics(dtheta)
         tau = drivers.tau_from_openhaptics_torque(tau)
     rate = (len(t) - 1) / (t[-1] - t[0])
-
-    def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        k = min(int(round(time * rate)), len(t) - 1)
-        return tau[k] + TRACKING_KP * (theta[k] - q) + TRACKING_KD * (dtheta[k] - v)
-    return controller, theta[0], dtheta[0], float(t[-1] - t[0]), rate
+    return simulation.tracking(t, theta, dtheta, tau), theta[0], dtheta[0], float(t[-1] - t[0]), rate
 
 
 def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:

@@ -1,15 +1,18 @@
 """Identification of a PHANToM's own dynamics: regressor, base parameters, excitation,
 estimation, physical consistency, and the CSV log (docs/identification.md).
 
-The public names: ``estimate`` (a log and a Phantom -> Fit), ``optimise`` (an excitation
-trajectory), ``read_log``/``write_log``/``read_trajectory`` and ``Log``, ``Regressor`` and
-``base_parameters``; ``LogError`` for a bad log."""
+The public names: ``estimate`` (a log and a Phantom -> Fit, in the ``general`` structure or the
+``report``'s), ``optimise`` (an excitation trajectory), ``read_log``/``write_log``/
+``read_trajectory`` and ``Log``, ``overlay``/``write_overlay`` (a Fit as --params keys),
+``track`` (a simulated device logging a trajectory), ``Regressor`` and ``base_parameters``;
+``LogError`` for a bad log."""
 
 from phantom_pin.identification.base import base_parameters
 from phantom_pin.identification.estimation import Fit, estimate
 from phantom_pin.identification.excitation import Excitation, optimise
-from phantom_pin.identification.io import Log, LogError, read_log, read_trajectory, write_log
+from phantom_pin.identification.io import Log, LogError, overlay, read_log, read_trajectory, write_log, write_overlay
 from phantom_pin.identification.regressor import Regressor
+from phantom_pin.identification.simulation import track
 
 __all__ = ["estimate", "Fit", "optimise", "Excitation", "read_log", "write_log", "read_trajectory", "Log",
-           "LogError", "Regressor", "base_parameters"]
+           "LogError", "overlay", "write_overlay", "track", "Regressor", "base_parameters"]

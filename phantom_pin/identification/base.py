@@ -6,12 +6,12 @@ parameters beta = pi_1 + R1^-1 R2 pi_2 (pi_1 the r pivot columns' parameters), w
 W pi = W_1 beta for every pi. ``BaseParameters.matrix`` is the map K: beta = K pi.
 
 Two models are used (run ``python -m phantom_pin.identification.base`` to print both):
-the general rigid-body model of ``Regressor`` (every standard parameter of every tree body,
-the three rotors and the friction), and the report's structure (``structured``: the report
-parameters of ``parameterization``, where centres of mass lie on the segments' axes and the
-segment axes are principal, plus friction). The second's rigid-body base is the report's
-eight constants K1, K2, K3, L, M22, M33 and the gravity coefficients of eqs 81-94
-(``report_constants``).
+the general rigid-body model (structures.General: every standard parameter of the five bodies,
+the rotor inertia and the friction, through ``Regressor``'s tree bodies), and the report's
+structure (``Structured``: the report parameters of ``parameterization``, where centres of mass
+lie on the segments' axes and the segment axes are principal, plus friction). The second's
+rigid-body base is the report's eight constants K1, K2, K3, L, M22, M33 and the gravity
+coefficients of eqs 81-94 (``report_constants``).
 """
 
 from __future__ import annotations
@@ -116,13 +116,19 @@ def sample(regressor: Regressor, n: int = 300, seed: int = 0) -> tuple[np.ndarra
 
 
 def main() -> None:
+    from phantom_pin.identification.structures import General
+
     regressor = Regressor(Phantom())
     states = sample(regressor)
     full = base_parameters(regressor.stacked(*states), regressor.names,
                            np.maximum(np.abs(regressor.parameters(5e-4, 0.01)), 1e-6))
-    print(f"General rigid-body model: {regressor.size} parameters "
-          f"({len(regressor.bodies)} tree bodies x 10, 3 rotors, 6 friction), {full.rank} base parameters:")
-    print("\n".join(full.describe()))
+    general = General(regressor.phantom)
+    print(f"The mimic tree's regressor: {regressor.size} parameters ({len(regressor.bodies)} tree bodies x 10, "
+          f"3 rotors, 6 friction), {full.rank} base parameters; two of them are the hinge pins' own first "
+          "moments (crank_pin_link.mx, forearm_pin_link.mx), fixed by the model, so that the device has")
+    print(f"General rigid-body model (identify's default): {len(general.names)} parameters (5 bodies x 10, "
+          f"the rotor inertia, 6 friction), {general.base.rank} base parameters:")
+    print("\n".join(general.base.describe()))
     structured = Structured(regressor)
     phi = structured(*states)[0].reshape(-1, len(structured.names))
     x0 = parameterization.report_vector(structured.description.config)

@@ -53,7 +53,14 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
-    identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+    identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
+                          help="held: each logged torque is a command applied until the next sample (a servo "
+                               "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
+    identify.add_argument("--structure", choices=("general", "report"), default="general",
+                          help="general: the rigid body in full, every identifiable base parameter (default); "
+                               "report: the report's eight constants (a model in the report's form)")
+    identify.add_argument("--force", "-f", action="store_true",
+                          help="overwrite an existing file, and write a result the checks refuse")
     identify.add_argument("--convention", choices=CONVENTIONS, default="report",
                           help="the log's theta and tau columns: the report's theta (rad) and N m (default), "
                                "or OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad) and joint torques (mN m)")
@@ -62,7 +69,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 def excite(args: argparse.Namespace, phantom) -> int:
     """phantom-pin excite, for the configuration of ``phantom`` (--model or --config)."""
     from phantom_pin import drivers
-    from phantom_pin.identification import constants, excitation, io
+    from phantom_pin.identification import excitation, io
 
     description = phantom.description
     _refuse(args.output, args.force)
@@ -92,7 +99,7 @@ def excite(args: argparse.Namespace, phantom) -> int:
     times = np.arange(rows) / args.rate
     bar = Progress("excite", 1.0, enabled=False if args.quiet else None)
     try:
-        result = excitation.optimise(description, args.period, args.harmonics, iterations=args.iterations,
+        result = excitation.optimise(phantom, args.period, args.harmonics, iterations=args.iterations,
                                      restarts=args.restarts, seed=args.seed, times=times, progress=bar.update)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
@@ -100,8 +107,7 @@ def excite(args: argparse.Namespace, phantom) -> int:
         bar.close()
     t = times
     theta, dtheta, ddtheta = result.trajectory(t)
-    beta = constants.nominal(description)
-    tau = constants.regressor(theta, dtheta, ddtheta, description) @ beta
+    tau = phantom.inverse_dynamics(theta, dtheta, ddtheta) + description.config.actuation.friction.torque(dtheta)
     peak = np.abs(tau).max(axis=0)
     if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
         theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
@@ -111,49 +117,64 @@ def excite(args: argparse.Namespace, phantom) -> int:
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
           f"{args.harmonics} harmonics per joint" + (", in OpenHaptics' joint angles (rad) and joint torques "
                                                     "(mN m)" if args.convention == "openhaptics" else ""))
-    print(f"condition number of the base regressor (14 columns scaled to unit norm): {result.condition:.3g}")
-    print("peak torque [N m] (report model + the configuration's friction) / joint torque limit: "
+    print(f"condition number of the general base regressor (columns scaled to unit norm): {result.condition:.3g}"
+          + ("" if result.report_condition is None else
+             f"; of the report structure's: {result.report_condition:.3g}"))
+    print("peak torque [N m] (the model + its friction) / joint torque limit: "
           + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(peak, effort)))
     print(f"nearest approach to a stop: {result.min_slack:.3f} rad; the file starts and ends at rest")
     return 0
 
 
 def identify(args: argparse.Namespace, phantom) -> int:
-    """phantom-pin identify, for the configuration of ``phantom`` (--model or --config)."""
+    """phantom-pin identify, for the configuration of ``phantom`` (--model, --config, --params)."""
     from phantom_pin.description.build import describe
-    from phantom_pin.identification import constants, estimation, io, parameterization
+    from phantom_pin.identification import estimation, io
 
     _refuse(args.output, args.force)
+    if args.structure == "report" and phantom.config.report is None:
+        raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name} "
+                              "gives its links in full (use --structure general)")
     log = io.read_log(args.log, args.convention)
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
-        fit = estimation.estimate(log, phantom, args.cutoff, progress=bar.update)
+        fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
+                                  timing=args.torque_timing)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
     finally:
         bar.close()
-    keys, notes = io.overlay(fit, phantom.config)
+    if fit.problems and not args.force:
+        more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
+        raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--force writes it anyway)")
+    given = getattr(args, "overrides", {})
+    keys, notes = io.overlay(fit, given)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)
     except PhantomPinError as error:
         raise PhantomPinError(f"identified parameters not physically valid: {error}") from None
-    report = constants.report_constants(parameterization.report_vector(phantom.config), phantom.description)
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
-          f"condition number {fit.condition:.3g}")
+          f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g}")
     print("residual RMS per joint [N m]: " + ", ".join(
-        f"{r:.3g} ({100 * r / s:.1f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms)))
-    print(f"{'base parameter':15} {'estimate':>12} {'std dev':>10} {'written':>12} {'report':>12}  unit")
-    names = constants.NAMES + constants.FRICTION_NAMES
-    for k, (name, unit) in enumerate(zip(names, constants.UNITS)):
-        written = f"{fit.constants[k]:12.5g}" if k < len(report) else " " * 12
-        ref = f"{report[k]:12.5g}" if k < len(report) else " " * 12
-        print(f"{name:15} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {written} {ref}  {unit}")
+        f"{r:.3g} ({100 * r / s:.2f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms))
+          + "; of the written parameters: " + ", ".join(f"{r:.3g}" for r in fit.written_rms))
+    if fit.comparison is not None:
+        name, rms = fit.comparison
+        print(f"the {name} structure leaves " + ", ".join(f"{r:.3g}" for r in rms) + " N m RMS ("
+              + ", ".join(f"{100 * r / s:.2f} %" for r, s in zip(rms, fit.torque_rms)) + ")")
+    recommendation = fit.recommendation()
+    if recommendation:
+        print(f"recommendation: {recommendation}")
+    elif fit.comparison is not None:
+        print(f"the report's structure suffices for this log (within {estimation.NEEDS_GENERAL} times the general "
+              "model's residual on every joint)")
+    print(f"{'':6} {'estimate':>12} {'std dev':>10} {'written':>12}  {'unit':9} base parameter")
+    for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
+        print(f"beta{k + 1:<2} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {fit.written[k]:12.5g}  {unit:9} {name}")
     for note in notes:
         print(note)
-    print(f"check of the report's structure: the general rigid-body model ({fit.general_rank} base "
-          "parameters, products of inertia and off-axis centres of mass included) leaves "
-          + ", ".join(f"{r:.3g}" for r in fit.general_rms) + " N m RMS; much less than the fit's "
-          "residual means the report's structure misses something on this device")
-    io.write_overlay(args.output, fit, args.log.name, phantom.config)
+    for problem in fit.problems:
+        print(f"warning (written with --force): {problem}")
+    io.write_overlay(args.output, fit, args.log.name, given)
     print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
     return 0

@@ -1,16 +1,24 @@
-"""Estimation: zero-phase filtering, weighted least squares of the base parameters and the
-friction, and the nearest physically consistent report parameters.
+"""Estimation: zero-phase filtering, weighted least squares of the base parameters, the nearest
+physically consistent parameters, and the checks that decide whether they may be written.
 
 1. The positions (rad) are low-passed by a Butterworth filter run forwards and backwards
-   (scipy.signal.filtfilt, no phase lag) and differentiated by central differences into
-   dtheta (rad/s) and ddtheta (rad/s^2); the torques get the same filter (parallel
-   filtering), so that both sides of tau = Phi beta see the same distortion. The filter's
-   edge transients are cut and the samples decimated to about 5 times the cutoff.
-2. beta (constants.NAMES + friction) by ordinary least squares, then weighted by the inverse
-   residual standard deviation of each joint (Gauss-Markov); covariance
-   s^2 (Phi_w^T Phi_w)^-1.
-3. physical.nearest: the report parameters x whose constants C x are nearest to beta in the
-   covariance's metric, with every link physically consistent.
+   (scipy.signal.sosfiltfilt, no phase lag) and differentiated by central differences into
+   dtheta (rad/s) and ddtheta (rad/s^2). The torques get the same filter, and so do the
+   friction columns of the regressor, computed at the log's rate from dtheta (parallel
+   filtering): both sides of tau = Phi beta see the same distortion, so that the Coulomb
+   reversals the filter smears in the torque are smeared alike in the regressor (without
+   it, viscous friction came out 5-33 % off, depending on the cutoff). The rigid-body
+   columns, smooth functions of a motion far below the cutoff, pass the filter unchanged
+   and are computed at the kept samples. The filter's edge transients are cut and the
+   samples decimated to about 5 times the cutoff.
+2. beta by ordinary least squares, then weighted by the inverse residual standard deviation
+   of each joint (Gauss-Markov); covariance s^2 (Phi_w^T Phi_w)^-1.
+3. physical.nearest: the structure's parameters x (structures.py) whose base parameters are
+   nearest to beta in the covariance's metric, with every link physical and friction >= 0.
+4. The checks (``Fit.problems``, each one line): torques unrelated to the motion, a
+   projection that moves an estimate far or flips its sign, negative friction, torques
+   whose size or sign disagree with the model's, joints whose torques fit markedly better
+   scaled (a wrong transmission ratio or amplifier sign), angles far beyond the stops.
 """
 
 from __future__ import annotations
@@ -21,121 +29,299 @@ from typing import Callable
 import numpy as np
 import scipy.signal
 
+from phantom_pin.config import Friction
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification import constants, parameterization, physical
-from phantom_pin.identification.base import Structured, base_parameters
 from phantom_pin.identification.io import Log, LogError
-from phantom_pin.identification.regressor import Regressor
+from phantom_pin.identification.structures import STRUCTURES, Structure
 
 #: Largest accepted condition number of the base regressor (columns scaled to unit norm).
 MAX_CONDITION = 1e3
 #: Filter order and edge cut (s).
 FILTER_ORDER, EDGE = 4, 0.25
+#: Fewest log samples per second per hertz of cutoff: central differences of a motion at the
+#: cutoff err by (2 pi cutoff / rate)^2 / 6, 1.6 % at this ratio.
+RATE_PER_CUTOFF = 20.0
+#: Largest residual RMS of a joint, as a share of its torque RMS, that a usable log leaves
+#: (a device's log leaves 0.3-3 %; torques unrelated to the motion, 50-100 %).
+MAX_RESIDUAL_SHARE = 0.15
+#: A base parameter the physical projection moves by more than this many standard deviations
+#: and more than SHIFT_SHARE of its value means the estimate is not of a physical arm.
+MAX_SHIFT_SIGMA, SHIFT_SHARE = 10.0, 0.1
+#: The logged torques fit the model best scaled by s: refused outside these bounds (a unit).
+TORQUE_SCALE = (1 / 3, 3.0)
+#: A joint whose torque fits better scaled: flagged if the sum of the joints' squared residual
+#: shares drops below this share of the unscaled fit's and the scale differs from 1 by more
+#: than RATIO_SHARE.
+MARKED_IMPROVEMENT, RATIO_SHARE = 0.75, 0.01
+#: Angles further than this (rad) beyond the stops are not of the arm.
+BEYOND_STOPS = 0.2
+#: The report's structure needs the general model when it leaves more than this times the
+#: general model's residual on some joint.
+NEEDS_GENERAL = 1.2
+
+
+@dataclasses.dataclass(frozen=True)
+class Samples:
+    """The filtered log at its kept samples: theta (N, 3) rad, dtheta rad/s, ddtheta rad/s^2,
+    tau N m, and the regressor's friction columns filtered as tau, ``friction`` (N, 3, 6):
+    viscous1..3 then coulomb1..3."""
+
+    theta: np.ndarray
+    dtheta: np.ndarray
+    ddtheta: np.ndarray
+    tau: np.ndarray
+    friction: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
 class Fit:
-    """Result of ``estimate``: beta (14,) and its standard deviations, the residual RMS per
-    joint (N m) and the RMS torque (N m), the condition number, the number of samples, the
-    consistent report parameters x (20,) and their constants C x (8,); and, as a check of the
-    report's structure, the residual RMS per joint (N m) and the rank of the general
-    rigid-body model (every standard parameter of every body: ``general_rms``, ``general_rank``)."""
+    """Result of ``estimate``.
 
+    ``structure`` ("general" or "report"); ``names``, ``units``: the base parameters, each a
+    sum of physical parameters; ``beta``, ``sigma``: their estimates and standard deviations;
+    ``rms``: the residual RMS per joint (N m) of beta, ``written_rms`` of the written
+    parameters, ``torque_rms`` the torque's RMS (N m); ``condition`` of the base regressor
+    (columns scaled to unit norm); ``samples`` used; ``x``: the physical parameters
+    (Structure.names: the structure's, then viscous1..3 N m s/rad, coulomb1..3 N m),
+    ``written`` = their beta, ``overrides`` their --params keys (without friction: io.overlay);
+    ``comparison``: (name, residual RMS per joint, N m) of the other structure, or None;
+    ``torque_scale`` (3,): the factors each joint's logged torque fits best with (joint 1's
+    is 1), ``scaled_rms``: the residual with them; ``problems``: why the result should not be
+    written (one line each; empty for a usable log)."""
+
+    structure: str
+    names: tuple[str, ...]
+    units: tuple[str, ...]
     beta: np.ndarray
     sigma: np.ndarray
     rms: np.ndarray
+    written_rms: np.ndarray
     torque_rms: np.ndarray
     condition: float
     samples: int
     x: np.ndarray
-    constants: np.ndarray
-    general_rms: np.ndarray
-    general_rank: int
+    written: np.ndarray
+    overrides: dict
+    comparison: tuple[str, np.ndarray] | None
+    torque_scale: np.ndarray
+    scaled_rms: np.ndarray
+    problems: tuple[str, ...]
+
+    @property
+    def friction(self) -> tuple[np.ndarray, np.ndarray]:
+        """(estimates, standard deviations) of viscous1..3 (N m s/rad) and coulomb1..3 (N m)."""
+        return self.beta[-6:], self.sigma[-6:]
+
+    def recommendation(self) -> str | None:
+        """One line if the log shows the general model is needed (the report's structure leaves
+        more than NEEDS_GENERAL times its residual on a joint), else None."""
+        if self.comparison is None:
+            return None
+        general, report = (self.rms, self.comparison[1]) if self.structure == "general" else \
+            (self.comparison[1], self.rms)
+        ratio = float((report / general).max())
+        if ratio <= NEEDS_GENERAL:
+            return None
+        return (f"the report's structure leaves up to {ratio:.2f} times the general model's residual (threshold "
+                f"{NEEDS_GENERAL}): this device has products of inertia or off-axis centres of mass; "
+                + ("keep the general structure's result" if self.structure == "general"
+                   else "identify with --structure general"))
 
 
-def filtered(log: Log, cutoff: float) -> tuple[np.ndarray, ...]:
-    """(theta, dtheta, ddtheta, tau), filtered at ``cutoff`` (Hz), edges cut, decimated."""
+#: How a log's torques relate to its times: "held", commands each applied from its sample to the
+#: next (a servo loop's zero-order hold: the default), or "sampled", the torque at that instant
+#: (a torque sensor, or torques computed from the motion).
+TIMINGS = ("held", "sampled")
+
+
+def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Samples:
+    """The log filtered at ``cutoff`` (Hz), with the friction columns of ``law`` (Friction.torque
+    with unit coefficients), edges cut, decimated (module doc, step 1); ``timing`` (TIMINGS)."""
     rate = log.rate
-    if not 0 < cutoff < rate / 2:
-        raise LogError(f"cutoff: {cutoff} Hz must lie between 0 and half the rate ({rate / 2:.4g} Hz)")
+    if not 0 < cutoff * RATE_PER_CUTOFF <= rate:
+        raise LogError(f"cutoff: {cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
+                       f"(this one: {rate:.4g} Hz; central differences need {RATE_PER_CUTOFF:g} samples per "
+                       "second per hertz of cutoff); lower --cutoff or log faster")
     sos = scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
     theta = scipy.signal.sosfiltfilt(sos, log.theta, axis=0)
     tau = scipy.signal.sosfiltfilt(sos, log.tau, axis=0)
+    if timing == "held":
+        # the torque logged at t_k acts until t_k+1 (zero-order hold): low-passed, it is the
+        # smooth signal half a period late; read it at t_k - 1/(2 rate), halfway back (without
+        # this, viscous friction came out up to 20 % low)
+        tau = np.concatenate([tau[:1], 0.5 * (tau[1:] + tau[:-1])])
     dt = 1.0 / rate
     dtheta = np.gradient(theta, dt, axis=0)
     ddtheta = np.gradient(dtheta, dt, axis=0)
+    unit = dataclasses.replace(law, viscous=0.0, coulomb=1.0)
+    columns = scipy.signal.sosfiltfilt(sos, np.concatenate([dtheta, unit.torque(dtheta)], axis=1), axis=0)
     edge = int(np.ceil(EDGE * rate))
     step = max(1, int(rate / (5 * cutoff)))
     keep = slice(edge, len(log.t) - edge, step)
-    return theta[keep], dtheta[keep], ddtheta[keep], tau[keep]
+    friction = columns[keep][:, None, :] * np.tile(np.eye(3), 2)          # (N, 3, 6): diagonal blocks
+    return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau[keep], friction)
 
 
-def base_regressor(structured: Structured, theta, dtheta, ddtheta) -> tuple[np.ndarray, np.ndarray]:
-    """(Phi (N, 3, 14), tau_0 (N, 3)) in beta = (constants, friction), from Pinocchio's regressor:
-    Phi = [Phi_x C^+, Phi_friction] (Phi_x = Y A, exact because Phi_x = Phi_constants C)."""
-    phi_x, tau0 = structured(theta, dtheta, ddtheta)
-    n = len(parameterization.NAMES)
-    pseudo = np.linalg.pinv(constants.constants_matrix(structured.description))
-    return np.concatenate([phi_x[..., :n] @ pseudo, phi_x[..., n:]], axis=-1), tau0
+def _fit(phi: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Weighted least squares of y (N, 3) on phi (N, 3, P): (beta, covariance, residual (N, 3),
+    joint weights (3,)), each joint weighted by 1 / its residual standard deviation."""
+    p = phi.shape[-1]
+    stacked = phi.reshape(-1, p)
+    beta = np.linalg.lstsq(stacked, y.reshape(-1), rcond=None)[0]
+    residual = y - phi @ beta
+    joint_sigma = np.sqrt((residual**2).sum(axis=0) / (len(residual) - p / 3))
+    weight = 1.0 / np.maximum(joint_sigma, 1e-300)
+    weighted, yw = (phi * weight[:, None]).reshape(-1, p), (y * weight).reshape(-1)
+    beta = np.linalg.lstsq(weighted, yw, rcond=None)[0]
+    rw = yw - weighted @ beta
+    covariance = (rw @ rw / (len(yw) - p)) * np.linalg.inv(weighted.T @ weighted)
+    return beta, covariance, y - phi @ beta, weight
 
 
-def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, prior_weight: float = 1e-3,
-             progress: Callable[[float], None] | None = None) -> Fit:
-    """Identify beta and the nearest consistent report parameters from a device log, for the
-    configuration of ``phantom`` (its report numbers are the prior, its friction law the
-    friction columns). Everything it needs is computed once per Description (cached on it).
-    ``progress(share)`` is called as its stages end (filtering, the regressor, the fits)."""
+def _rms(residual: np.ndarray) -> np.ndarray:
+    return np.sqrt((residual**2).mean(axis=0))
+
+
+def _scaled(phi: np.ndarray, y: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The factors s (3,) (s_1 = 1) with which the joints' torques fit best, s_j y_j = Phi_j beta
+    (a linear least-squares problem in beta, s_2, s_3), and the residual RMS per joint in the
+    log's torque units."""
+    n, _, p = phi.shape
+    rows = np.zeros((3, n, p + 2))
+    rows[:, :, :p] = phi.transpose(1, 0, 2) * weight[:, None, None]
+    rows[1, :, p] = -y[:, 1] * weight[1]
+    rows[2, :, p + 1] = -y[:, 2] * weight[2]
+    rhs = np.zeros((3, n))
+    rhs[0] = y[:, 0] * weight[0]
+    solution = np.linalg.lstsq(rows.reshape(-1, p + 2), rhs.reshape(-1), rcond=None)[0]
+    scale = np.array([1.0, *solution[p:]])
+    return scale, _rms((phi @ solution[:p]) / np.where(scale != 0, scale, 1.0) - y)
+
+
+def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
+             prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
+             timing: str = "held") -> Fit:
+    """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
+    the prior, its friction law the friction columns): the base parameters of ``structure``
+    ("general": the rigid body in full; "report": the report's structure, for a model in the
+    report's form) and the nearest physically consistent parameters (module doc). Raises
+    LogError for a log that cannot be identified at all (too short, too low a rate for
+    ``cutoff`` Hz, too poorly excited, constant torques); ``Fit.problems`` lists the reasons
+    a fitted result should not be written. ``timing``: how the torques relate to the times
+    (TIMINGS: "held" commands, the default, or "sampled" values). ``progress(share)`` is called
+    as stages end."""
     def stage(share: float) -> None:
         if progress is not None:
             progress(share)
 
     if not isinstance(log, Log):
-        raise InvalidInputError(f"log: expected a phantom_pin.identification.io.Log (read_log), got {log!r}")
+        raise InvalidInputError(f"log: expected a phantom_pin.identification.Log (read_log), got {log!r}")
     if not isinstance(phantom, Phantom):
         raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, got {phantom!r}")
     for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
             raise InvalidInputError(f"{name}: expected a finite number > 0, got {value!r}")
-
-    theta, dtheta, ddtheta, tau = filtered(log, cutoff)
+    if timing not in TIMINGS:
+        raise InvalidInputError(f"timing: expected one of {', '.join(TIMINGS)}, got {timing!r}")
+    if structure not in STRUCTURES:
+        raise InvalidInputError(f"structure: expected one of {', '.join(STRUCTURES)}, got {structure!r}")
+    constant = [f"tau{j + 1}" for j in range(3) if np.ptp(log.tau[:, j]) == 0]
+    if constant:
+        raise LogError(f"{', '.join(constant)}: constant torque{'s' if len(constant) > 1 else ''} over the whole "
+                       "log: nothing to identify (the log must hold the torques commanded during the motion)")
+    model = STRUCTURES[structure](phantom)
+    samples = filtered(log, cutoff, phantom.config.actuation.friction, timing)
     stage(0.1)
-    if len(theta) < 50:
-        raise LogError(f"too short: {len(theta)} samples after filtering (need 50)")
-    structured = Structured(Regressor(phantom))
-    phi, tau0 = base_regressor(structured, theta, dtheta, ddtheta)
+    if len(samples.theta) < 50:
+        raise LogError(f"too short: {len(samples.theta)} samples after filtering (need 50)")
+    phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     stage(0.4)
-    p = phi.shape[-1]
-    stacked, y = phi.reshape(-1, p), (tau - tau0).reshape(-1)
+    y = samples.tau - tau0
+    stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)
     condition = float(np.linalg.cond(stacked / np.where(norms > 0, norms, 1.0)))
     if not condition <= MAX_CONDITION:
         raise LogError(f"not exciting enough: the base regressor's condition number is {condition:.3g} "
                        f"(at most {MAX_CONDITION:.0e}); log an excitation trajectory (phantom-pin excite)")
-    beta = np.linalg.lstsq(stacked, y, rcond=None)[0]
-    residual = (y - stacked @ beta).reshape(-1, 3)
-    joint_sigma = np.sqrt((residual**2).sum(axis=0) / (len(residual) - p / 3))
-    weight = np.tile(1.0 / joint_sigma, len(theta))
-    weighted, yw = stacked * weight[:, None], y * weight
-    beta, *_ = np.linalg.lstsq(weighted, yw, rcond=None)
-    rw = yw - weighted @ beta
-    s2 = rw @ rw / (len(yw) - p)
-    covariance = s2 * np.linalg.inv(weighted.T @ weighted)
-    residual = (y - stacked @ beta).reshape(-1, 3)
-    c = constants.constants_matrix(phantom.description)
-    n = len(constants.NAMES)
-    info = np.linalg.inv(covariance[:n, :n])
-    root = np.linalg.cholesky(info).T                       # root^T root = covariance^-1
-    affine, offset = structured.affine, structured.offset
-    prior = parameterization.report_vector(phantom.config)
+    beta, covariance, residual, weight = _fit(phi, y)
+    sigma = np.sqrt(np.diag(covariance))
+    root = np.linalg.cholesky(np.linalg.inv(covariance)).T            # root^T root = covariance^-1
     stage(0.5)
-    x = physical.nearest(beta[:n], root, c, prior, affine, offset, phantom.config, prior_weight)
+    x = model.nearest(beta, root, prior_weight)
+    written = model.matrix @ x + model.offset
     stage(0.7)
-    general = structured.regressor.stacked(theta, dtheta, ddtheta)
-    base = base_parameters(general, structured.regressor.names)
-    independent = general[:, list(base.independent)]
-    fitted = independent @ np.linalg.lstsq(independent, tau.reshape(-1), rcond=None)[0]
-    general_rms = np.sqrt(((tau.reshape(-1) - fitted).reshape(-1, 3) ** 2).mean(axis=0))
-    return Fit(beta, np.sqrt(np.diag(covariance)), np.sqrt((residual**2).mean(axis=0)),
-               np.sqrt(((tau - tau0)**2).mean(axis=0)), condition, len(theta), x, c @ x,
-               general_rms, base.rank)
+    comparison = _comparison(model, phantom, samples)
+    scale, scaled_rms = _scaled(phi, y, weight)
+    fit = Fit(model.name, model.base_names, model.units, beta, sigma, _rms(residual), _rms(y - phi @ written),
+              _rms(y), condition, len(samples.theta), x, written, model.overrides(x), comparison, scale,
+              scaled_rms, ())
+    problems = _problems(fit, model, phi, y, log, phantom)
+    stage(1.0)
+    return dataclasses.replace(fit, problems=tuple(problems))
+
+
+def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[str, np.ndarray] | None:
+    """The other structure's least-squares residual RMS per joint (N m), if it applies."""
+    other = "report" if model.name == "general" else "general"
+    if other == "report" and phantom.config.report is None:
+        return None
+    phi, tau0 = STRUCTURES[other](phantom).regressor_of(samples.theta, samples.dtheta, samples.ddtheta,
+                                                        samples.friction)
+    y = samples.tau - tau0
+    return other, _rms(_fit(phi, y)[2])
+
+
+def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Log, phantom: Phantom) -> list[str]:
+    """Why ``fit`` should not be written (module doc, step 4), most telling first."""
+    problems = []
+    beyond = float(np.abs(phantom.config.limits.stops.penetration(log.theta)).max())
+    if beyond > BEYOND_STOPS:
+        problems.append(f"theta: the log's angles reach {beyond:.3g} rad beyond the stops; are they in degrees, or "
+                        "in another convention? (the log holds the report's theta in rad, or use --convention "
+                        "openhaptics)")
+    share = fit.rms / fit.torque_rms
+    if share.max() > MAX_RESIDUAL_SHARE:
+        problems.append("the fit leaves " + ", ".join(f"{100 * s:.0f} %" for s in share) + " of the torque RMS "
+                        f"(at most {100 * MAX_RESIDUAL_SHARE:.0f} %): the torques do not follow the motion; check "
+                        "that theta and tau are the same samples, in rad and N m")
+    prior = phi @ (model.matrix @ model.prior + model.offset)
+    size = float((y * prior).sum() / (prior * prior).sum())
+    if not TORQUE_SCALE[0] <= size <= TORQUE_SCALE[1]:
+        problems.append(f"tau: the logged torques are {size:.3g} times the model's prediction along the motion"
+                        + ("; are their signs flipped (amplifier polarity)?" if size < 0 else
+                           "; are they in another unit (N m at the joint, not mN m or motor torques)?"))
+    values, sigma = fit.friction
+    negative = [name for name, v, s in zip(model.names[-6:], values, sigma) if v < -3 * s]
+    if negative:
+        problems.append(f"negative friction ({', '.join(negative)}): check the torque signs, units and "
+                        "transmission ratios (friction is written as 0 or more)")
+    moved = np.abs(fit.written - fit.beta)
+    far = np.flatnonzero((moved > MAX_SHIFT_SIGMA * fit.sigma) & (moved > SHIFT_SHARE * np.abs(fit.beta)))
+    if far.size:
+        k = far[np.argmax((moved / fit.sigma)[far])]
+        flipped = np.sign(fit.written[k]) != np.sign(fit.beta[k])
+        name = model.base_names[k].split(" = ")[0]
+        name = name if len(name) <= 40 else name[:40].rsplit(" ", 1)[0] + " ..."
+        problems.append(f"the nearest physical parameters move beta{k + 1} ({name}) from "
+                        f"{fit.beta[k]:.4g} to {fit.written[k]:.4g} {fit.units[k]} ({moved[k] / fit.sigma[k]:.3g} "
+                        f"standard deviations{', a flipped sign' if flipped else ''}): the estimate is not of a "
+                        "physical arm; check torque signs, units and transmission ratios")
+    off = np.abs(fit.torque_scale - 1)
+    if off.max() > RATIO_SHARE and ((fit.scaled_rms / fit.torque_rms) ** 2).sum() < \
+            MARKED_IMPROVEMENT * ((fit.rms / fit.torque_rms) ** 2).sum():
+        ratios = phantom.config.actuation.ratios
+        joints = [j for j in (1, 2) if off[j] > RATIO_SHARE]
+        flipped = [j for j in joints if fit.torque_scale[j] < 0]
+        hint = "" if ratios is None else " (" + ", ".join(
+            f"ratio {ratios[j] / fit.torque_scale[j]:.4g} instead of the model's {ratios[j]:.4g}"
+            for j in joints if j not in flipped) + ")"
+        cause = (", ".join(f"tau{j + 1}" for j in flipped) + "'s sign is flipped (amplifier polarity)" if flipped
+                 else f"were the joint torques converted with other transmission ratios{hint}? The log must hold "
+                      "joint torques (N m at the joint: motor torque x ratio)")
+        problems.insert(0, ", ".join(f"tau{j + 1}" for j in joints) + " fit markedly better scaled by "
+                        + ", ".join(f"{fit.torque_scale[j]:.4g}" for j in joints)
+                        + " against tau1 (residual " + ", ".join(f"{100 * s:.2g} %" for s in fit.rms / fit.torque_rms)
+                        + " -> " + ", ".join(f"{100 * s:.2g} %" for s in fit.scaled_rms / fit.torque_rms)
+                        + f"): {cause}")
+    return problems

@@ -15,7 +15,7 @@ import numpy as np
 import scipy.optimize
 
 from phantom_pin.description.build import Description
-from phantom_pin.identification import constants
+from phantom_pin.dynamics.model import Phantom
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,50 +64,72 @@ def condition_number(phi: np.ndarray) -> float:
 @dataclasses.dataclass(frozen=True)
 class Excitation:
     trajectory: Fourier
-    condition: float        # of the base regressor over one period (columns scaled to unit norm)
-    peak_torque: np.ndarray  # N m per joint, report model with the configuration's friction
+    condition: float        # of the general base regressor over one period (columns scaled to unit norm)
+    report_condition: float  # of the report structure's (None for a model in full)
+    peak_torque: np.ndarray  # N m per joint, the configuration's model with its friction
     min_slack: float        # rad, nearest approach to a stop
 
 
-def optimise(description: Description, period: float = 5.0, harmonics: int = 5,
+def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
              progress: Callable[[float], None] | None = None,
              amplitude_weight: float = 3.0) -> Excitation:
     """Minimise log(condition number) - amplitude_weight x mean log(singular value) of the
-    base regressor (columns scaled to unit norm for the first, weighted by the nominal beta
-    for the second, so that the torques grow against the noise) over the Fourier
-    coefficients, subject to: positions ``margin`` (rad) inside every stop, and the report model's torque (with the
-    configuration's friction) below ``torque_share`` of each motor's continuous torque. SLSQP from
-    ``restarts`` seeded random starts; the best feasible result is returned.
+    general base regressor (structures.General: every identifiable combination of the rigid
+    body in full and friction; columns scaled to unit norm for the first, weighted by each base
+    parameter's typical size for the second, so that the torques grow against the noise) over
+    the Fourier coefficients, subject to: positions ``margin`` (rad) inside every stop, and the
+    configuration's model's torque (with its friction) below ``torque_share`` of each joint's
+    torque limit. SLSQP from ``restarts`` seeded random starts; the best feasible result is
+    returned.
 
     The optimiser samples a period at ``samples`` points; the result is then checked at
     ``times`` (s, the file's samples; default: the same points), stepping back towards the
     start until the stops' margin and the torque share hold there too, and its condition
-    number, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
-    called with the share of the SLSQP iterations done."""
+    numbers, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
+    called with the share of the SLSQP iterations done. ``model``: the Phantom (or its
+    Description, then loaded once more into Pinocchio) whose configuration is excited."""
+    from phantom_pin.identification.structures import General, Report
+
+    phantom = model if isinstance(model, Phantom) else Phantom(model)
+    description = phantom.description
     limits = description.config.limits
     effort = continuous_effort(description)
-    beta = constants.nominal(description)
+    general = General(phantom)
+    beta = general.matrix @ general.prior                    # the configuration's own base parameters
+    typical = np.abs(general.matrix) @ general.scale         # each base parameter's typical size
     t = np.linspace(0.0, period, samples, endpoint=False)
     rng = np.random.default_rng(seed)
+    memo: dict[bytes, tuple] = {}
 
-    def evaluate(free):
-        trajectory = Fourier.from_free(free, harmonics, period)
-        states = trajectory(t)
-        phi = constants.regressor(*states, description).reshape(-1, len(beta))
-        return states, phi
+    def evaluate(free, at=t):
+        """(states, Phi stacked (3N, P), torque (N, 3)) at the times ``at``."""
+        key = free.tobytes() + (b"" if at is t else b"checked")
+        if key not in memo:
+            memo.clear()
+            states = Fourier.from_free(free, harmonics, period)(at)
+            phi, tau0 = general.regressor_of(*states)
+            memo[key] = states, phi.reshape(-1, len(beta)), phi @ beta + tau0
+        return memo[key]
 
     def cost(free):
         phi = evaluate(free)[1]
         # condition number, and (D-optimality) the mean log singular value of the regressor with
-        # columns weighted by the nominal beta: rewards torque signals large against the noise
-        size = np.linalg.svd(phi * np.abs(beta) / np.sqrt(len(phi)), compute_uv=False)
+        # columns weighted by the typical sizes: rewards torque signals large against the noise.
+        # Both from the eigenvalues of the small Gram matrix (the squared singular values), or
+        # from singular values where squaring would lose them (a poorly exciting start)
+        gram = phi.T @ phi
+        norms = np.sqrt(np.diag(gram))
+        unit = np.linalg.eigvalsh(gram / np.outer(norms, norms))
+        if unit[0] > 1e-10 * unit[-1]:
+            weighted = np.linalg.eigvalsh(gram * np.outer(typical, typical) / len(phi))
+            return 0.5 * np.log(unit[-1] / unit[0]) - amplitude_weight * 0.5 * np.log(weighted).mean()
+        size = np.linalg.svd(phi * typical / np.sqrt(len(phi)), compute_uv=False)
         return np.log(condition_number(phi)) - amplitude_weight * np.log(size).mean()
 
     def inequalities(free):
-        states, phi = evaluate(free)
-        torque = (phi @ beta).reshape(-1, 3)
+        states, _, torque = evaluate(free)
         return np.concatenate([limits.slack(states[0]).ravel() - margin,
                                (torque_share * effort - np.abs(torque)).ravel() * 10])
 
@@ -117,8 +139,7 @@ def optimise(description: Description, period: float = 5.0, harmonics: int = 5,
         """The inequalities at the optimiser's points and at ``checked``."""
         if inequalities(free).min() < -1e-9:
             return False
-        states = Fourier.from_free(free, harmonics, period)(checked)
-        torque = constants.regressor(*states, description) @ beta
+        states, _, torque = evaluate(free, checked)
         return bool(limits.slack(states[0]).min() >= margin - 1e-9
                     and (torque_share * effort - np.abs(torque)).min() >= -1e-12)
 
@@ -148,8 +169,9 @@ def optimise(description: Description, period: float = 5.0, harmonics: int = 5,
     if best is None:
         raise RuntimeError("excitation: no feasible trajectory found; raise --restarts")
     trajectory = Fourier.from_free(best, harmonics, period)
-    states = trajectory(checked)
-    phi = constants.regressor(*states, description).reshape(-1, len(beta))
-    torque = (phi @ beta).reshape(-1, 3)
-    return Excitation(trajectory, condition_number(phi), np.abs(torque).max(axis=0),
+    states, phi, torque = evaluate(best, checked)
+    report = None
+    if description.config.report is not None:
+        report = condition_number(Report(general.phantom).regressor_of(*states)[0].reshape(-1, 14))
+    return Excitation(trajectory, condition_number(phi), report, np.abs(torque).max(axis=0),
                       float(limits.slack(states[0]).min()))

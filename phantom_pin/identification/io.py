@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.validation import as_states
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
@@ -153,18 +153,27 @@ def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2)
     return mean if ok.all() else None
 
 
-def overlay(fit, config) -> tuple[dict[str, float], list[str]]:
-    """The --params keys of an identification on the configuration ``config`` and the comment
-    lines that explain them."""
-    from phantom_pin.identification import constants, parameterization
+def overlay(fit, given: dict | None = None) -> tuple[dict[str, float], list[str]]:
+    """The --params keys of an identification (estimation.Fit) on a model with the overrides
+    ``given`` (those of the bodies it identified dropped: the segments and links), and the
+    comment lines that explain its friction: one value per law, the joints' inverse-variance
+    mean of the physical (never negative) values, written only if they agree
+    (friction_overlay)."""
+    from phantom_pin.config import REPORT_SEGMENTS, section
+    from phantom_pin.identification.estimation import Fit
 
-    keys = parameterization.overrides(fit.x, config)
+    if not isinstance(fit, Fit):
+        raise InvalidInputError(f"fit: expected a phantom_pin.identification.Fit (estimate), got {fit!r}")
+    if given is not None and not isinstance(given, dict):
+        raise InvalidInputError(f"given: expected a dict of --params keys or None, got {given!r}")
+    bodies = REPORT_SEGMENTS + ("links",)
+    keys = {key: value for key, value in (given or {}).items() if section(key) not in bodies}
+    keys.update(fit.overrides)
     notes = []
-    n = len(constants.NAMES)
-    for kind, first in (("viscous", n), ("coulomb", n + 3)):
-        values, sigma = fit.beta[first:first + 3], fit.sigma[first:first + 3]
-        common = friction_overlay(values, sigma)
-        listed = ", ".join(f"{v:.4g} +- {s:.2g}" for v, s in zip(values, sigma))
+    values, sigma = fit.friction
+    for kind, part in (("viscous", slice(0, 3)), ("coulomb", slice(3, 6))):
+        common = friction_overlay(fit.x[-6:][part], sigma[part])   # the projection's: >= 0
+        listed = ", ".join(f"{v:.4g} +- {s:.2g}" for v, s in zip(values[part], sigma[part]))
         if common is None:
             notes.append(f"friction.{kind} per joint: {listed} (the joints differ: not written; "
                          "actuation.yaml holds one value for all joints)")
@@ -174,20 +183,21 @@ def overlay(fit, config) -> tuple[dict[str, float], list[str]]:
     return keys, notes
 
 
-def write_overlay(path: Path | str, fit, source: str, config) -> None:
-    """Write the identified parameters as a --params YAML file (dotted keys, SI units)."""
-    from phantom_pin.identification import constants
-
-    keys, notes = overlay(fit, config)
-    lines = [f"# Identified by phantom-pin identify from {source}: a --params overlay for",
-             "# phantom-pin urdf/srdf/mjcf and Phantom (docs/identification.md). SI units.",
+def write_overlay(path: Path | str, fit, source: str, given: dict | None = None) -> None:
+    """Write an identification (estimation.Fit) as a --params YAML file (dotted keys, SI units),
+    with the model's other overrides ``given`` (see ``overlay``)."""
+    keys, notes = overlay(fit, given)
+    lines = [f"# Identified by phantom-pin identify from {source} ({fit.structure} structure): a --params",
+             "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
+             "# (docs/identification.md). SI units.",
              f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g}; "
              "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms),
              "# base parameters (estimate +- standard deviation; of the written parameters):"]
-    for name, unit, value, sigma, written in zip(constants.NAMES, constants.UNITS, fit.beta,
-                                                 fit.sigma, fit.constants):
-        lines.append(f"#   {name:4} = {value:.6g} +- {sigma:.2g} {unit}; written {written:.6g}")
+    for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
+        lines.append(f"#   beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written "
+                     f"{fit.written[k]:.6g}: {name}")
     lines += [f"# {note}" for note in notes]
-    lines += ["# Directions the torques do not determine are kept near the report's values (prior)."]
+    lines += [f"# problem, written with --force: {problem}" for problem in fit.problems]
+    lines += ["# Directions the torques do not determine are kept near the model's values (the prior)."]
     lines += [f"{key}: {value!r}" for key, value in keys.items()]
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")

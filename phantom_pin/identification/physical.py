@@ -1,45 +1,32 @@
-"""Physical consistency of identified parameters: every link passes the one physical check of a
-link (phantom_pin.inertial.problem), the rotor inertia is positive; and the nearest
-consistent report parameters to an estimate.
+"""Physical consistency of identified parameters, and the nearest consistent parameters to an
+estimate.
+
+A link is physical when its pseudo-inertia J = [[Sigma, h], [h^T, m]] (Sigma = integral(r r^T
+dm) = tr(I)/2 1 - I about the link origin, h = m c) is positive definite: m > 0 and principal
+moments at the centre of mass strictly inside the triangle inequality (Wensing, Kim and
+Slotine, IEEE RA-L 2018). J is linear in the standard parameters, so the physical parameters
+form a convex set, and the nearest of them to an estimate in any quadratic metric is a convex
+problem: ``nearest`` solves it by a log-det barrier (interior point) method whose Newton steps
+do not mind the metric's conditioning (the torques fix some combinations to 1e-8 and leave
+others to a prior). The decision stays with the one physical check of a link
+(phantom_pin.inertial.problem), which asks a margin of TRIANGLE_SLACK inside the boundary.
 """
 
 from __future__ import annotations
 
+from typing import Callable, Sequence
+
 import numpy as np
-import scipy.optimize
 
 from phantom_pin.config import Config
 from phantom_pin.identification import parameterization
 from phantom_pin.inertial import problem
 from phantom_pin.report.parameters import links
 
-#: How far inside the triangle inequality (a share of the largest moment) SLSQP aims. It is
-#: not a tolerance of the law: ``consistent`` decides with the exact links and the one check
-#: (phantom_pin.inertial.problem); this margin only covers the affine map's rounding (up to
-#: about 1e-12 of the largest parameter), so that the optimiser's answer passes that check.
-_AIM = 1e-9
-
-
-def body_margins(pi_inertial: np.ndarray) -> np.ndarray:
-    """(n_bodies, 4): mass (kg), smallest principal moment at the COM, the triangle slack
-    lambda1 + lambda2 - lambda3 and the largest moment lambda3 (kg m^2, ascending) of each body,
-    from standard parameters [m, h, I_origin] (Pinocchio's order)."""
-    out = []
-    for m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz in np.asarray(pi_inertial).reshape(-1, 10):
-        h = np.array([hx, hy, hz])
-        origin = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-        com = origin - (h @ h * np.eye(3) - np.outer(h, h)) / m if m > 0 else origin
-        moments = np.linalg.eigvalsh(com)
-        out.append([m, moments[0], moments[0] + moments[1] - moments[2], moments[2]])
-    return np.array(out)
-
-
-def _constraints(x: np.ndarray, affine: np.ndarray, offset: np.ndarray) -> np.ndarray:
-    """The smooth margins of the physical check (>= 0 where it holds, scaled for SLSQP)."""
-    pi = affine @ x + offset
-    margins = body_margins(pi[:-3])
-    return np.concatenate([margins[:, 0], margins[:, 1] * 1e4, (margins[:, 2] - _AIM * margins[:, 3]) * 1e4,
-                           [x[parameterization.ROTOR] * 1e6]])
+#: The barrier method's end: the duality gap (in units of the whitened cost, a chi-square).
+GAP = 1e-7
+#: Newton steps per barrier weight, and the weight's growth.
+NEWTON_STEPS, GROWTH = 60, 10.0
 
 
 def consistent(x: np.ndarray, config: Config) -> bool:
@@ -55,51 +42,128 @@ def consistent(x: np.ndarray, config: Config) -> bool:
     return all(problem(link) is None for link in linked.values())
 
 
-def nearest(target: np.ndarray, weights: np.ndarray, constants_matrix: np.ndarray,
-            prior: np.ndarray, affine: np.ndarray, offset: np.ndarray, config: Config,
+def pseudo_inertia(pi: np.ndarray) -> np.ndarray:
+    """The 4x4 pseudo-inertia J of one body's standard parameters (Pinocchio's order [m, m c,
+    I_origin xx, xy, yy, xz, yz, zz]; module doc); linear in them."""
+    m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = np.asarray(pi, float)
+    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    out = np.empty((4, 4))
+    out[:3, :3] = 0.5 * np.trace(inertia) * np.eye(3) - inertia
+    out[:3, 3] = out[3, :3] = (hx, hy, hz)
+    out[3, 3] = m
+    return out
+
+
+def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,
+            scale: np.ndarray, bodies: Sequence[tuple[np.ndarray, np.ndarray]], positive: Sequence[int],
+            consistent: Callable[[np.ndarray], bool], fixed: Sequence[int] = (),
             prior_weight: float = 1e-3) -> np.ndarray:
-    """The report parameters x nearest to the estimated constants ``target``:
-    minimise |W (C x - target)|^2 + prior_weight^2 |(x - prior) / prior|^2 subject to
-    every tree body's mass, inertia and triangle conditions and J > 0. The unconstrained
-    optimum if it is consistent; else the farthest consistent point from the prior towards it,
-    refined by SLSQP: always consistent. ``weights`` W is
-    a matrix with W^T W = the inverse covariance of ``target`` (or a vector: its diagonal).
-    The prior (the report's values) fixes the directions the data cannot see; its weight is
-    small so that it does not move the identifiable constants measurably."""
-    scale = np.where(prior != 0, np.abs(prior), 1.0)  # J = 0 without public motor data
+    """The parameters x nearest to the estimated base parameters ``target``:
+
+        minimise |W (matrix x - target)|^2 + prior_weight^2 |(x - prior) / scale|^2
+
+    subject to every body physical, its standard parameters ``A x + b`` for each (A, b) of
+    ``bodies``, and x_i > 0 for i in ``positive``; the entries ``fixed`` stay at the prior.
+    ``weights`` W is a matrix with W^T W = the inverse covariance of ``target`` (or a vector:
+    its diagonal). The prior (the model's own values, consistent) fixes the directions the data
+    cannot see; its weight is small so that it does not move the identifiable combinations
+    measurably. The unconstrained optimum if it is ``consistent``; else the barrier method's
+    optimum (module doc), stepped back towards the prior as far as ``consistent`` needs."""
     weights = np.diag(weights) if np.ndim(weights) == 1 else np.asarray(weights)
-
-    def residual(z):
-        x = z * scale
-        return np.concatenate([weights @ (constants_matrix @ x - target), prior_weight * (z - prior / scale)])
-
-    def cost(z):
-        r = residual(z)
-        return 0.5 * r @ r
-
-    def gradient(z):
-        jac = np.vstack([weights @ constants_matrix * scale, prior_weight * np.eye(len(z))])
-        return jac.T @ residual(z)
-
+    prior, scale = np.asarray(prior, float), np.asarray(scale, float)
+    held = np.asarray(fixed, int)
+    free = np.setdiff1d(np.arange(len(prior)), held)
     z0 = prior / scale
-    unconstrained = scipy.optimize.least_squares(residual, z0, method="lm").x
-    if consistent(unconstrained * scale, config):
-        return unconstrained * scale
-    # the farthest consistent point on the segment from the (consistent) prior to the
-    # unconstrained optimum, by bisection: always available, and SLSQP's start
-    low, high = 0.0, 1.0
+    # the cost in z = x / scale over the free entries: 0.5 |K z - k|^2, K = [W matrix scale;
+    # pw 1]. Its singular value decomposition K = U S V^T whitens it, y = S V^T z: 0.5 |y - y_u|^2
+    # (no normal equations: the metric spans 1e-6 to 1e18)
+    d = weights @ matrix * scale
+    stacked = np.vstack([d[:, free], prior_weight * np.eye(len(free))])
+    rhs = np.concatenate([weights @ target - d[:, held] @ z0[held], prior_weight * z0[free]])
+    u, sizes, vt = np.linalg.svd(stacked, full_matrices=False)
+    to_z = vt.T / sizes                                            # z = to_z @ y
+    optimum = u.T @ rhs                                            # y_u
+
+    def full(y: np.ndarray) -> np.ndarray:
+        out = prior.copy()
+        out[free] = (to_z @ y) * scale[free]
+        return out
+
+    if consistent(full(optimum)):
+        return full(optimum)
+    # each body's pseudo-inertia as C + sum_j y_j B_j
+    blocks = []
+    for a, b in bodies:
+        a = np.asarray(a, float)[:, free] * scale[free] @ to_z
+        if np.abs(a).max() > 0:
+            blocks.append((np.array([pseudo_inertia(column) for column in a.T]), pseudo_inertia(b)))
+    rows = to_z[[list(free).index(i) for i in positive if i in free]]      # z_i = rows @ y > 0
+    m = 4 * len(blocks) + len(rows)
+
+    def barrier(y: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
+        """(-log det of every J - log z_i of the positive entries, its gradient, its Hessian);
+        None outside the domain."""
+        value, gradient, curvature = 0.0, np.zeros(len(y)), np.zeros((len(y), len(y)))
+        for basis, constant in blocks:
+            j = constant + np.tensordot(y, basis, axes=1)
+            try:
+                root = np.linalg.cholesky(j)
+            except np.linalg.LinAlgError:
+                return None
+            value -= 2 * np.log(np.diag(root)).sum()
+            inverse_basis = np.linalg.solve(j, basis)                      # J^-1 B_j, stacked
+            gradient -= np.trace(inverse_basis, axis1=1, axis2=2)
+            curvature += np.einsum("iab,jba->ij", inverse_basis, inverse_basis)
+        if len(rows):
+            values = rows @ y
+            if (values <= 0).any():
+                return None
+            value -= np.log(values).sum()
+            gradient -= rows.T @ (1 / values)
+            curvature += (rows.T / values**2) @ rows
+        return value, gradient, curvature
+
+    def cost(y: np.ndarray) -> float:
+        return float(0.5 * (y - optimum) @ (y - optimum))
+
+    y = vt @ z0[free] * sizes                                      # the prior: consistent
+    # the first weight balances the barrier and the cost (m / the prior's cost), but no less than
+    # 1e-12 of the barrier's curvature: the Newton system stays solvable in floating point
+    weight = max(m / max(cost(y), 1e-300), 1e-12 * np.abs(barrier(y)[2]).max())
+    while True:
+        for _ in range(NEWTON_STEPS):
+            value, gradient, curvature = barrier(y)
+            g = weight * (y - optimum) + gradient
+            system = weight * np.eye(len(y)) + curvature
+            try:
+                step = -np.linalg.solve(system, g)
+            except np.linalg.LinAlgError:       # rounding, with a J near singular: least squares
+                step = -np.linalg.lstsq(system, g, rcond=None)[0]
+            if not np.isfinite(step).all():
+                break
+            decrement = -g @ step
+            if decrement < 1e-12:
+                break
+            here, alpha = weight * cost(y) + value, 1.0
+            while alpha > 1e-12:
+                trial = barrier(y + alpha * step)
+                if trial is not None and weight * cost(y + alpha * step) + trial[0] <= here - 0.25 * alpha * decrement:
+                    break
+                alpha *= 0.5
+            if alpha <= 1e-12:
+                break
+            y = y + alpha * step
+        if m / weight < GAP:
+            break
+        weight *= GROWTH
+    x = full(y)
+    if consistent(x):
+        return x
+    low, high = 0.0, 1.0          # the barrier's end lies within rounding of the boundary: step back
     for _ in range(60):
         middle = (low + high) / 2
-        if consistent((z0 + middle * (unconstrained - z0)) * scale, config):
+        if consistent(prior + middle * (x - prior)):
             low = middle
         else:
             high = middle
-    fallback = z0 + low * (unconstrained - z0)
-    norm = max(cost(fallback), 1e-300)
-    result = scipy.optimize.minimize(
-        lambda z: cost(z) / norm, fallback, jac=lambda z: gradient(z) / norm, method="SLSQP",
-        constraints=[{"type": "ineq", "fun": lambda z: _constraints(z * scale, affine, offset)}],
-        options={"maxiter": 500, "ftol": 1e-12})
-    if consistent(result.x * scale, config) and cost(result.x) < cost(fallback):
-        return result.x * scale
-    return fallback * scale
+    return prior + low * (x - prior)

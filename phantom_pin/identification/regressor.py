@@ -74,23 +74,29 @@ class Regressor:
                                           np.broadcast_to(np.asarray(viscous, float), 3),
                                           np.broadcast_to(np.asarray(coulomb, float), 3)])
 
-    def _one(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        c = self.coupling
-        tree_y = pin.computeJointTorqueRegressor(self.tree, self._data, c.configuration(q),
-                                                 c.tangent(v), c.tangent(a))
-        return np.hstack([c.matrix.T @ tree_y, np.diag(a), np.diag(v),
-                          np.diag(self._coulomb(v))])
-
     def __call__(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
         """Y at one state (3, P) or a batch (N, 3, P); rad, rad/s, rad/s^2 -> N m per unit."""
-        q, batch = as_states(theta, "theta")
+        q, _ = as_states(theta, "theta")
         v, _ = as_states(dtheta, "dtheta")
         a, _ = as_states(ddtheta, "ddtheta")
         same_batch(("theta", "dtheta", "ddtheta"), q, v, a)
-        if not batch:
-            return self._one(q, v, a)
-        flat = [self._one(*row) for row in zip(q.reshape(-1, 3), v.reshape(-1, 3), a.reshape(-1, 3))]
-        return np.stack(flat).reshape(q.shape[:-1] + (3, self.size))
+        shape = q.shape[:-1]
+        q, v, a = (x.reshape(-1, 3) for x in (q, v, a))
+        c = self.coupling
+        # Pinocchio once per state on the tree; the projection G^T Y_tree and the diagonal
+        # rotor and friction columns for the whole batch
+        tree_q, tree_v, tree_a = c.configuration(q), c.tangent(v), c.tangent(a)
+        tree_y = np.empty((len(q), self.tree.nv, self.n_inertial))
+        regressor, tree, data = pin.computeJointTorqueRegressor, self.tree, self._data
+        for i in range(len(q)):
+            tree_y[i] = regressor(tree, data, tree_q[i], tree_v[i], tree_a[i])
+        out = np.zeros((len(q), 3, self.size))
+        out[..., self.inertial] = np.einsum("tj,ntp->njp", c.matrix, tree_y)
+        rows = np.arange(3)
+        out[:, rows, self.rotors.start + rows] = a
+        out[:, rows, self.friction.start + rows] = v
+        out[:, rows, self.friction.start + 3 + rows] = self._coulomb(v)
+        return out.reshape(shape + (3, self.size))
 
     def stacked(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
         """Y of a batch stacked into (3N, P): rows tau1, tau2, tau3 of state 0, then state 1..."""

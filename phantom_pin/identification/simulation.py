@@ -1,10 +1,11 @@
-"""A simulated PHANToM for testing identification: the report's closed-form dynamics with
-any parameters, friction, torque noise and encoder quantization, tracking a trajectory.
+"""A simulated device logging an identification run: the device's own plant (phantom_pin.simulate:
+the rigid body with its rotors, friction, stops and saturation, RK4 with a zero-order hold)
+tracking a trajectory with feed-forward plus PD, as ``phantom-pin simulate --trajectory`` does.
 
-Integration: classical RK4 (phantom_pin.integration) at the log's rate with the commanded torque held over each step
-(zero-order hold). Controller: the inverse dynamics of the parameters model along the
-reference plus PD feedback (on the quantized position and the true velocity). Logged: time,
-the quantized positions and the *commanded* torques, as a real device's log.
+``tracking(t, theta, dtheta, tau)`` is that controller; ``track(device, ...)`` runs it and
+returns the Log a real device would write: the encoder's angles (quantized, with an encoder)
+and the *commanded* torques, each held until the next sample ("held" timing), while the plant
+receives them plus white noise (an amplifier's error the log does not see).
 """
 
 from __future__ import annotations
@@ -13,44 +14,51 @@ from typing import Callable
 
 import numpy as np
 
-from phantom_pin.config import Friction
+from phantom_pin.device.device import Device
+from phantom_pin.device.simulation import simulate
+from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log
-from phantom_pin.integration import rk4_step
-from phantom_pin.report import closed_form
-from phantom_pin.report.parameters import ReportParameters
+
+#: The PD gains of the tracking controller (N m/rad, N m s/rad).
+KP, KD = 5.0, 0.05
 
 
-def simulate(reference: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
-             duration: float, truth: ReportParameters, model: ReportParameters, friction: Friction,
-             rate: float = 1000.0, torque_noise: float = 0.0,
-             resolution: np.ndarray | float = 0.0, kp: float = 5.0, kd: float = 0.05,
-             seed: int = 0) -> Log:
-    """Track ``reference(t) -> (theta, dtheta, ddtheta)`` (rad, rad/s, rad/s^2 at (N,) times)
-    for ``duration`` s on the device ``truth``, fed forward with the inverse dynamics of
-    ``model`` (the parameters the controller believes), with the friction law ``friction``
-    (phantom_pin.config.Friction, the same on each joint). ``torque_noise``: standard
-    deviation (N m) of white noise added to the applied torque; ``resolution``: encoder step
-    at the joint (rad); kp (N m/rad), kd (N m s/rad): feedback gains."""
+def tracking(t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray,
+             kp: float = KP, kd: float = KD) -> Callable[[float, np.ndarray, np.ndarray], np.ndarray]:
+    """The controller (simulate's) that follows a trajectory sampled at the fixed rate of ``t``
+    (s; theta rad, dtheta rad/s, tau the feed-forward torque N m, each (N, 3)): at time s it
+    returns tau[k] + kp (theta[k] - theta_measured) + kd (dtheta[k] - dtheta_measured), k the
+    sample at t[0] + s (the last one after the end): simulate's time starts at 0."""
+    rate = (len(t) - 1) / (t[-1] - t[0])
+
+    def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        k = min(int(round(time * rate)), len(t) - 1)
+        return tau[k] + kp * (theta[k] - q) + kd * (dtheta[k] - v)
+    return controller
+
+
+def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray,
+          torque_noise: float = 0.0, quantization: bool = True, seed: int = 0) -> Log:
+    """The log of ``device`` tracking the trajectory (``tracking``'s arguments; its rate is the
+    log's) from its first state: times, the encoder's angles (with ``quantization``, which needs
+    the device's encoder; else the true ones) and the commanded torques (N m), the plant
+    receiving them plus white noise of standard deviation ``torque_noise`` (N m, seeded)."""
+    if not isinstance(device, Device):
+        raise InvalidInputError(f"device: expected a phantom_pin.Device, got {device!r}")
+    if not (np.isfinite(torque_noise) and torque_noise >= 0):
+        raise InvalidInputError(f"torque_noise: expected a finite number >= 0 (N m), got {torque_noise!r}")
+    t, theta, dtheta, tau = (np.asarray(x, float) for x in (t, theta, dtheta, tau))
+    follow = tracking(t, theta, dtheta, tau)
     rng = np.random.default_rng(seed)
-    n = int(round(duration * rate)) + 1
-    t = np.arange(n) / rate
-    dt = 1.0 / rate
-    ref_q, ref_v, ref_a = reference(t)
-    feedforward = closed_form.inverse_dynamics(ref_q, ref_v, ref_a, model)
-    resolution = np.broadcast_to(np.asarray(resolution, float), 3)
+    commanded = np.zeros((len(t), 3))
 
-    def quantize(q):
-        return np.where(resolution > 0, np.round(q / np.where(resolution > 0, resolution, 1)) * resolution, q)
+    def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        k = min(int(round(time * rate)), len(t) - 1)
+        commanded[k] = follow(time, q, v)
+        return commanded[k] + torque_noise * rng.standard_normal(3)
 
-    def acceleration(q, v, torque):
-        bias = closed_form.coriolis_matrix(q, v, truth) @ v + closed_form.gravity(q, truth)
-        return np.linalg.solve(closed_form.mass_matrix(q, truth), torque - friction.torque(v) - bias)
-
-    q, v = ref_q[0].copy(), ref_v[0].copy()
-    measured, commanded = np.empty((n, 3)), np.empty((n, 3))
-    for i in range(n):
-        measured[i] = quantize(q)
-        commanded[i] = feedforward[i] + kp * (ref_q[i] - measured[i]) + kd * (ref_v[i] - v)
-        applied = commanded[i] + torque_noise * rng.standard_normal(3)
-        q, v = rk4_step(lambda q_, v_: acceleration(q_, v_, applied), q, v, dt)
-    return Log(t, measured, commanded)
+    rate = (len(t) - 1) / (t[-1] - t[0])
+    result = simulate(theta[0], t[-1] - t[0], controller, dtheta0=dtheta[0], rate=rate, device=device,
+                      quantization=quantization)
+    measured = device.encoder_theta(device.encoder_counts(result.theta)) if quantization else result.theta
+    return Log(result.t, measured, commanded[:len(result.t)])

@@ -1,0 +1,232 @@
+"""The two structures ``estimate`` fits, each a set of physical parameters ``x`` (what the
+overlay writes, then the six friction coefficients viscous1..3 in N m s/rad and coulomb1..3
+in N m) and the base parameters the joint torques determine, beta = matrix x + offset:
+
+- ``General``: the rigid body in full. x = the five bodies (config.schema.BODIES) in
+  standard parameters about their link frame's origin, Pinocchio's order [m (kg), m c
+  (kg m), I_origin xx, xy, yy, xz, yz, zz (kg m^2)], then the rotor inertia J (kg m^2, at
+  the motor shaft; absent without public motor data), then friction. beta: the base
+  parameters of the mimic tree's regressor (base.base_parameters over seeded states: 26 for
+  the Premium 1.5), every identifiable combination of mass, centre of mass, full inertia
+  tensor and rotor inertia. Written as ``links.<body>.*`` keys: any model, in the report's
+  form or in full, becomes a model in full (config.read).
+- ``Report``: the report's structure (centres of mass on the segments' axes, the segment
+  axes principal). x = parameterization.NAMES (20), then friction; beta = the report's
+  eight constants (constants.NAMES) and friction. Written as the report's keys; only for a
+  model in the report's form.
+
+Each structure's physical check of x is the one of a link (phantom_pin.inertial.problem on
+every link the overlay gives), with J > 0 for a model with a motor and friction >= 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from phantom_pin.config.schema import BODIES, carve, uncarve
+from phantom_pin.dynamics.model import Phantom
+from phantom_pin.identification import constants, parameterization, physical
+from phantom_pin.identification.base import Structured, base_parameters, sample, words
+from phantom_pin.identification.regressor import INERTIAL_NAMES, Regressor
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem
+
+FRICTION = constants.FRICTION_NAMES
+#: The unit of each standard parameter (INERTIAL_NAMES order).
+INERTIAL_UNITS = ("kg",) + ("kg m",) * 3 + ("kg m^2",) * 6
+
+
+class Structure:
+    """Common part: the regressor of the Phantom, friction columns and the overlay's friction."""
+
+    name = ""
+    names: tuple[str, ...]            # x's
+    base_names: tuple[str, ...]       # beta's, as sums of x's or of the regressor's parameters
+    units: tuple[str, ...]            # beta's
+    matrix: np.ndarray                # beta = matrix x + offset
+    offset: np.ndarray
+    prior: np.ndarray                 # x of the Phantom's own model (friction: its law, each joint)
+    scale: np.ndarray                 # the typical size of each entry of x
+
+    def __init__(self, phantom: Phantom) -> None:
+        self.phantom = phantom
+        self.config = phantom.config
+        self.regressor = Regressor(phantom)
+        law = self.config.actuation.friction
+        self.friction_prior = np.array([law.viscous] * 3 + [law.coulomb] * 3)
+
+    @property
+    def motor(self) -> bool:
+        return self.config.actuation.motor is not None
+
+    def friction_columns(self, dtheta: object) -> np.ndarray:
+        """The regressor's friction columns (..., 3, 6) at rates ``dtheta`` (rad/s), unfiltered."""
+        return self.regressor(np.zeros_like(dtheta), dtheta, np.zeros_like(dtheta))[..., self.regressor.friction]
+
+    def nearest(self, target: np.ndarray, weights: np.ndarray, prior_weight: float) -> np.ndarray:
+        """physical.nearest: the consistent x whose base parameters are nearest to ``target`` in
+        the metric W^T W (``weights``: the inverse covariance's root)."""
+        n = len(self.names)
+        bodies = [(self.affine[rows], self.constant[rows]) for rows in
+                  (slice(10 * k, 10 * k + 10) for k in range(len(self.regressor.bodies)))]
+        rotor = [self.rotor] if self.rotor is not None else []
+        positive = (rotor if self.motor else []) + list(range(n - 6, n))
+        fixed = [] if self.motor or self.rotor is None else rotor
+        return physical.nearest(target - self.offset, weights, self.matrix, self.prior, self.scale, bodies,
+                                positive, self.consistent, fixed, prior_weight)
+
+    def friction_ok(self, x: np.ndarray) -> bool:
+        return bool((np.asarray(x)[-6:] >= 0).all())
+
+
+class General(Structure):
+    """The rigid body in full (module doc)."""
+
+    name = "general"
+
+    def __init__(self, phantom: Phantom) -> None:
+        super().__init__(phantom)
+        description, regressor = phantom.description, self.regressor
+        config, kinematics = self.config, self.config.kinematics
+        prefix = description.prefix
+        self.bodies = uncarve(config.links, kinematics)
+        self.pin = config.links["crank_pin_link"]
+        self.names = tuple(f"{b}.{p}" for b in BODIES for p in INERTIAL_NAMES) + (
+            ("actuation.motor.rotor_inertia",) if self.motor else ()) + FRICTION
+        n = len(self.names)
+        # pi (the regressor's parameters) = A x + b: each tree link is its body less the
+        # pins' shares (constant: carve), the pins are fixed, the rotors J r^2
+        a, b = np.zeros((regressor.size, n)), np.zeros(regressor.size)
+        for k, link in enumerate(regressor.bodies):
+            name, rows = link[len(prefix):], slice(10 * k, 10 * k + 10)
+            if name in BODIES:
+                i = BODIES.index(name)
+                a[rows, 10 * i:10 * i + 10] = np.eye(10)
+                b[rows] = config.links[name].dynamic_parameters() - self.bodies[name].dynamic_parameters()
+            else:
+                b[rows] = config.links[name].dynamic_parameters()
+        if self.motor:
+            a[regressor.rotors, 50] = np.square(config.actuation.ratios)
+        a[regressor.friction, n - 6:] = np.eye(6)
+        self.affine, self.constant = a, b
+        self.rotor = 50 if self.motor else None
+        self.prior = np.concatenate([*(self.bodies[name].dynamic_parameters() for name in BODIES),
+                                     [config.actuation.rotor[0]] if self.motor else [], self.friction_prior])
+        self.scale = np.concatenate([*(_body_scale(self.bodies[name]) for name in BODIES),
+                                     [config.actuation.rotor[0]] if self.motor else [], self.friction_prior])
+        key = ("general base", prefix)
+        if key not in description.cache:      # the base of Y A: combinations of x only
+            description.cache[key] = base_parameters(regressor.stacked(*sample(regressor)) @ a, self.names,
+                                                     self.scale)
+        base = description.cache[key]
+        order = np.argsort(base.independent)            # pivots in x's order: friction last
+        self.base = dataclasses.replace(base, independent=tuple(base.independent[k] for k in order),
+                                        matrix=base.matrix[order])
+        self.independent = list(self.base.independent)
+        self.matrix = self.base.matrix
+        self.offset = np.zeros(self.base.rank)
+        self.base_names = tuple(self.base.words(k) for k in range(self.base.rank))
+        self.units = tuple(_unit(self.names[i]) for i in self.independent)
+        self._friction_columns = [self.independent.index(i) for i in range(n - 6, n)]
+
+    def regressor_of(self, theta, dtheta, ddtheta, friction=None) -> tuple[np.ndarray, np.ndarray]:
+        """(Phi (N, 3, rank), tau_0 (N, 3)): the independent columns of the regressor in x,
+        Y A, its friction columns replaced by ``friction`` (N, 3, 6) if given (estimation's
+        filtered ones), and tau_0 = Y b, the torque of the known parameters (the hinge pins)."""
+        y = self.regressor(theta, dtheta, ddtheta)
+        phi = (y @ self.affine)[..., self.independent]
+        if friction is not None:
+            phi[..., self._friction_columns] = friction
+        return phi, y @ self.constant
+
+    def bodies_of(self, x: np.ndarray) -> dict[str, Inertial] | None:
+        """The five bodies of ``x`` as the overlay writes them (None if a mass is not positive)."""
+        x = np.asarray(x, float)
+        if (x[0:50:10] <= 0).any():
+            return None
+        return {name: Inertial.from_dynamic_parameters(x[10 * i:10 * i + 10]) for i, name in enumerate(BODIES)}
+
+    def consistent(self, x: np.ndarray) -> bool:
+        """Every body the overlay writes and every link carved from them passes the one physical
+        check (config.read checks both), the rotor inertia is positive, friction >= 0."""
+        bodies = self.bodies_of(x)
+        if bodies is None or (self.motor and not x[50] > 0) or not self.friction_ok(x):
+            return False
+        links = carve(bodies, self.pin, self.config.kinematics)
+        return all(problem(inertial) is None for inertial in (*bodies.values(), *links.values()))
+
+    def overrides(self, x: np.ndarray) -> dict[str, float]:
+        """The links.* keys (mass kg, com m, inertia about the com kg m^2) and the rotor inertia."""
+        out: dict[str, float] = {}
+        for name, body in self.bodies_of(x).items():
+            out[f"links.{name}.mass"] = body.mass
+            out.update({f"links.{name}.com.{k}": v for k, v in enumerate(body.com)})
+            out.update({f"links.{name}.inertia.{k}": v for k, v in zip(INERTIA_KEYS, body.inertia)})
+        if self.motor:
+            out["actuation.motor.rotor_inertia"] = float(x[50])
+        return out
+
+
+class Report(Structure):
+    """The report's structure (module doc); InvalidInputError for a model in full."""
+
+    name = "report"
+
+    def __init__(self, phantom: Phantom) -> None:
+        super().__init__(phantom)
+        self.structured = Structured(self.regressor)
+        description = phantom.description
+        c = constants.constants_matrix(description)
+        self.matrix = np.zeros((c.shape[0] + 6, c.shape[1] + 6))
+        self.matrix[:c.shape[0], :c.shape[1]] = c
+        self.matrix[c.shape[0]:, c.shape[1]:] = np.eye(6)
+        self.offset = np.zeros(len(self.matrix))
+        self.names = parameterization.NAMES + FRICTION
+        self.base_names = tuple(f"{name} = {words(row, parameterization.SYMBOLS)}"
+                                for name, row in zip(constants.NAMES, c)) + FRICTION
+        self.units = constants.UNITS
+        x0 = parameterization.report_vector(self.config)
+        self.prior = np.concatenate([x0, self.friction_prior])
+        self.scale = np.concatenate([np.where(x0 != 0, np.abs(x0), 1.0), self.friction_prior])
+        self._pseudo = np.linalg.pinv(c)
+        s = self.structured
+        self.affine = np.hstack([s.affine, np.zeros((len(s.affine), 6))])
+        self.constant = s.offset
+        self.rotor = parameterization.ROTOR
+
+    def regressor_of(self, theta, dtheta, ddtheta, friction=None) -> tuple[np.ndarray, np.ndarray]:
+        """(Phi (N, 3, 14), tau_0 (N, 3)) in beta = (constants, friction), from Pinocchio's
+        regressor: Phi = [Phi_x C^+, friction] (Phi_x = Y A, exact because Phi_x = Phi_constants
+        C); ``friction`` (N, 3, 6) replaces the friction columns if given."""
+        phi_x, tau0 = self.structured(theta, dtheta, ddtheta)
+        n = len(parameterization.NAMES)
+        friction = phi_x[..., n:] if friction is None else friction
+        return np.concatenate([phi_x[..., :n] @ self._pseudo, friction], axis=-1), tau0
+
+    def consistent(self, x: np.ndarray) -> bool:
+        return self.friction_ok(x) and physical.consistent(x[:-6], self.config)
+
+    def overrides(self, x: np.ndarray) -> dict[str, float]:
+        return parameterization.overrides(x[:-6], self.config)
+
+
+STRUCTURES = {"general": General, "report": Report}
+
+
+def _unit(name: str) -> str:
+    """The unit of one of General.names."""
+    if name.startswith(("viscous", "coulomb")):
+        return "N m s/rad" if name.startswith("viscous") else "N m"
+    if name.endswith("rotor_inertia"):
+        return "kg m^2"
+    return INERTIAL_UNITS[INERTIAL_NAMES.index(name.rsplit(".", 1)[1])]
+
+
+def _body_scale(body: Inertial) -> np.ndarray:
+    """The typical size of a body's standard parameters: m, m r, m r^2 with r its radius of
+    gyration about the link origin (m)."""
+    pi = body.dynamic_parameters()
+    m = pi[0]
+    r = np.sqrt(max(pi[[4, 6, 9]].max(), 1e-12) / m)
+    return np.array([m, *[m * r] * 3, *[m * r * r] * 6])
