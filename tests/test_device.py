@@ -18,7 +18,7 @@ DEG = math.pi / 180
 #: mahilab/Phantom's stops (deg): per joint, and the parallelogram's coupled ones.
 STOPS_DEG = {"q1": (-90, 90), "q2": (-124, 119), "q3": (-29, 214), "q2-q3": 65, "q3-q2": 55}
 K_STOP, B_STOP = 10.0, 0.1                       # N m/rad, N m s/rad (mahilab's hard stop)
-VISCOUS, COULOMB = 5e-4, 0.01                    # N m s/rad, N m; smoothed as tanh(10 q')
+VISCOUS, COULOMB = 5e-4, 0.01                    # N m s/rad, N m (mahilab's; its tanh(10 q') smoothing not kept)
 KT, I_NOMINAL, TAU_NOMINAL = 23.4e-3, 1.24, 28.6e-3   # N m/A, A, N m (data sheet)
 I_STALL, TAU_STALL = 5.5, 129e-3                 # A, N m (data sheet)
 RATIOS = np.array([13.3, 11.6, 11.6])            # the report (docs/errata.md E15)
@@ -105,10 +105,13 @@ def test_stop_torque_is_minus_the_gradient_of_the_stop_energy_and_damps(device):
 
 
 # -- friction --------------------------------------------------------------------------
-def test_friction_is_mahilabs_and_opposes_motion(device):
+def test_sliding_friction_is_viscous_plus_coulomb_and_opposes_motion(device):
+    """In motion: mahilab's viscous and Coulomb coefficients, the Coulomb term at its full level
+    at any rate (no smoothing); at rest 0 (the stick torque depends on the load: simulate)."""
     rate = np.random.default_rng(3).normal(0, 1, (200, 3))
-    expected = VISCOUS * rate + COULOMB * np.tanh(10 * rate)
+    expected = VISCOUS * rate + COULOMB * np.where(rate > 0, 1.0, -1.0)
     np.testing.assert_allclose(device.friction(rate), expected, rtol=1e-14)
+    np.testing.assert_allclose(device.friction([1e-9, -1e-9, 0.0]), [COULOMB, -COULOMB, 0.0], rtol=1e-6)
     assert np.all(device.friction(rate) * rate >= 0)   # removes power: -tau_f . dtheta <= 0
     np.testing.assert_array_equal(device.friction([0.0, 0.0, 0.0]), 0.0)
 
@@ -190,7 +193,7 @@ def test_encoder_resolution_counts_and_tip_resolution(device, states):
 # -- parameters ------------------------------------------------------------------------
 def test_shipped_device_numbers_and_sources(device):
     friction, stops, sources = device.config.actuation.friction, device.config.limits.stops, device.config.sources
-    assert (friction.viscous, friction.coulomb, friction.smoothing_speed) == (VISCOUS, COULOMB, 0.1)
+    assert (friction.viscous, friction.coulomb) == (VISCOUS, COULOMB)
     assert (stops.stiffness, stops.damping) == (K_STOP, B_STOP)
     np.testing.assert_allclose(stops.lower, np.radians([-90, -124, -29]), rtol=1e-15)
     np.testing.assert_allclose(stops.upper, np.radians([90, 119, 214]), rtol=1e-15)
@@ -230,8 +233,7 @@ def test_device_reads_its_config_folder(tmp_path, phantom):
     text = (folder / "actuation.yaml").read_text()
     (folder / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
     for device in (Device(folder), Device(Phantom(folder))):
-        np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB * np.tanh(10), 0, 0],
-                                   rtol=1e-14)
+        np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB, 0, 0], rtol=1e-14)
     with pytest.raises(TypeError):
         Device(phantom, folder)
     with pytest.raises(TypeError, match="config_dir"):

@@ -158,7 +158,7 @@ BAD_LOGS = {
     "mN m": (lambda r: _bad(r, tau=1000 * r.log.tau), "are they in another unit"),
     "a 10 Hz log": (lambda r: _bad(r, step=100), "cutoff: 20 Hz needs a log at 400 Hz or faster (this one: 10 Hz"),
     "transmission ratio 11.2": (lambda r: _bad(r, tau=r.log.tau * [1, 11.2 / 11.6, 11.2 / 11.6]),
-                                "other transmission ratios (ratio 11.2"),
+                                "other transmission ratios (ratio 11."),
 }
 
 
@@ -170,6 +170,9 @@ def test_a_bad_log_is_refused_in_one_line_and_nothing_is_written(run, case, tmp_
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml")
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert not (tmp_path / "id.yaml").exists()
+    if case == "transmission ratio 11.2":      # the ratios it suggests: 11.2 within 0.1
+        ratios = [float(v) for v in re.findall(r"ratio (\S+) instead of the model's 11.6", err)]
+        assert len(ratios) == 2 and all(abs(r - 11.2) < 0.1 for r in ratios), ratios
 
 
 def test_forced_friction_is_never_negative(run, tmp_path):
@@ -177,7 +180,7 @@ def test_forced_friction_is_never_negative(run, tmp_path):
     friction it writes is not the negative estimate: 0 or more."""
     io.write_log(tmp_path / "log.csv", run.log.t, run.log.theta, -run.log.tau)
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--force")
-    assert code == 0 and "warning (written with --force): tau: the logged torques are -1" in out, err
+    assert code == 0 and "warning (written with --force): tau: the logged torques are -0.99" in out, err
     text = (tmp_path / "id.yaml").read_text()
     assert "# problem, written with --force:" in text
     keys = read_overrides(tmp_path / "id.yaml")

@@ -35,19 +35,18 @@ def test_regressor_times_shipped_parameters_is_inverse_dynamics(regressor):
 def test_friction_columns_follow_the_actuation_law(regressor):
     theta, dtheta, ddtheta = states(regressor, 50, 1)
     viscous, coulomb = np.array([1e-3, 2e-3, 3e-3]), np.array([0.01, 0.02, 0.03])
-    speed = regressor.phantom.config.actuation.friction.smoothing_speed
-    law = viscous * dtheta + coulomb * np.tanh(dtheta / speed)
+    law = viscous * dtheta + coulomb * np.sign(dtheta)
     rigid = regressor(theta, dtheta, ddtheta) @ regressor.parameters()
     with_friction = regressor(theta, dtheta, ddtheta) @ regressor.parameters(viscous, coulomb)
     np.testing.assert_allclose(with_friction - rigid, law, rtol=0, atol=1e-15)
 
 
-def test_the_coulomb_column_uses_the_phantoms_own_smoothing_speed():
-    """Before, Regressor(Phantom(cfg)) took the shipped 0.1 rad/s, not cfg's: at dtheta =
-    0.05 rad/s the column was tanh(0.5) = 0.46 instead of tanh(1) = 0.76."""
-    slow = Regressor(Phantom(describe(overrides={"actuation.friction.smoothing_speed": 0.05})))
-    column = slow(np.zeros(3), np.full(3, 0.05), np.zeros(3))[:, slow.friction][:, 3:]
-    np.testing.assert_allclose(np.diag(column), np.tanh(1.0), rtol=1e-15)
+def test_the_coulomb_column_is_the_full_level_at_any_rate():
+    """The simulator's sliding law: 1e-6 rad/s already meets the whole Coulomb torque (the
+    smoothed tanh(dtheta / 0.1 rad/s) of before gave 1e-5 of it); 0 at rest."""
+    regressor = Regressor(Phantom())
+    column = regressor(np.zeros(3), np.array([1e-6, -1e-6, 0.0]), np.zeros(3))[:, regressor.friction][:, 3:]
+    np.testing.assert_array_equal(np.diag(column), [1.0, -1.0, 0.0])
 
 
 def test_single_state_equals_the_batch_row(regressor):
@@ -102,14 +101,13 @@ def test_affine_map_times_the_regressor_is_the_closed_form_at_other_parameters(r
 
 
 def test_every_column_is_what_its_name_says(regressor):
-    """rotor_j is ddtheta_j on joint j, viscous_j is dtheta_j, coulomb_j is the law's tanh with
-    unit Coulomb (dtheta_j / smoothing_speed), each on joint j only."""
+    """rotor_j is ddtheta_j on joint j, viscous_j is dtheta_j, coulomb_j is sign(dtheta_j), each
+    on joint j only."""
     theta, dtheta, ddtheta = states(regressor, 20, 9)
     y = regressor(theta, dtheta, ddtheta)
-    speed = regressor.phantom.config.actuation.friction.smoothing_speed
     for j in range(3):
         for name, expected in ((f"rotor{j + 1}", ddtheta[:, j]), (f"viscous{j + 1}", dtheta[:, j]),
-                               (f"coulomb{j + 1}", np.tanh(dtheta[:, j] / speed))):
+                               (f"coulomb{j + 1}", np.sign(dtheta[:, j]))):
             column = y[:, :, regressor.names.index(name)]
             np.testing.assert_allclose(column[:, j], expected, rtol=1e-15, atol=0)
             assert not np.delete(column, j, axis=1).any()

@@ -78,20 +78,25 @@ class Encoder:
 
 @dataclasses.dataclass(frozen=True)
 class Friction:
-    """Joint friction, the same on each joint: viscous (N m s/rad), Coulomb (N m), and the
-    speed (rad/s) of the tanh that smooths the Coulomb term."""
+    """Joint friction, the same on each joint: Coulomb friction with stiction, and viscous.
+
+    In motion, tau_f = viscous * dtheta + coulomb * sign(dtheta) (N m s/rad, N m), opposing
+    it. At rest a joint sticks: its friction is whatever torque holds it, up to ``coulomb``
+    (the breakaway torque equals the sliding one: no Stribeck effect, which nothing public
+    measured on a PHANToM and MuJoCo's frictionloss cannot express). phantom_pin.simulate
+    integrates the stick phase exactly (no creep); the MJCF gives MuJoCo's frictionloss the
+    same level (its soft constraint creeps slowly: config/mjcf.yaml's friction solref)."""
 
     viscous: float
     coulomb: float
-    smoothing_speed: float
 
     def torque(self, dtheta: np.ndarray | float) -> np.ndarray | float:
-        """The friction law: tau_f = viscous * dtheta + coulomb * tanh(dtheta / smoothing_speed)
-        (N m) at rates dtheta (rad/s, an array or one float: the simulator's scalar loop),
-        opposing motion. Smooth at rest, so it holds nothing still (no stiction); below
-        smoothing_speed it acts as a damper of coulomb / smoothing_speed N m s/rad."""
-        tanh = math.tanh if isinstance(dtheta, float) else np.tanh
-        return self.viscous * dtheta + self.coulomb * tanh(dtheta / self.smoothing_speed)
+        """The sliding law viscous * dtheta + coulomb * sign(dtheta) (N m) at rates dtheta (rad/s,
+        an array or one float); 0 at rest, where the torque that holds a joint depends on the
+        load (simulate decides it). The identification's friction columns are its two terms."""
+        if isinstance(dtheta, float):
+            return self.viscous * dtheta + (math.copysign(self.coulomb, dtheta) if dtheta else 0.0)
+        return self.viscous * dtheta + self.coulomb * np.sign(dtheta)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -207,13 +212,16 @@ class Scene:
 @dataclasses.dataclass(frozen=True)
 class MujocoSettings:
     """The MJCF's timestep (s) and integrator, the mimic equalities' solref (time constant
-    in timesteps, damping ratio) and solimp (dmin, dmax, width), and the scene."""
+    in timesteps, damping ratio) and solimp (dmin, dmax, width), the joints' dry friction's
+    solref (time constant in timesteps, damping ratio), and the scene."""
 
     timestep: float
     integrator: str
     equality_solref_timesteps: float
     equality_solref_damping_ratio: float
     equality_solimp: tuple[float, float, float]
+    friction_solref_timesteps: float
+    friction_solref_damping_ratio: float
     scene: Scene
 
 
@@ -337,8 +345,7 @@ def _actuation(r: _Reader) -> Actuation:
     def act(*keys: str, **kind: bool) -> float:
         return r.number(arg, *keys, **kind)
 
-    friction = Friction(act("friction", "viscous", non_negative=True), act("friction", "coulomb", non_negative=True),
-                        act("friction", "smoothing_speed", positive=True))
+    friction = Friction(act("friction", "viscous", non_negative=True), act("friction", "coulomb", non_negative=True))
     public = [r.node(arg, section) is not None for section in DRIVE]
     document = r.documents[arg]
     if public[0] != public[1]:
@@ -409,7 +416,9 @@ def _mujoco(r: _Reader) -> MujocoSettings:
     return MujocoSettings(r.number(arg, "timestep", positive=True), integrator,
                           r.number(arg, "equality_solref_timesteps", positive=True),
                           r.number(arg, "equality_solref_damping_ratio", positive=True),
-                          r.vector(arg, "equality_solimp", length=3), scene)
+                          r.vector(arg, "equality_solimp", length=3),
+                          r.number(arg, "friction_solref_timesteps", positive=True),
+                          r.number(arg, "friction_solref_damping_ratio", positive=True), scene)
 
 
 def _sources(r: _Reader) -> dict[str, str]:

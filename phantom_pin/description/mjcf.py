@@ -156,8 +156,10 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
         if joint is not None:
             _place(body, joint.find("origin"))
             if joint.get("type") == "revolute":
+                friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
+                                        settings.friction_solref_damping_ratio])
                 ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
-                                                               joint.get("name") in mimics))
+                                                               joint.get("name") in mimics, friction_solref))
             elif joint.get("type") != "fixed":
                 raise ValueError(f"unsupported URDF joint type {joint.get('type')!r}")
         link = links[name]
@@ -220,8 +222,9 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
 
 
 def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
-                      rotor_inertia: float, mimic: bool) -> dict[str, str]:
-    """A revolute URDF joint as MJCF hinge attributes; armature = rotor inertia x ratio^2.
+                      rotor_inertia: float, mimic: bool, friction_solref: str) -> dict[str, str]:
+    """A revolute URDF joint as MJCF hinge attributes; armature = rotor inertia x ratio^2; a
+    joint with dry friction gets ``friction_solref`` (its frictionloss constraint's softness).
 
     A mimic joint gets no range: its primary's range bounds it through the equality, and
     a second limit on the same motion would over-constrain MuJoCo's solver.
@@ -238,9 +241,11 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
         attributes["armature"] = _num(rotor_inertia * ratio**2)
     dynamics = joint.find("dynamics")
-    if dynamics is not None:  # MuJoCo's frictionloss is dry friction without smoothing
+    if dynamics is not None:  # MuJoCo's frictionloss is dry friction with stiction, a soft constraint
         attributes["damping"] = _num(float(dynamics.get("damping", 0)))
         attributes["frictionloss"] = _num(float(dynamics.get("friction", 0)))
+        if float(dynamics.get("friction", 0)):
+            attributes["solreffriction"] = friction_solref
     return attributes
 
 

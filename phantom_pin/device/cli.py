@@ -168,7 +168,7 @@ def info(phantom: Phantom) -> tuple[dict, list[str]]:
           f"{stops.coupled.theta3_minus_theta2_max * deg:.1f}; K {stops.stiffness:g} N m/rad, "
           f"B {stops.damping:g} N m s/rad",
         "friction": f"friction: viscous {friction.viscous:g} N m s/rad + coulomb {friction.coulomb:g} N m * "
-                    f"tanh(dtheta / {friction.smoothing_speed:g} rad/s)",
+                    "sign(dtheta) in motion; at rest a joint sticks below the Coulomb torque",
     }
     if motor is None:
         # what the model lacks, said instead of invented (its sources say why)

@@ -137,12 +137,13 @@ class Device:
 
     # -- friction --------------------------------------------------------------------
     def friction(self, dtheta: object) -> np.ndarray:
-        """Friction torque (N m) of each joint at rates dtheta (rad/s): (..., 3).
+        """Sliding friction torque (N m) of each joint at rates dtheta (rad/s): (..., 3).
 
-        tau_f = viscous * dtheta + coulomb * tanh(dtheta / smoothing_speed), with the sign of
-        dtheta: it opposes motion, M ddtheta + C dtheta + N + tau_f = tau. Smooth at rest, so
-        it holds nothing still (no stiction); below smoothing_speed it acts as a damper of
-        coulomb / smoothing_speed N m s/rad.
+        tau_f = viscous * dtheta + coulomb * sign(dtheta), with the sign of dtheta: it opposes
+        motion, M ddtheta + C dtheta + N + tau_f = tau. At rest (dtheta = 0) it returns 0: a
+        joint at rest sticks, held by whatever torque that takes up to ``coulomb`` (the
+        breakaway torque), which depends on the load; phantom_pin.simulate integrates that
+        (config.Friction).
         """
         v, _ = as_states(dtheta, "dtheta")
         return self._friction(v)

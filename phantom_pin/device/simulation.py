@@ -28,6 +28,9 @@ STEP_SCALE = 0.25
 #: Longest RK4 step (s) whatever the stiff terms: the free rigid body integrated at 1 ms is
 #: within 3e-11 rad of a 0.1 ms integration over 0.15 s (tests/test_simulation.py).
 MAX_STEP = 1e-3
+#: A friction event (a joint reverses, stops or breaks away) is located by regula falsi
+#: (Illinois) on its slack, at most EVENT_ITERATIONS RK4 steps, to EVENT_TOLERANCE of the step.
+EVENT_ITERATIONS, EVENT_TOLERANCE = 8, 1e-9
 #: A step in which a stop engages or releases is halved this many times around the event,
 #: so that RK4 never steps across the stop force's kink and damping jump by more than
 #: h / 2**EVENT_BISECTIONS.
@@ -81,13 +84,13 @@ def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool,
     joint inertia m (half the smallest eigenvalue of M(theta0), as M varies by about 15 %
     across the stops): the stops' natural frequency sqrt(3 K / m) (a joint may touch its own
     stop and the coupled one, stiffness matrix eigenvalue up to 3 K) and the damping rate
-    (3 B + viscous + coulomb / smoothing_speed) / m (the tanh friction's slope at rest).
+    (3 B + viscous) / m. The Coulomb friction adds no stiffness: its stick phase is a mode of
+    the integration, not a steep force.
     """
     stops, law = device.config.limits.stops, device.config.actuation.friction
     inertia = 0.5 * float(np.linalg.eigvalsh(device.phantom.mass_matrix(theta0)).min())
     stiffness = 3 * stops.stiffness if hard_stops else 0.0
-    damping = (3 * stops.damping if hard_stops else 0.0) + \
-        (law.viscous + law.coulomb / law.smoothing_speed if friction else 0.0)
+    damping = (3 * stops.damping if hard_stops else 0.0) + (law.viscous if friction else 0.0)
     fastest = max(math.sqrt(stiffness / inertia), damping / inertia)
     return max(1, math.ceil(period * fastest / STEP_SCALE), math.ceil(period / MAX_STEP * (1 - 1e-12)))
 
@@ -147,6 +150,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples, "
                                 f"more than {MAX_SAMPLES}")
     period = 1.0 / rate
+    fixed = substeps is not None
+    free_substeps = max(1, math.ceil(period / MAX_STEP * (1 - 1e-12)))   # RK4 steps away from the stops
     if substeps is None:
         substeps = _substeps(device, theta, period, friction, hard_stops)
     elif isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
@@ -166,19 +171,22 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     peak = device.peak_torque
     bounds = list(zip(device._stop_lower.tolist(), device._stop_upper.tolist()))
     stop_force = device.config.limits.stops.force
-    friction_torque = device.config.actuation.friction.torque
+    law = device.config.actuation.friction
+    viscous, coulomb = law.viscous, law.coulomb
 
     # Stop coordinates c = theta1, theta2, theta3, theta2 - theta3 with their gradients
     # dc/dtheta (the rows of STOP_COORDINATES): Device.stop_torque, in scalars for speed.
     stops = [(0, None, *bounds[0]), (1, None, *bounds[1]), (2, None, *bounds[2]), (1, 2, *bounds[3])]
 
-    def acceleration(q: np.ndarray, v: np.ndarray, tau: list[float]) -> np.ndarray:
-        """M^-1 (tau - friction + stops - C dtheta - N): Phantom.forward_dynamics plus
-        Device.friction and Device.stop_torque, without their per-call checks."""
+    def dynamics(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> tuple:
+        """(ddtheta, friction holding each stuck joint) in the friction ``mode`` (per joint +1 or
+        -1: sliding that way, Coulomb friction against it; 0: stuck, ddtheta = 0, held by
+        whatever torque that takes). M^-1 (tau - friction + stops - C dtheta - N):
+        Phantom.forward_dynamics plus Device.friction and Device.stop_torque, without their
+        per-call checks."""
         qs, vs, total = q.tolist(), v.tolist(), list(tau)
         if friction:
-            total = [total[0] - friction_torque(vs[0]), total[1] - friction_torque(vs[1]),
-                     total[2] - friction_torque(vs[2])]
+            total = [total[i] - viscous * vs[i] - coulomb * mode[i] for i in range(3)]
         if hard_stops:
             for i, j, lo, hi in stops:
                 c, rate = (qs[i], vs[i]) if j is None else (qs[i] - qs[j], vs[i] - vs[j])
@@ -189,26 +197,100 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                     if j is not None:
                         total[j] += force
         bias = pin.nonLinearEffects(model, data, q, v).tolist()
-        solution = solve_spd(pin.crba(model, data, q).tolist(),
-                             (total[0] - bias[0], total[1] - bias[1], total[2] - bias[2]))
-        if solution is None:  # M(theta) includes the rotors: positive definite at every finite theta
-            raise _Diverged
-        return np.array(solution)
+        rhs = (total[0] - bias[0], total[1] - bias[1], total[2] - bias[2])
+        mass = pin.crba(model, data, q).tolist()
+        if not friction or all(mode):
+            solution = solve_spd(mass, rhs)
+            if solution is None:  # M(theta) includes the rotors: positive definite at every finite theta
+                raise _Diverged
+            return np.array(solution), ()
+        return _constrained(mass, rhs, mode)
+
+    def mode_at(q: np.ndarray, v: np.ndarray, tau: list[float]) -> tuple:
+        """The friction mode at a state: a moving joint slides; a joint at rest sticks if the
+        torque that holds it is within the Coulomb torque, else it breaks away in the
+        direction the net torque pushes it (released one at a time, the most overloaded first)."""
+        if not friction:
+            return (1, 1, 1)
+        mode = [1 if x > 0 else -1 if x < 0 else 0 for x in v.tolist()]
+        while 0 in mode:
+            _, held = dynamics(q, v, tau, tuple(mode))
+            stuck = [i for i in range(3) if mode[i] == 0]
+            worst = max(range(len(stuck)), key=lambda k: abs(held[k]))
+            if abs(held[worst]) < coulomb:        # at the Coulomb torque it breaks away
+                break
+            mode[stuck[worst]] = -1 if held[worst] > 0 else 1
+        return tuple(mode)
+
+    def slack(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> list[float]:
+        """How far the mode holds at a state, per joint (> 0 while it does): a sliding joint's
+        rate along its direction (rad/s), a stuck joint's Coulomb torque less the torque that
+        holds it (N m)."""
+        vs = v.tolist()
+        held = iter(dynamics(q, v, tau, mode)[1] if not all(mode) else ())
+        return [vs[i] * m if m else coulomb - abs(next(held)) for i, m in enumerate(mode)]
 
     def contacts(q: np.ndarray) -> list[bool]:
         """Which stops are engaged at q."""
         qs = q.tolist()
         return [not lo <= (qs[i] if j is None else qs[i] - qs[j]) <= hi for i, j, lo, hi in stops]
 
-    def advance(q: np.ndarray, v: np.ndarray, tau: np.ndarray, h: float, depth: int) -> tuple:
-        """One RK4 step of h; a step across a stop's boundary is bisected (event location)."""
-        q_end, v_end = rk4_step(lambda q_, v_: acceleration(q_, v_, tau), q, v, h)
-        if hard_stops and depth < EVENT_BISECTIONS and contacts(q) != contacts(q_end):
+    def advance(q: np.ndarray, v: np.ndarray, tau: list[float], h: float, depth: int) -> tuple:
+        """One RK4 step of h in the friction mode of the start. A step across a stop's boundary
+        is bisected (event location, EVENT_BISECTIONS halvings); a step that ends the friction
+        mode (a sliding joint reverses or stops, a stuck one breaks away) is cut where the
+        mode's slack, interpolated linearly, reaches zero: the reversing joint is set at rest
+        there, and the rest of the step starts in the mode of that state (mode_at decides
+        whether it sticks)."""
+        mode = mode_at(q, v, tau)
+        if friction and not any(mode):    # every joint stuck (v = 0, ddtheta = 0) for the held torque
+            return q, v
+        q_end, v_end = rk4_step(lambda q_, v_: dynamics(q_, v_, tau, mode)[0], q, v, h)
+        if hard_stops and h > contact_step * (1 + 1e-9) and (any(contacts(q)) or any(contacts(q_end))):
+            count = math.ceil(h / contact_step * (1 - 1e-12))    # a stop engaged: its substeps
+            for _ in range(count):
+                q, v = advance(q, v, tau, h / count, depth)
+            return q, v
+        if hard_stops and contacts(q) != contacts(q_end) and depth < EVENT_BISECTIONS:
             q_mid, v_mid = advance(q, v, tau, 0.5 * h, depth + 1)
             return advance(q_mid, v_mid, tau, 0.5 * h, depth + 1)
+        if not friction:
+            return q_end, v_end
+        end = slack(q_end, v_end, tau, mode)
+        if min(end) > 0:
+            return q_end, v_end
+        start = slack(q, v, tau, mode)
+        shares = [a / (a - b) if b <= 0 < a else (0.0 if b <= 0 else 1.0) for a, b in zip(start, end)]
+        first = min(range(3), key=shares.__getitem__)
+        share = shares[first] if depth < EVENT_BISECTIONS else 1.0
+        if share <= 0.0:                # the mode ended at the start already
+            share, q_end, v_end = 0.0, q, v
+        elif share < 1.0:
+            # the Illinois variant of regula falsi on the first joint's slack, bracketed in
+            # [low, high] (slack > 0 at low, <= 0 at high); the step ends at high, just past the
+            # event, where the mode has ended (mode_at then releases or stops the joint)
+            low, high, at_low, at_high, side = 0.0, 1.0, start[first], end[first], 0
+            for _ in range(EVENT_ITERATIONS):
+                q_try, v_try = rk4_step(lambda q_, v_: dynamics(q_, v_, tau, mode)[0], q, v, share * h)
+                value = slack(q_try, v_try, tau, mode)[first]
+                if value > 0:
+                    low, at_low = share, value
+                    at_high, side = (at_high / 2 if side == 1 else at_high), 1
+                else:
+                    high, at_high, q_end, v_end = share, value, q_try, v_try
+                    at_low, side = (at_low / 2 if side == -1 else at_low), -1
+                if high - low <= EVENT_TOLERANCE:
+                    break
+                share = low + (high - low) * at_low / (at_low - at_high)
+            share = high
+        if mode[first]:                 # a sliding joint reversed or stopped there: at rest
+            v_end = v_end.copy()
+            v_end[first] = 0.0
+        if share < 1.0:
+            return advance(q_end, v_end, tau, (1.0 - share) * h, depth + 1)
         return q_end, v_end
 
-    h = period / substeps
+    contact_step = period / substeps
     counts_per_radian = device._counts_per_radian
     if quantization:
         previous = np.rint((theta - velocity * period) * counts_per_radian) / counts_per_radian
@@ -237,9 +319,12 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         tau = tau.tolist()
         if k == samples - 1:
             break
+        # the stiff stops need their substeps only while engaged (advance); elsewhere
+        # free_substeps (or an explicit ``substeps``)
+        count = substeps if fixed else free_substeps
         try:
-            for _ in range(substeps):
-                theta, velocity = advance(theta, velocity, tau, h, 0)
+            for _ in range(count):
+                theta, velocity = advance(theta, velocity, tau, period / count, 0)
             if not (np.isfinite(theta).all() and np.isfinite(velocity).all()):
                 raise _Diverged
         except _Diverged:
@@ -253,6 +338,26 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
 
 class _Diverged(Exception):
     """The integrated state left the finite numbers (inside simulate)."""
+
+
+def _constrained(mass: list[list[float]], rhs: tuple, mode: tuple) -> tuple[np.ndarray, list[float]]:
+    """(ddtheta, the torques holding the stuck joints) of M ddtheta = rhs + f with ddtheta_i = 0
+    and f_i free where mode[i] == 0 (stuck), f_i = 0 elsewhere: M_LL a_L = rhs_L, f_S = M_SL a_L -
+    rhs_S. ``mass`` is the 3x3 M (nested lists)."""
+    free = [i for i in range(3) if mode[i]]
+    stuck = [i for i in range(3) if not mode[i]]
+    a = [0.0, 0.0, 0.0]
+    if len(free) == 1:
+        i = free[0]
+        a[i] = rhs[i] / mass[i][i]
+    elif len(free) == 2:
+        i, j = free
+        m11, m12, m22 = mass[i][i], mass[min(i, j)][max(i, j)], mass[j][j]
+        det = m11 * m22 - m12 * m12
+        a[i] = (m22 * rhs[i] - m12 * rhs[j]) / det
+        a[j] = (m11 * rhs[j] - m12 * rhs[i]) / det
+    held = [sum(mass[min(s, k)][max(s, k)] * a[k] for k in free) - rhs[s] for s in stuck]
+    return np.array(a), held
 
 
 def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool) -> str:

@@ -6,7 +6,7 @@ as closed_form): M11 = K1 + K2/8 cos 2t2 + K3/8 cos 2t3 + L cos t2 sin t3, M22, 
 M23 = -L/2 sin(t2 - t3), N2 = n2 cos t2, N3 = n3 sin t3. They are linear in the report
 parameters (lengths fixed): constants = C x (``constants_matrix``), and they span exactly
 the base parameters of the report's structure (tests/test_identification_base.py).
-The friction columns are dtheta_i and tanh(dtheta_i / smoothing_speed).
+The friction columns are dtheta_i and sign(dtheta_i) (config.Friction in motion).
 """
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ def _linear_parameters(x: np.ndarray, known: ReportParameters) -> ReportParamete
 def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
               description: Description) -> np.ndarray:
     """Phi (..., 3, 14) from closed_form's inverse dynamics, one constant at a time (vectorised);
-    the friction columns are dtheta_i and tanh(dtheta_i / smoothing_speed) of the description's
+    the friction columns are dtheta_i and sign(dtheta_i), the terms of the description's
     friction law (Friction.torque with unit coefficients)."""
     columns = [closed_form.inverse_dynamics(theta, dtheta, ddtheta, p) for p in _unit_parameters(description)]
     dtheta = np.asarray(dtheta, float)

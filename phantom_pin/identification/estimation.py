@@ -27,6 +27,7 @@ import dataclasses
 from typing import Callable
 
 import numpy as np
+import scipy.ndimage
 import scipy.signal
 
 from phantom_pin.config import Friction
@@ -64,14 +65,16 @@ NEEDS_GENERAL = 1.2
 @dataclasses.dataclass(frozen=True)
 class Samples:
     """The filtered log at its kept samples: theta (N, 3) rad, dtheta rad/s, ddtheta rad/s^2,
-    tau N m, and the regressor's friction columns filtered as tau, ``friction`` (N, 3, 6):
-    viscous1..3 then coulomb1..3."""
+    tau N m, the regressor's friction columns filtered as tau, ``friction`` (N, 3, 6):
+    viscous1..3 then coulomb1..3, and ``moving`` (N, 3): whether each joint's equation is
+    fitted (its rate stays above MIN_SPEED over the filter's span around the sample)."""
 
     theta: np.ndarray
     dtheta: np.ndarray
     ddtheta: np.ndarray
     tau: np.ndarray
     friction: np.ndarray
+    moving: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -129,6 +132,10 @@ class Fit:
                    else "identify with --structure general"))
 
 
+#: A joint's equation is fitted only where its rate stays above MIN_SPEED (rad/s) over the
+#: filter's span (1 / cutoff) either side: near rest a joint may stick, and its friction is then
+#: whatever holds it, not the sliding law the regressor's columns describe.
+MIN_SPEED = 0.01
 #: How a log's torques relate to its times: "held", commands each applied from its sample to the
 #: next (a servo loop's zero-order hold: the default), or "sampled", the torque at that instant
 #: (a torque sensor, or torques computed from the motion).
@@ -160,30 +167,38 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Sa
     step = max(1, int(rate / (5 * cutoff)))
     keep = slice(edge, len(log.t) - edge, step)
     friction = columns[keep][:, None, :] * np.tile(np.eye(3), 2)          # (N, 3, 6): diagonal blocks
-    return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau[keep], friction)
+    span = max(1, int(round(rate / cutoff)))
+    slow = scipy.ndimage.maximum_filter1d((np.abs(dtheta) < MIN_SPEED).astype(np.uint8), 2 * span + 1, axis=0)
+    return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau[keep], friction, ~slow[keep].astype(bool))
 
 
-def _fit(phi: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Weighted least squares of y (N, 3) on phi (N, 3, P): (beta, covariance, residual (N, 3),
-    joint weights (3,)), each joint weighted by 1 / its residual standard deviation."""
+def _fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """Weighted least squares of y (N, 3) on phi (N, 3, P) over the equations ``moving`` (N, 3)
+    (all by default): (beta, covariance, residual (N, 3; 0 where not fitted), joint weights
+    (3,)), each joint weighted by 1 / its residual standard deviation."""
     p = phi.shape[-1]
+    moving = np.ones(y.shape, bool) if moving is None else moving
+    phi, y = phi * moving[..., None], y * moving
     stacked = phi.reshape(-1, p)
     beta = np.linalg.lstsq(stacked, y.reshape(-1), rcond=None)[0]
     residual = y - phi @ beta
-    joint_sigma = np.sqrt((residual**2).sum(axis=0) / (len(residual) - p / 3))
+    joint_sigma = np.sqrt((residual**2).sum(axis=0) / np.maximum(moving.sum(axis=0) - p / 3, 1))
     weight = 1.0 / np.maximum(joint_sigma, 1e-300)
     weighted, yw = (phi * weight[:, None]).reshape(-1, p), (y * weight).reshape(-1)
     beta = np.linalg.lstsq(weighted, yw, rcond=None)[0]
     rw = yw - weighted @ beta
-    covariance = (rw @ rw / (len(yw) - p)) * np.linalg.inv(weighted.T @ weighted)
+    covariance = (rw @ rw / (moving.sum() - p)) * np.linalg.inv(weighted.T @ weighted)
     return beta, covariance, y - phi @ beta, weight
 
 
-def _rms(residual: np.ndarray) -> np.ndarray:
-    return np.sqrt((residual**2).mean(axis=0))
+def _rms(residual: np.ndarray, moving: np.ndarray | None = None) -> np.ndarray:
+    """RMS per joint (N, 3) -> (3,) over the equations ``moving`` (all by default)."""
+    moving = np.ones(residual.shape, bool) if moving is None else moving
+    return np.sqrt((residual**2 * moving).sum(axis=0) / np.maximum(moving.sum(axis=0), 1))
 
 
-def _scaled(phi: np.ndarray, y: np.ndarray, weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _scaled(phi: np.ndarray, y: np.ndarray, weight: np.ndarray,
+            moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The factors s (3,) (s_1 = 1) with which the joints' torques fit best, s_j y_j = Phi_j beta
     (a linear least-squares problem in beta, s_2, s_3), and the residual RMS per joint in the
     log's torque units."""
@@ -196,7 +211,7 @@ def _scaled(phi: np.ndarray, y: np.ndarray, weight: np.ndarray) -> tuple[np.ndar
     rhs[0] = y[:, 0] * weight[0]
     solution = np.linalg.lstsq(rows.reshape(-1, p + 2), rhs.reshape(-1), rcond=None)[0]
     scale = np.array([1.0, *solution[p:]])
-    return scale, _rms((phi @ solution[:p]) / np.where(scale != 0, scale, 1.0) - y)
+    return scale, _rms((phi @ solution[:p]) / np.where(scale != 0, scale, 1.0) - y, moving)
 
 
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
@@ -237,14 +252,19 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise LogError(f"too short: {len(samples.theta)} samples after filtering (need 50)")
     phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     stage(0.4)
-    y = samples.tau - tau0
+    moving = samples.moving                  # the equations fitted: joints clear of rest
+    if (moving.sum(axis=0) < 50).any():
+        still = ", ".join(str(j + 1) for j in np.flatnonzero(moving.sum(axis=0) < 50))
+        raise LogError(f"too little motion: joint(s) {still} move faster than {MIN_SPEED} rad/s in fewer than 50 "
+                       "filtered samples; log an excitation trajectory (phantom-pin excite)")
+    phi, y = phi * moving[..., None], (samples.tau - tau0) * moving
     stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)
     condition = float(np.linalg.cond(stacked / np.where(norms > 0, norms, 1.0)))
     if not condition <= MAX_CONDITION:
         raise LogError(f"not exciting enough: the base regressor's condition number is {condition:.3g} "
                        f"(at most {MAX_CONDITION:.0e}); log an excitation trajectory (phantom-pin excite)")
-    beta, covariance, residual, weight = _fit(phi, y)
+    beta, covariance, residual, weight = _fit(phi, y, moving)
     sigma = np.sqrt(np.diag(covariance))
     root = np.linalg.cholesky(np.linalg.inv(covariance)).T            # root^T root = covariance^-1
     stage(0.5)
@@ -252,10 +272,10 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     written = model.matrix @ x + model.offset
     stage(0.7)
     comparison = _comparison(model, phantom, samples)
-    scale, scaled_rms = _scaled(phi, y, weight)
-    fit = Fit(model.name, model.base_names, model.units, beta, sigma, _rms(residual), _rms(y - phi @ written),
-              _rms(y), condition, len(samples.theta), x, written, model.overrides(x), comparison, scale,
-              scaled_rms, ())
+    scale, scaled_rms = _scaled(phi, y, weight, moving)
+    fit = Fit(model.name, model.base_names, model.units, beta, sigma, _rms(residual, moving),
+              _rms(y - phi @ written, moving), _rms(y, moving), condition, len(samples.theta), x, written,
+              model.overrides(x), comparison, scale, scaled_rms, ())
     problems = _problems(fit, model, phi, y, log, phantom)
     stage(1.0)
     return dataclasses.replace(fit, problems=tuple(problems))
@@ -269,7 +289,7 @@ def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[s
     phi, tau0 = STRUCTURES[other](phantom).regressor_of(samples.theta, samples.dtheta, samples.ddtheta,
                                                         samples.friction)
     y = samples.tau - tau0
-    return other, _rms(_fit(phi, y)[2])
+    return other, _rms(_fit(phi, y, samples.moving)[2], samples.moving)
 
 
 def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Log, phantom: Phantom) -> list[str]:

@@ -17,6 +17,10 @@ import scipy.optimize
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 
+#: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
+#: would stall SLSQP's finite differences); the result is checked with the law itself.
+SMOOTH_SPEED = 0.05
+
 
 @dataclasses.dataclass(frozen=True)
 class Fourier:
@@ -103,13 +107,18 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
     rng = np.random.default_rng(seed)
     memo: dict[bytes, tuple] = {}
 
-    def evaluate(free, at=t):
-        """(states, Phi stacked (3N, P), torque (N, 3)) at the times ``at``."""
-        key = free.tobytes() + (b"" if at is t else b"checked")
+    def evaluate(free, at=t, exact=False):
+        """(states, Phi stacked (3N, P), torque (N, 3)) at the times ``at``: for the optimiser
+        with the Coulomb column smoothed (tanh(dtheta / SMOOTH_SPEED): the cost and the
+        constraints stay differentiable for SLSQP), ``exact`` with the friction law itself."""
+        key = free.tobytes() + (b"exact" if exact else b"") + (b"" if at is t else b"checked")
         if key not in memo:
             memo.clear()
             states = Fourier.from_free(free, harmonics, period)(at)
-            phi, tau0 = general.regressor_of(*states)
+            rates = states[1]
+            smooth = None if exact else (np.concatenate([rates, np.tanh(rates / SMOOTH_SPEED)], axis=-1)[:, None, :]
+                                         * np.tile(np.eye(3), 2))
+            phi, tau0 = general.regressor_of(*states, smooth)
             memo[key] = states, phi.reshape(-1, len(beta)), phi @ beta + tau0
         return memo[key]
 
@@ -139,7 +148,7 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
         """The inequalities at the optimiser's points and at ``checked``."""
         if inequalities(free).min() < -1e-9:
             return False
-        states, _, torque = evaluate(free, checked)
+        states, _, torque = evaluate(free, checked, exact=True)
         return bool(limits.slack(states[0]).min() >= margin - 1e-9
                     and (torque_share * effort - np.abs(torque)).min() >= -1e-12)
 
@@ -169,7 +178,7 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
     if best is None:
         raise RuntimeError("excitation: no feasible trajectory found; raise --restarts")
     trajectory = Fourier.from_free(best, harmonics, period)
-    states, phi, torque = evaluate(best, checked)
+    states, phi, torque = evaluate(best, checked, exact=True)
     report = None
     if description.config.report is not None:
         report = condition_number(Report(general.phantom).regressor_of(*states)[0].reshape(-1, 14))

@@ -8,7 +8,7 @@ pi stacks, in this order (``Regressor.names``):
   origin*, both in the body's joint frame (the URDF link frame);
 - the reflected rotor inertia of each motor, J r_i^2 (kg m^2), acting on ddtheta_i;
 - per joint, a viscous coefficient (N m s/rad) on dtheta_i and a Coulomb torque (N m) on
-  tanh(dtheta_i / smoothing_speed): actuation.yaml's friction law.
+  sign(dtheta_i): actuation.yaml's friction law in motion (config.Friction).
 
 Pinocchio refuses computeJointTorqueRegressor on mimic models, so it runs on the tree
 model at the tree state (q_tree from the mimic tags, v_tree = G dtheta, a_tree = G ddtheta)
@@ -41,7 +41,7 @@ def body_names(tree: pin.Model) -> list[str]:
 
 class Regressor:
     """Y(theta, dtheta, ddtheta) of a Phantom: (..., 3, n_parameters), see the module doc.
-    The friction columns follow the Phantom's own friction law (its config's smoothing speed)."""
+    The friction columns follow the Phantom's own friction law in motion (config.Friction)."""
 
     def __init__(self, phantom: Phantom) -> None:
         if not isinstance(phantom, Phantom):
