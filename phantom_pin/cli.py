@@ -113,9 +113,11 @@ def _check(args: argparse.Namespace, phantom: Phantom) -> int:
         raise PhantomPinError(f"-n: {args.n} states is more than {CHECK_MAX:.0e} (about 4 minutes); check fewer")
     p = phantom.config.report
     if p is None:
-        raise PhantomPinError(f"check: the model {phantom.config.name} is not written in the report's terms, so "
-                              f"the closed form does not apply (tests/test_cad_model.py checks it against an "
-                              f"independent derivation)")
+        given = (" with the --params/--set overrides (links in full, as identify's general overlay writes them)"
+                 if phantom.config.overridden else "")
+        raise PhantomPinError(f"check: the model {phantom.config.name}{given} is not written in the report's terms, "
+                              f"so the closed form does not apply (tests/test_cad_model.py checks a model in full "
+                              f"against an independent derivation)")
     methods = {"forward_kinematics": 1, "spatial_jacobian": 1, "body_jacobian": 1, "mass_matrix": 1,
                "coriolis_matrix": 2, "gravity": 1, "inverse_dynamics": 3}  # name: number of arguments
     worst = {name: [0.0, 0.0] for name in methods}  # max |ours - reference|, max |reference|

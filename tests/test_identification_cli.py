@@ -233,3 +233,25 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     assert keys["actuation.friction.coulomb"] == pytest.approx(law.coulomb, rel=1e-2)
     code, _, err = run(capsys, "simulate", "--trajectory", traj, "--duration", "3")
     assert code == 2 and "--duration: --trajectory sets it" in err
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["identify", "LOG", "-o", "OUT/missing/id.yaml"], "--output: cannot write in"),
+    (["identify", "LOG", "-o", "OUT", "--force"], "is a folder; name a file"),
+    (["identify", "LOG", "-o", "OUT/id.yaml", "--cutoff", "1e-9"], "--cutoff: 1e-09 Hz is too low for a"),
+    (["identify", "LOG", "-o", "OUT/id.yaml", "--cutoff", "nan"], "--cutoff: expected a finite positive"),
+    (["excite", "-o", "OUT/traj.csv", "--seed", "-1"], "--seed: expected an integer of at least 0"),
+    (["excite", "-o", "OUT/traj.csv", "--iterations", "0"], "--iterations: expected an integer of at least 1"),
+    (["excite", "-o", "OUT", "--force"], "is a folder; name a file"),
+])
+def test_bad_options_name_themselves_before_any_work(tmp_path, capsys, arguments, message):
+    """What a review tried: one line naming the option, exit 2, nothing written, and no fit or
+    optimisation run first (before: a missing folder failed after the whole fit)."""
+    path = tmp_path / "log.csv"
+    io.write_log(path, *(lambda t: (t, np.zeros((len(t), 3)) + t[:, None], np.zeros((len(t), 3))))(
+        np.arange(3001) / 1000.0))
+    before = sorted(p.name for p in tmp_path.iterdir())
+    args = [a.replace("LOG", str(path)).replace("OUT", str(tmp_path)) for a in arguments]
+    code, out, err = run(capsys, *args)
+    assert code == 2 and err.count("\n") == 1 and message in err, err
+    assert out == "" and sorted(p.name for p in tmp_path.iterdir()) == before

@@ -116,9 +116,16 @@ def test_a_free_fall_comes_to_rest_against_the_parallelogram_stop(fall):
     assert theta[0] == pytest.approx(START[0], abs=1e-12)               # no gravity on theta1
 
 
-def test_saturation_clips_at_the_stall_torque():
-    result = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.5])
-    np.testing.assert_allclose(result.tau_commanded, np.tile([5.0, -5.0, 0.5], (11, 1)))
+def test_saturation_clips_at_the_configurations_policy():
+    """By default (actuation.yaml: saturation continuous) at the motors' continuous torque, as the
+    MJCF's ctrlrange: 28.6 mN m x ratio, 0.665 A; with saturation="peak" at the stall torque,
+    129 mN m x ratio, 5.5 A."""
+    continuous = np.array([0.0286 * 13.3, 0.0286 * 11.6, 0.0286 * 11.6])
+    result = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.2])
+    np.testing.assert_allclose(result.tau_commanded, np.tile([5.0, -5.0, 0.2], (11, 1)))
+    np.testing.assert_allclose(result.tau, np.tile([continuous[0], -continuous[1], 0.2], (11, 1)), rtol=1e-15)
+    np.testing.assert_allclose(result.current[0], [0.0286 / 0.0234, -0.0286 / 0.0234, 0.2 / (11.6 * 0.0234)])
+    result = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.5], saturation="peak")
     np.testing.assert_allclose(result.tau, np.tile([PEAK[0], -PEAK[1], 0.5], (11, 1)), rtol=1e-15)
     np.testing.assert_allclose(result.current[0], [0.129 / 0.0234, -0.129 / 0.0234, 0.5 / (11.6 * 0.0234)])
     unclipped = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.5], saturation=False)
@@ -221,7 +228,7 @@ def test_work_beyond_a_few_minutes_is_refused_at_once(duration, rate, stiffness,
 @pytest.mark.parametrize("flag", ["friction", "hard_stops", "saturation", "quantization"])
 def test_flags_are_booleans(flag):
     """Before, friction="no" kept friction on (a truthy string)."""
-    with pytest.raises(InvalidInputError, match=f"^{flag}: expected True or False, got 'no'"):
+    with pytest.raises(InvalidInputError, match=f"^{flag}: expected True(,| or) False.* got 'no'"):
         simulate(START, 0.01, **{flag: "no"})
 
 

@@ -34,6 +34,8 @@ JOINT_LIMIT_BOUND = 2 * math.pi
 #: The stop coordinates as linear maps of theta (rows): theta1, theta2, theta3, theta2 - theta3.
 STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, -1.0]])
 STOP_COORDINATES.flags.writeable = False
+#: Where the simulators clip commanded torques (actuation.yaml's ``saturation``).
+SATURATIONS = ("continuous", "peak")
 #: MuJoCo's integrators, as config/mjcf.yaml may name them.
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
 #: The SRDF's named postures, which joint_limits.yaml gives (srdf/phantom_1_5.srdf.xacro).
@@ -118,6 +120,14 @@ class Actuation:
     effort: tuple[float, float, float]
     velocity: tuple[float, float, float]
     peak: tuple[float, float, float]
+    saturation: str = "continuous"
+
+    @property
+    def saturation_torque(self) -> tuple[float, float, float]:
+        """Where the simulators clip a commanded joint torque (N m), by ``saturation`` (SATURATIONS):
+        "continuous", the motors' rating (``effort``, the default), or "peak", their stall torque
+        (``peak``); the same in phantom_pin.simulate and the MJCF's ctrlrange and forcerange."""
+        return self.effort if self.saturation == "continuous" else self.peak
 
     @property
     def rotor(self) -> tuple[float, tuple[float, float, float]]:
@@ -213,7 +223,8 @@ class Scene:
 class MujocoSettings:
     """The MJCF's timestep (s) and integrator, the mimic equalities' solref (time constant
     in timesteps, damping ratio) and solimp (dmin, dmax, width), the joints' dry friction's
-    solref (time constant in timesteps, damping ratio), and the scene."""
+    solref (time constant in timesteps, damping ratio), the stops' (joint and tendon limits')
+    solref (time constant s, damping ratio) and solimp, and the scene."""
 
     timestep: float
     integrator: str
@@ -222,6 +233,8 @@ class MujocoSettings:
     equality_solimp: tuple[float, float, float]
     friction_solref_timesteps: float
     friction_solref_damping_ratio: float
+    stop_solref: tuple[float, float]
+    stop_solimp: tuple[float, float, float]
     scene: Scene
 
 
@@ -346,6 +359,9 @@ def _actuation(r: _Reader) -> Actuation:
         return r.number(arg, *keys, **kind)
 
     friction = Friction(act("friction", "viscous", non_negative=True), act("friction", "coulomb", non_negative=True))
+    saturation = r.text(arg, "saturation")
+    if saturation not in SATURATIONS:
+        raise r.error(arg, f"saturation must be {' or '.join(SATURATIONS)}, got {saturation!r}")
     public = [r.node(arg, section) is not None for section in DRIVE]
     document = r.documents[arg]
     if public[0] != public[1]:
@@ -355,7 +371,7 @@ def _actuation(r: _Reader) -> Actuation:
     if not public[1]:
         effort = tuple(act("joint_torque_limit", j, positive=True) for j in JOINTS)
         velocity = tuple(act("joint_velocity_limit", j, positive=True) for j in JOINTS)
-        return Actuation(None, None, None, friction, effort, velocity, effort)
+        return Actuation(None, None, None, friction, effort, velocity, effort, saturation)
     extra = [key for key in JOINT_LIMITS if key in document]
     if extra:
         raise r.error(arg, f"{extra[0]} is for a model without motor data; with a motor, the joint limits "
@@ -367,7 +383,7 @@ def _actuation(r: _Reader) -> Actuation:
     return Actuation(ratios, motor, encoder, friction,
                      tuple(motor.max_continuous_torque * k for k in ratios),
                      tuple(motor.max_speed / k for k in ratios),
-                     tuple(motor.stall_torque * k for k in ratios))
+                     tuple(motor.stall_torque * k for k in ratios), saturation)
 
 
 def _limits(r: _Reader) -> Limits:
@@ -418,7 +434,8 @@ def _mujoco(r: _Reader) -> MujocoSettings:
                           r.number(arg, "equality_solref_damping_ratio", positive=True),
                           r.vector(arg, "equality_solimp", length=3),
                           r.number(arg, "friction_solref_timesteps", positive=True),
-                          r.number(arg, "friction_solref_damping_ratio", positive=True), scene)
+                          r.number(arg, "friction_solref_damping_ratio", positive=True),
+                          r.vector(arg, "stop_solref", length=2), r.vector(arg, "stop_solimp", length=3), scene)
 
 
 def _sources(r: _Reader) -> dict[str, str]:

@@ -113,6 +113,8 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     ``robot_file`` and adds a floor, a light, a table and a stand under the turret.
     ``robot_name`` names the generated files in the header (urdf/ROBOT_NAME.urdf).
     """
+    device_stops = config.limits.stops
+    stop_ranges = {f"{prefix}joint{j + 1}": (device_stops.lower[j], device_stops.upper[j]) for j in range(3)}
     settings = config.mujoco
     stops = config.limits.stops.coupled
     urdf = ET.fromstring(urdf_xml)
@@ -158,8 +160,10 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
             if joint.get("type") == "revolute":
                 friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
                                         settings.friction_solref_damping_ratio])
+                stop_soft = {"solreflimit": _vec(settings.stop_solref), "solimplimit": _vec(settings.stop_solimp)}
                 ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
-                                                               joint.get("name") in mimics, friction_solref))
+                                                               joint.get("name") in mimics, friction_solref,
+                                                               stop_ranges.get(joint.get("name")), stop_soft))
             elif joint.get("type") != "fixed":
                 raise ValueError(f"unsupported URDF joint type {joint.get('type')!r}")
         link = links[name]
@@ -189,7 +193,8 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     # theta2 - theta3 limited to [-(theta3 - theta2)_max, (theta2 - theta3)_max]
     tendon = ET.SubElement(ET.SubElement(mujoco, "tendon"), "fixed", {
         "name": f"{prefix}parallelogram",
-        "range": _vec([-stops.theta3_minus_theta2_max, stops.theta2_minus_theta3_max])})
+        "range": _vec([-stops.theta3_minus_theta2_max, stops.theta2_minus_theta3_max]),
+        "solreflimit": _vec(settings.stop_solref), "solimplimit": _vec(settings.stop_solimp)})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint2", "coef": "1"})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint3", "coef": "-1"})
 
@@ -205,7 +210,10 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     motor = config.actuation.motor
     for index, (name, transmission) in enumerate(transmissions.items()):
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
-        torque = config.actuation.effort[index] if motor is None else motor.max_continuous_torque
+        # the saturation policy's torque at the motor shaft (the joint's without motor data: gear 1)
+        torque = config.actuation.saturation_torque[index] / (1.0 if motor is None else ratio)
+        if motor is not None:           # the data sheet's number itself, not a quotient's rounding
+            torque = motor.max_continuous_torque if config.actuation.saturation == "continuous" else motor.stall_torque
         ET.SubElement(actuator, "motor", {"name": transmission.find("actuator").get("name"),
                                           "joint": name, "gear": _num(ratio),
                                           "ctrlrange": _vec([-torque, torque]),
@@ -221,10 +229,13 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
             _text(_scene(settings.scene, links[f"{prefix}turret_link"], robot_file, urdf.get("name")), robot_name))
 
 
-def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
-                      rotor_inertia: float, mimic: bool, friction_solref: str) -> dict[str, str]:
+def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element], rotor_inertia: float,
+                      mimic: bool, friction_solref: str, stops: tuple[float, float] | None,
+                      stop_soft: dict[str, str]) -> dict[str, str]:
     """A revolute URDF joint as MJCF hinge attributes; armature = rotor inertia x ratio^2; a
     joint with dry friction gets ``friction_solref`` (its frictionloss constraint's softness).
+    Its range is the device's stop (``stops``, joint_limits.yaml's: where phantom_pin.simulate's
+    stops are), not the URDF's joint box, which planners keep inside.
 
     A mimic joint gets no range: its primary's range bounds it through the equality, and
     a second limit on the same motion would over-constrain MuJoCo's solver.
@@ -232,7 +243,9 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element],
     attributes = {"name": joint.get("name")}
     if not mimic:
         limit = joint.find("limit")
-        attributes["range"] = _vec([float(limit.get("lower")), float(limit.get("upper"))])
+        lower, upper = stops if stops is not None else (float(limit.get("lower")), float(limit.get("upper")))
+        attributes["range"] = _vec([lower, upper])
+        attributes.update(stop_soft)
     axis = joint.find("axis").get("xyz")
     if axis != "0 -1 0":  # the default class's axis, that of joints 2, 3 and the pins
         attributes["axis"] = axis

@@ -51,6 +51,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--no-friction", action="store_true")
     command.add_argument("--no-hard-stops", action="store_true")
     command.add_argument("--no-saturation", action="store_true")
+    command.add_argument("--saturation", choices=("continuous", "peak"),
+                         help="clip commands at the motors' continuous or peak torque (default: actuation.yaml's "
+                              "saturation, as the MJCF)")
     command.add_argument("--quantization", action="store_true",
                          help="the controller sees encoder counts (and their backward difference)")
     command.add_argument("--format", choices=["json", "csv"], default="json")
@@ -99,7 +102,8 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     try:
         result = simulate(args.theta0, args.duration, controller, dtheta0=args.dtheta0, rate=args.rate,
                           friction=not args.no_friction, hard_stops=not args.no_hard_stops,
-                          saturation=not args.no_saturation, quantization=args.quantization, device=device,
+                          saturation=False if args.no_saturation else args.saturation or True,
+                          quantization=args.quantization, device=device,
                           progress=bar.update)
     except PhantomPinError as error:  # name the option, not simulate()'s argument
         name, _, rest = str(error).partition(":")
@@ -112,7 +116,7 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
         print(f"phantom-pin: warning: --theta0 {args.theta0} rad starts beyond the stops, which push it back",
               file=sys.stderr)
     settings = {key: getattr(args, key) for key in ("theta0", "dtheta0", "duration", "rate", "controller",
-                                                    "no_friction", "no_hard_stops", "no_saturation",
+                                                    "no_friction", "no_hard_stops", "no_saturation", "saturation",
                                                     "quantization")}
     settings["substeps"] = result.substeps
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)

@@ -162,9 +162,14 @@ class Device:
     @property
     def peak_torque(self) -> np.ndarray:
         """The most torque (N m) each joint's drive gives: the motor's stall_torque * ratio, or
-        the configuration's joint_torque_limit without public motor data. simulate() clips
-        commanded torques here."""
+        the configuration's joint_torque_limit without public motor data."""
         return np.array(self.config.actuation.peak)
+
+    @property
+    def saturation_torque(self) -> np.ndarray:
+        """Where simulate() and the MJCF clip commanded torques (N m): the continuous or the peak
+        torque, by actuation.yaml's ``saturation`` (config.Actuation.saturation_torque)."""
+        return np.array(self.config.actuation.saturation_torque)
 
     def _limit(self, continuous: bool) -> np.ndarray:
         return self.continuous_torque if continuous else self.peak_torque

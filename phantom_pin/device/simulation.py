@@ -11,6 +11,7 @@ from typing import Callable
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin.config.schema import SATURATIONS
 from phantom_pin.device.device import Device
 from phantom_pin.dynamics.model import solve_spd
 from phantom_pin.exceptions import InvalidInputError
@@ -76,6 +77,22 @@ def _positive(value: object, name: str) -> float:
     return float(value)
 
 
+def arguments(theta0: object, dtheta0: object, duration: object, rate: object, controller: object,
+              device: object) -> tuple[np.ndarray, np.ndarray, float, float, Device]:
+    """The arguments a plant's run shares, checked (InvalidInputError naming the bad one):
+    (theta0, dtheta0 or zeros, duration, rate, the Device or the shipped one)."""
+    theta = as_state(theta0, "theta0").copy()
+    velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
+    duration, rate = _positive(duration, "duration"), _positive(rate, "rate")
+    if controller is not None and not callable(controller):
+        raise InvalidInputError(f"controller: expected a callable (t, theta, dtheta) -> tau, got {controller!r}")
+    if device is None:
+        device = default_device()
+    elif not isinstance(device, Device):
+        raise InvalidInputError(f"device: expected a phantom_pin.Device or None, got {device!r}")
+    return theta, velocity, duration, rate, device
+
+
 def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool, hard_stops: bool) -> int:
     """RK4 substeps per sample period: ceil(period * LAMBDA / STEP_SCALE), and at least
     ceil(period / MAX_STEP).
@@ -97,7 +114,7 @@ def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool,
 
 def simulate(theta0: object, duration: float, controller: Controller | None = None, *,
              dtheta0: object = None, rate: float = 1000.0, friction: bool = True,
-             hard_stops: bool = True, saturation: bool = True, quantization: bool = False,
+             hard_stops: bool = True, saturation: bool | str = True, quantization: bool = False,
              device: Device | None = None, substeps: int | None = None,
              progress: Callable[[float], None] | None = None) -> SimulationResult:
     """Run ``controller`` against the device from rest (or ``dtheta0``) at ``theta0``.
@@ -111,32 +128,28 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     Plant: M(theta) ddtheta + C dtheta + N(theta) = tau_motor - tau_friction + tau_stops,
     with M including the rotors' reflected inertia (Pinocchio's crba and nonLinearEffects
     on the Phantom's mimic model, the computation of Phantom.forward_dynamics),
-    ``friction`` Device.friction, ``hard_stops`` Device.stop_torque, and with
-    ``saturation`` tau_motor = the command clipped to +-Device.peak_torque (the motors'
-    stall torque, or the configuration's joint_torque_limit). Between samples: fixed-step RK4
-    with ``substeps`` steps per period
-    (default from the stiffest term, see _substeps: 4 at 1 kHz with the shipped numbers),
-    and a step in which a stop engages or releases is bisected around the event
-    (EVENT_BISECTIONS halvings).
+    ``friction`` config.Friction (viscous and Coulomb in motion; a joint at rest sticks while
+    the torque that holds it is below the Coulomb torque: an exact mode of the integration, no
+    creep), ``hard_stops`` Device.stop_torque, and ``saturation``: tau_motor = the command
+    clipped to +-Device.saturation_torque (True: actuation.yaml's policy, "continuous" by
+    default; "continuous" or "peak" to choose; False: no clipping), as the MJCF's ctrlrange.
+    Between samples: fixed-step RK4, one step per period (at most MAX_STEP) away from the stops
+    and ``substeps`` per period while a stop is engaged (default from the stiffest term, see
+    _substeps: 3 at 1 kHz with the shipped numbers); a step in which a stop engages or
+    releases is bisected around the event (EVENT_BISECTIONS halvings), one that ends a
+    friction mode is cut at the event (regula falsi).
 
     ``device``: the Device to simulate (default: the shipped one, built once). ``progress``:
     called with the share of the samples done (0..1), for a progress bar.
     Raises InvalidInputError naming the bad argument, or the controller's bad return;
     MissingDataError for ``quantization`` on a model without public encoder data.
     """
-    for name, flag in (("friction", friction), ("hard_stops", hard_stops), ("saturation", saturation),
-                       ("quantization", quantization)):
+    for name, flag in (("friction", friction), ("hard_stops", hard_stops), ("quantization", quantization)):
         if not isinstance(flag, (bool, np.bool_)):
             raise InvalidInputError(f"{name}: expected True or False, got {flag!r}")
-    theta = as_state(theta0, "theta0").copy()
-    velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
-    duration, rate = _positive(duration, "duration"), _positive(rate, "rate")
-    if controller is not None and not callable(controller):
-        raise InvalidInputError(f"controller: expected a callable (t, theta, dtheta) -> tau, got {controller!r}")
-    if device is None:
-        device = default_device()
-    elif not isinstance(device, Device):
-        raise InvalidInputError(f"device: expected a phantom_pin.Device or None, got {device!r}")
+    if not isinstance(saturation, (bool, np.bool_)) and saturation not in SATURATIONS:
+        raise InvalidInputError(f"saturation: expected True, False, 'continuous' or 'peak', got {saturation!r}")
+    theta, velocity, duration, rate, device = arguments(theta0, dtheta0, duration, rate, controller, device)
     if quantization:
         device._require("encoder", "quantization")
     beyond = float(np.abs(device.config.limits.stops.penetration(theta)).max())
@@ -168,7 +181,9 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
 
     model = device.phantom.model
     data = model.createData()
-    peak = device.peak_torque
+    policy = device.config.actuation.saturation if saturation is True else saturation
+    actuation = device.config.actuation
+    peak = np.array(actuation.peak if policy == "peak" else actuation.effort)       # N m, the clip
     bounds = list(zip(device._stop_lower.tolist(), device._stop_upper.tolist()))
     stop_force = device.config.limits.stops.force
     law = device.config.actuation.friction

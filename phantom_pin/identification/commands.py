@@ -32,6 +32,15 @@ def _refuse(path: Path, force: bool) -> None:
         raise PhantomPinError(f"--output: {path} exists; add --force to overwrite it")
 
 
+def _writable(path: Path) -> None:
+    """--output names a file in a folder we may write, before any work."""
+    folder = path.resolve().parent
+    if path.is_dir():
+        raise PhantomPinError(f"--output: {path} is a folder; name a file")
+    if not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise PhantomPinError(f"--output: cannot write in {folder}")
+
+
 def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add the excite and identify subcommands to the phantom-pin parser."""
     excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
@@ -77,8 +86,9 @@ def excite(args: argparse.Namespace, phantom) -> int:
         value = getattr(args, name)
         if not (math.isfinite(value) and value > 0):
             raise PhantomPinError(f"--{name}: expected a finite positive number, got {value!r}")
-    if args.harmonics < 2 or args.iterations < 1 or args.restarts < 1:
-        raise PhantomPinError("--harmonics must be at least 2, --iterations and --restarts at least 1")
+    for name, least in (("harmonics", 2), ("iterations", 1), ("restarts", 1), ("seed", 0)):
+        if getattr(args, name) < least:
+            raise PhantomPinError(f"--{name}: expected an integer of at least {least}, got {getattr(args, name)}")
     if not PERIOD_RANGE[0] <= args.period <= PERIOD_RANGE[1]:
         raise PhantomPinError(f"--period: {args.period:g} s is outside {PERIOD_RANGE[0]:g}..{PERIOD_RANGE[1]:g} s "
                               "(shorter periods ask more torque than the arm has; longer ones excite nothing)")
@@ -93,9 +103,7 @@ def excite(args: argparse.Namespace, phantom) -> int:
                               f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1
-    folder = args.output.resolve().parent
-    if not folder.is_dir() or not os.access(folder, os.W_OK):
-        raise PhantomPinError(f"--output: cannot write in {folder}")
+    _writable(args.output)
     times = np.arange(rows) / args.rate
     bar = Progress("excite", 1.0, enabled=False if args.quiet else None)
     try:
@@ -132,16 +140,21 @@ def identify(args: argparse.Namespace, phantom) -> int:
     from phantom_pin.identification import estimation, io
 
     _refuse(args.output, args.force)
+    _writable(args.output)
     if args.structure == "report" and phantom.config.report is None:
-        raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name} "
+        given = " with its --params/--set overrides" if getattr(args, "overrides", None) else ""
+        raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name}{given} "
                               "gives its links in full (use --structure general)")
+    if not (math.isfinite(args.cutoff) and args.cutoff > 0):
+        raise PhantomPinError(f"--cutoff: expected a finite positive frequency (Hz), got {args.cutoff!r}")
     log = io.read_log(args.log, args.convention)
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
                                   timing=args.torque_timing)
-    except RuntimeError as error:
-        raise PhantomPinError(str(error)) from None
+    except PhantomPinError as error:                     # name the option, not estimate()'s argument
+        message = str(error)
+        raise PhantomPinError("--" + message if message.startswith("cutoff:") else message) from None
     finally:
         bar.close()
     if fit.problems and not args.force:

@@ -36,6 +36,8 @@ from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log, LogError
 from phantom_pin.identification.structures import STRUCTURES, Structure
 
+#: Fewest periods of the cutoff the log must span (the filter's transients and edges).
+MIN_CYCLES = 10.0
 #: Largest accepted condition number of the base regressor (columns scaled to unit norm).
 MAX_CONDITION = 1e3
 #: Filter order and edge cut (s).
@@ -237,6 +239,12 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
             raise InvalidInputError(f"{name}: expected a finite number > 0, got {value!r}")
+    if progress is not None and not callable(progress):
+        raise InvalidInputError(f"progress: expected a callable (share) or None, got {progress!r}")
+    duration = float(log.t[-1] - log.t[0])
+    if cutoff * duration < MIN_CYCLES:
+        raise LogError(f"cutoff: {cutoff:g} Hz is too low for a {duration:.3g} s log (the filter needs at least "
+                       f"{MIN_CYCLES:g} of its periods in the log: {MIN_CYCLES / duration:.3g} Hz or more)")
     if timing not in TIMINGS:
         raise InvalidInputError(f"timing: expected one of {', '.join(TIMINGS)}, got {timing!r}")
     if structure not in STRUCTURES:
@@ -249,14 +257,16 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     samples = filtered(log, cutoff, phantom.config.actuation.friction, timing)
     stage(0.1)
     if len(samples.theta) < 50:
-        raise LogError(f"too short: {len(samples.theta)} samples after filtering (need 50)")
+        raise LogError(f"too short: {len(samples.theta)} samples after filtering at {cutoff:g} Hz and cutting "
+                       f"{EDGE} s at each end (need 50)")
     phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     stage(0.4)
     moving = samples.moving                  # the equations fitted: joints clear of rest
     if (moving.sum(axis=0) < 50).any():
         still = ", ".join(str(j + 1) for j in np.flatnonzero(moving.sum(axis=0) < 50))
         raise LogError(f"too little motion: joint(s) {still} move faster than {MIN_SPEED} rad/s in fewer than 50 "
-                       "filtered samples; log an excitation trajectory (phantom-pin excite)")
+                       f"samples filtered at {cutoff:g} Hz; log an excitation trajectory (phantom-pin excite), or "
+                       "filter less")
     phi, y = phi * moving[..., None], (samples.tau - tau0) * moving
     stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)

@@ -16,6 +16,7 @@ import scipy.optimize
 
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import InvalidInputError
 
 #: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
 #: would stall SLSQP's finite differences); the result is checked with the law itself.
@@ -74,6 +75,24 @@ class Excitation:
     min_slack: float        # rad, nearest approach to a stop
 
 
+def _check_arguments(**values: object) -> None:
+    """optimise()'s numbers: InvalidInputError naming the first that is out of its range."""
+    integers = {"harmonics": 2, "samples": 10, "restarts": 1, "iterations": 1, "seed": 0}
+    for name, value in values.items():
+        if name in integers:
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < integers[name]:
+                raise InvalidInputError(f"{name}: expected an integer of at least {integers[name]}, got {value!r}")
+        elif isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            raise InvalidInputError(f"{name}: expected a finite number, got {value!r}")
+    if values["period"] <= 0:
+        raise InvalidInputError(f"period: expected a positive number (s), got {values['period']!r}")
+    for name in ("margin", "amplitude_weight"):
+        if values[name] < 0:
+            raise InvalidInputError(f"{name}: expected a number >= 0, got {values[name]!r}")
+    if not 0 < values["torque_share"] <= 1:
+        raise InvalidInputError(f"torque_share: expected a share in (0, 1], got {values['torque_share']!r}")
+
+
 def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
@@ -96,6 +115,16 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
     Description, then loaded once more into Pinocchio) whose configuration is excited."""
     from phantom_pin.identification.structures import General, Report
 
+    _check_arguments(period=period, harmonics=harmonics, samples=samples, margin=margin, torque_share=torque_share,
+                     restarts=restarts, iterations=iterations, seed=seed, amplitude_weight=amplitude_weight)
+    if progress is not None and not callable(progress):
+        raise InvalidInputError(f"progress: expected a callable (share) or None, got {progress!r}")
+    if times is not None:
+        times = np.asarray(times, dtype=float)
+        if times.ndim != 1 or not len(times) or not np.isfinite(times).all():
+            raise InvalidInputError("times: expected a non-empty 1-D array of finite times (s)")
+    if not isinstance(model, (Phantom, Description)):
+        raise InvalidInputError(f"model: expected a phantom_pin.Phantom or Description, got {model!r}")
     phantom = model if isinstance(model, Phantom) else Phantom(model)
     description = phantom.description
     limits = description.config.limits
@@ -176,7 +205,8 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
                     best, best_cost = candidate, cost(candidate)
                 break
     if best is None:
-        raise RuntimeError("excitation: no feasible trajectory found; raise --restarts")
+        raise InvalidInputError(f"restarts: no feasible trajectory found in {restarts} start(s); raise restarts "
+                                "(--restarts) or lower margin")
     trajectory = Fourier.from_free(best, harmonics, period)
     states, phi, torque = evaluate(best, checked, exact=True)
     report = None

@@ -33,9 +33,29 @@ class LogError(PhantomPinError, ValueError):
 
 @dataclasses.dataclass(frozen=True)
 class Log:
+    """A device's log: times ``t`` (N,) s, strictly increasing; joint angles ``theta`` (N, 3)
+    rad (the report's); joint torques ``tau`` (N, 3) N m; all finite (LogError naming ``log``
+    otherwise)."""
+
     t: np.ndarray       # (N,) s
     theta: np.ndarray   # (N, 3) rad
     tau: np.ndarray     # (N, 3) N m
+
+    def __post_init__(self) -> None:
+        try:
+            arrays = [np.asarray(x, dtype=float) for x in (self.t, self.theta, self.tau)]
+        except (TypeError, ValueError):
+            raise LogError("log: t, theta and tau must be arrays of numbers") from None
+        t, theta, tau = arrays
+        if t.ndim != 1 or len(t) < 2 or theta.shape != (len(t), 3) or tau.shape != (len(t), 3):
+            raise LogError(f"log: expected t (N,), theta (N, 3), tau (N, 3) with N >= 2, got {t.shape}, "
+                           f"{theta.shape}, {tau.shape}")
+        if not all(np.isfinite(x).all() for x in arrays):
+            raise LogError("log: t, theta and tau must be finite (no NaN or inf)")
+        if not (np.diff(t) > 0).all():
+            raise LogError("log: the times t must increase strictly")
+        for name, value in zip(("t", "theta", "tau"), arrays):
+            object.__setattr__(self, name, value)
 
     @property
     def rate(self) -> float:
@@ -49,10 +69,19 @@ def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> 
 def write_log(path: Path | str, t: object, theta: object, tau: object, force: bool = False) -> None:
     """Write a log: times ``t`` (N,) s, ``theta`` (N, 3) rad and ``tau`` (N, 3) N m, finite, as
     read_log reads it. An existing file is kept unless ``force``: LogError naming the argument."""
+    if not isinstance(path, (str, Path)):
+        raise LogError(f"path: expected a file path, got {path!r}")
+    if not isinstance(force, bool):
+        raise LogError(f"force: expected True or False, got {force!r}")
     path = Path(path)
     if path.exists() and not force:
         raise LogError(f"path: {path} exists; pass force=True to overwrite it")
-    times = np.asarray(t, dtype=float)
+    if not path.resolve().parent.is_dir():
+        raise LogError(f"path: the folder {path.resolve().parent} does not exist")
+    try:
+        times = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise LogError(f"t: expected numbers (s), got {t!r:.60}") from None
     angles, _ = as_states(theta, "theta")
     torques, _ = as_states(tau, "tau")
     if times.ndim != 1 or angles.shape != (len(times), 3) or torques.shape != (len(times), 3):
@@ -60,6 +89,8 @@ def write_log(path: Path | str, t: object, theta: object, tau: object, force: bo
                        f"{angles.shape}, {torques.shape}")
     if not np.isfinite(times).all():
         raise LogError("t: contains NaN or inf")
+    if not (np.diff(times) > 0).all():
+        raise LogError("t: the times must increase strictly")
     write_csv(path, LOG_COLUMNS, np.column_stack([times, angles, torques]))
 
 
@@ -118,11 +149,15 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     mN m)."""
     if convention not in ("report", "openhaptics"):
         raise LogError(f"convention: expected 'report' or 'openhaptics', got {convention!r}")
+    if not isinstance(path, (str, Path)):
+        raise LogError(f"path: expected a file path, got {path!r}")
     path = Path(path)
     lines, column = _read_table(path, LOG_COLUMNS)
     t = column["t"]
     step = np.diff(t)
-    if len(t) < 2 or not (step > 0).all():
+    if len(t) < 2:
+        raise LogError(f"{path}: too short ({len(t)} row(s) of data; at least {MIN_DURATION} s)")
+    if not (step > 0).all():
         raise LogError(f"{path}: time is not strictly increasing"
                        + (f" (line {lines[2 + int(np.argmin(step > 0))][0]})" if len(t) >= 2 else ""))
     if t[-1] - t[0] < MIN_DURATION:
@@ -179,7 +214,8 @@ def overlay(fit, given: dict | None = None) -> tuple[dict[str, float], list[str]
                          "actuation.yaml holds one value for all joints)")
         else:
             keys[f"actuation.friction.{kind}"] = common
-            notes.append(f"friction.{kind} per joint: {listed}; written as their mean")
+            notes.append(f"friction.{kind} per joint: {listed}; written {common:.4g}, the inverse-variance mean "
+                         "of the physical values (0 or more)")
     return keys, notes
 
 

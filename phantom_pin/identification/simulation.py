@@ -45,9 +45,23 @@ def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, 
     receiving them plus white noise of standard deviation ``torque_noise`` (N m, seeded)."""
     if not isinstance(device, Device):
         raise InvalidInputError(f"device: expected a phantom_pin.Device, got {device!r}")
-    if not (np.isfinite(torque_noise) and torque_noise >= 0):
+    if isinstance(torque_noise, bool) or not isinstance(torque_noise, (int, float)) or \
+            not (np.isfinite(torque_noise) and torque_noise >= 0):
         raise InvalidInputError(f"torque_noise: expected a finite number >= 0 (N m), got {torque_noise!r}")
-    t, theta, dtheta, tau = (np.asarray(x, float) for x in (t, theta, dtheta, tau))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidInputError(f"seed: expected an integer >= 0, got {seed!r}")
+    try:
+        t, theta, dtheta, tau = (np.asarray(x, float) for x in (t, theta, dtheta, tau))
+    except (TypeError, ValueError):
+        raise InvalidInputError("t, theta, dtheta, tau: expected arrays of numbers") from None
+    if t.ndim != 1 or len(t) < 2 or any(x.shape != (len(t), 3) for x in (theta, dtheta, tau)):
+        raise InvalidInputError(f"t, theta, dtheta, tau: expected shapes (N,), (N, 3), (N, 3), (N, 3) with N >= 2, "
+                                f"got {t.shape}, {theta.shape}, {dtheta.shape}, {tau.shape}")
+    if not all(np.isfinite(x).all() for x in (t, theta, dtheta, tau)):
+        raise InvalidInputError("t, theta, dtheta, tau: must be finite (no NaN or inf)")
+    step = np.diff(t)
+    if not (step > 0).all() or np.ptp(step) > 1e-6 * step.mean():
+        raise InvalidInputError("t: the times must increase at a fixed rate")
     follow = tracking(t, theta, dtheta, tau)
     rng = np.random.default_rng(seed)
     commanded = np.zeros((len(t), 3))

@@ -1,0 +1,80 @@
+"""The device in MuJoCo, driven like phantom_pin.simulate: the Description's MJCF (its motors and
+their ctrlrange, frictionloss, armature, joint and tendon limits, the mimic equalities), a
+controller sampled at a fixed rate with a zero-order hold, and simulate()'s SimulationResult,
+so that one controller runs unchanged against both plants (tests/test_plants.py compares
+them). Needs MuJoCo (``pip install phantom_pin[interop]``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from phantom_pin.device.device import Device
+from phantom_pin.device.simulation import MAX_SAMPLES, Controller, SimulationResult, _checked, arguments
+from phantom_pin.exceptions import InvalidInputError, MissingDataError
+
+
+def simulate_mujoco(theta0: object, duration: float, controller: Controller | None = None, *,
+                    dtheta0: object = None, rate: float = 1000.0, device: Device | None = None) -> SimulationResult:
+    """Run ``controller(t, theta, dtheta) -> tau`` (s, rad, rad/s -> N m at the joints) against
+    the MuJoCo model of ``device`` (default: the shipped one) from ``theta0`` (rad; at rest, or
+    ``dtheta0`` rad/s), at ``rate`` Hz with a zero-order hold, for ``duration`` s. The command
+    goes to the MJCF's motors as ctrl = tau / gear; MuJoCo clips it at their ctrlrange
+    (actuation.yaml's saturation policy, as simulate). MuJoCo steps the MJCF's timestep
+    (config/mjcf.yaml), 1 / (rate x timestep) steps per sample, which must be a whole number.
+    The result's theta and dtheta are MuJoCo's joint1..3; ``tau`` the applied torques."""
+    try:
+        import mujoco
+    except ImportError:
+        raise MissingDataError("simulate_mujoco: MuJoCo is not installed (pip install phantom_pin[interop])") \
+            from None
+    theta, velocity, duration, rate, device = arguments(theta0, dtheta0, duration, rate, controller, device)
+    description = device.phantom.description
+    model = mujoco.MjModel.from_xml_string(description.mjcf)
+    data = mujoco.MjData(model)
+    steps = 1.0 / (rate * model.opt.timestep)
+    if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
+        raise InvalidInputError(f"rate: {rate:g} Hz is not the MJCF's 1 / timestep ({1 / model.opt.timestep:g} Hz) "
+                                "divided by a whole number")
+    steps = int(round(steps))
+    samples = math.floor(duration * rate * (1 + 1e-12)) + 1
+    if not 2 <= samples <= MAX_SAMPLES:
+        raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples; expected 2 to "
+                                f"{MAX_SAMPLES}")
+    coupling = device.phantom.coupling
+    names = coupling.tree.names[1:]
+    qpos = [model.joint(name).qposadr[0] for name in names]
+    dofs = [model.joint(name).dofadr[0] for name in names]
+    primaries = [f"{description.prefix}joint{j}" for j in (1, 2, 3)]
+    primary_q = [model.joint(name).qposadr[0] for name in primaries]
+    primary_v = [model.joint(name).dofadr[0] for name in primaries]
+    actuators = [next(i for i in range(model.nu) if model.actuator_trnid[i, 0] == model.joint(name).id)
+                 for name in primaries]
+    gear = model.actuator_gear[actuators, 0].copy()
+    low, high = model.actuator_ctrlrange[actuators, 0], model.actuator_ctrlrange[actuators, 1]
+    data.qpos[qpos] = coupling.configuration(theta)
+    data.qvel[dofs] = coupling.tangent(velocity)
+    mujoco.mj_forward(model, data)
+    out_theta, out_dtheta = np.empty((samples, 3)), np.empty((samples, 3))
+    commanded, applied = np.zeros((samples, 3)), np.zeros((samples, 3))
+    for k in range(samples):
+        t = k / rate
+        out_theta[k], out_dtheta[k] = data.qpos[primary_q], data.qvel[primary_v]
+        if controller is not None:
+            commanded[k] = _checked(controller(t, out_theta[k].copy(), out_dtheta[k].copy()), t)
+        ctrl = np.clip(commanded[k] / gear, low, high)
+        applied[k] = ctrl * gear
+        if k == samples - 1:
+            break
+        data.ctrl[actuators] = ctrl
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+        if not np.isfinite(data.qpos).all():
+            raise InvalidInputError(f"controller or dtheta0: MuJoCo's state diverged between t = {t:.6g} s and the "
+                                    "next sample")
+    return SimulationResult(
+        t=np.arange(samples) / rate, theta=out_theta, dtheta=out_dtheta, tau=applied, tau_commanded=commanded,
+        current=None if device.config.actuation.motor is None else device.motor_currents(applied),
+        tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=steps)
