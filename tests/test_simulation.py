@@ -74,8 +74,8 @@ def test_halving_the_substep_changes_little_through_a_stop():
     """0.5 s of free fall, through the first contact with the coupled stop (at 0.3 s)."""
     default = simulate(START, 0.5)
     finer = simulate(START, 0.5, substeps=2 * default.substeps)
-    assert default.substeps == 3                                        # in contact; 1 away from the stops
-    assert np.abs(default.theta - finer.theta).max() < 1e-6             # measured 4.1e-7 rad
+    assert default.substeps == 1                                        # the shipped stops need no more
+    assert np.abs(default.theta - finer.theta).max() < 1e-6             # measured 1.0e-7 rad
 
 
 @pytest.fixture(scope="module")
@@ -210,7 +210,7 @@ def test_the_plant_is_phantom_forward_dynamics_with_friction_and_stops():
 
 
 @pytest.mark.parametrize("duration, rate, stiffness, argument", [
-    (1e300, 1e-300, None, "rate"), (2000.0, 0.001, None, "duration"), (0.1, 1000.0, 1e12, "duration")])
+    (1e300, 1e-300, None, "rate"), (5000.0, 0.001, None, "duration"), (0.1, 1000.0, 1e12, "duration")])
 def test_work_beyond_a_few_minutes_is_refused_at_once(duration, rate, stiffness, argument):
     """The bound counts RK4 steps (periods x substeps), not samples: a huge period or a
     stiff stop is refused within a second, naming the argument and the stiffest term."""

@@ -23,19 +23,22 @@ MAX_SAMPLES = 1_000_000
 #: Most RK4 steps one call may take (sample periods x substeps): about 4 minutes at the
 #: measured 60 microseconds per step with friction and stops (README, "Speed").
 MAX_STEPS = 4_000_000
-#: RK4 substep h is chosen so that h * LAMBDA <= STEP_SCALE, LAMBDA the fastest rate (1/s)
-#: of the plant's linearised stiff terms (see _substeps).
-STEP_SCALE = 0.25
+#: RK4 substep h (while a stop is engaged) is chosen so that h * OMEGA <= OSCILLATION_SCALE and
+#: h * RATE <= DAMPING_SCALE, OMEGA and RATE the fastest natural frequency (rad/s) and damping
+#: rate (1/s) of the plant's linearised stops (see _substeps). Measured (DEVELOPERS.md): a 0.5 s
+#: fall through the shipped stop within 1e-7 rad of 48 substeps at 1 substep; stiff undamped
+#: stops (1e3, 1e4 N m/rad) within 5e-7 rad of 8 times the substeps.
+OSCILLATION_SCALE, DAMPING_SCALE = 0.3, 0.7
 #: Longest RK4 step (s) whatever the stiff terms: the free rigid body integrated at 1 ms is
 #: within 3e-11 rad of a 0.1 ms integration over 0.15 s (tests/test_simulation.py).
 MAX_STEP = 1e-3
-#: A friction event (a joint reverses, stops or breaks away) is located by regula falsi
-#: (Illinois) on its slack, at most EVENT_ITERATIONS RK4 steps, to EVENT_TOLERANCE of the step.
+#: An event (a stop engages or releases; a joint reverses, stops or breaks away) is located by
+#: regula falsi (Illinois) on its function, at most EVENT_ITERATIONS RK4 steps, to
+#: EVENT_TOLERANCE (s).
 EVENT_ITERATIONS, EVENT_TOLERANCE = 8, 1e-9
-#: A step in which a stop engages or releases is halved this many times around the event,
-#: so that RK4 never steps across the stop force's kink and damping jump by more than
-#: h / 2**EVENT_BISECTIONS.
-EVENT_BISECTIONS = 12
+#: Most events located within one sample period (a bound on chattering: each costs a few RK4
+#: steps); beyond it a step is taken whole.
+MAX_EVENTS = 12
 
 Controller = Callable[[float, np.ndarray, np.ndarray], object]
 
@@ -94,22 +97,23 @@ def arguments(theta0: object, dtheta0: object, duration: object, rate: object, c
 
 
 def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool, hard_stops: bool) -> int:
-    """RK4 substeps per sample period: ceil(period * LAMBDA / STEP_SCALE), and at least
-    ceil(period / MAX_STEP).
+    """RK4 substeps per sample period while a stop is engaged: period * OMEGA / OSCILLATION_SCALE
+    and period * RATE / DAMPING_SCALE rounded up, and at least ceil(period / MAX_STEP).
 
-    LAMBDA (1/s) bounds the fastest linearised rates of the stiff terms on the smallest
-    joint inertia m (half the smallest eigenvalue of M(theta0), as M varies by about 15 %
-    across the stops): the stops' natural frequency sqrt(3 K / m) (a joint may touch its own
-    stop and the coupled one, stiffness matrix eigenvalue up to 3 K) and the damping rate
-    (3 B + viscous) / m. The Coulomb friction adds no stiffness: its stick phase is a mode of
+    OMEGA and RATE bound the stiff terms' linearised rates on the smallest joint inertia m (half
+    the smallest eigenvalue of M(theta0), as M varies by about 15 % across the stops): the
+    stops' natural frequency OMEGA = sqrt(3 K / m) (a joint may touch its own stop and the
+    coupled one, stiffness matrix eigenvalue up to 3 K) and the damping rate RATE = (3 B +
+    viscous) / m. The Coulomb friction adds no stiffness: its stick phase is a mode of
     the integration, not a steep force.
     """
     stops, law = device.config.limits.stops, device.config.actuation.friction
     inertia = 0.5 * float(np.linalg.eigvalsh(device.phantom.mass_matrix(theta0)).min())
     stiffness = 3 * stops.stiffness if hard_stops else 0.0
     damping = (3 * stops.damping if hard_stops else 0.0) + (law.viscous if friction else 0.0)
-    fastest = max(math.sqrt(stiffness / inertia), damping / inertia)
-    return max(1, math.ceil(period * fastest / STEP_SCALE), math.ceil(period / MAX_STEP * (1 - 1e-12)))
+    need = max(period * math.sqrt(stiffness / inertia) / OSCILLATION_SCALE,
+               period * damping / inertia / DAMPING_SCALE)
+    return max(1, math.ceil(need * (1 - 1e-12)), math.ceil(period / MAX_STEP * (1 - 1e-12)))
 
 
 def simulate(theta0: object, duration: float, controller: Controller | None = None, *,
@@ -135,9 +139,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     default; "continuous" or "peak" to choose; False: no clipping), as the MJCF's ctrlrange.
     Between samples: fixed-step RK4, one step per period (at most MAX_STEP) away from the stops
     and ``substeps`` per period while a stop is engaged (default from the stiffest term, see
-    _substeps: 3 at 1 kHz with the shipped numbers); a step in which a stop engages or
-    releases is bisected around the event (EVENT_BISECTIONS halvings), one that ends a
-    friction mode is cut at the event (regula falsi).
+    _substeps: 1 at 1 kHz with the shipped numbers); a step in which a stop engages or
+    releases, or a friction mode ends, is cut at the event (regula falsi, MAX_EVENTS per step).
 
     ``device``: the Device to simulate (default: the shipped one, built once). ``progress``:
     called with the share of the samples done (0..1), for a progress bar.
@@ -238,25 +241,38 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         return tuple(mode)
 
     def slack(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> list[float]:
-        """How far the mode holds at a state, per joint (> 0 while it does): a sliding joint's
-        rate along its direction (rad/s), a stuck joint's Coulomb torque less the torque that
-        holds it (N m)."""
+        """How far the friction mode holds at a state, per joint (> 0 while it does): a sliding
+        joint's rate along its direction (rad/s), a stuck joint's Coulomb torque less the torque
+        that holds it (N m); empty without friction."""
+        if not friction:
+            return []
         vs = v.tolist()
         held = iter(dynamics(q, v, tau, mode)[1] if not all(mode) else ())
         return [vs[i] * m if m else coulomb - abs(next(held)) for i, m in enumerate(mode)]
 
+    def margins(q: np.ndarray) -> list[float]:
+        """Each stop coordinate's distance inside its range (rad; < 0 while the stop is engaged);
+        empty without stops."""
+        if not hard_stops:
+            return []
+        qs = q.tolist()
+        out = []
+        for i, j, lo, hi in stops:
+            c = qs[i] if j is None else qs[i] - qs[j]
+            out.append(min(c - lo, hi - c))
+        return out
+
     def contacts(q: np.ndarray) -> list[bool]:
         """Which stops are engaged at q."""
-        qs = q.tolist()
-        return [not lo <= (qs[i] if j is None else qs[i] - qs[j]) <= hi for i, j, lo, hi in stops]
+        return [m < 0 for m in margins(q)]
 
     def advance(q: np.ndarray, v: np.ndarray, tau: list[float], h: float, depth: int) -> tuple:
-        """One RK4 step of h in the friction mode of the start. A step across a stop's boundary
-        is bisected (event location, EVENT_BISECTIONS halvings); a step that ends the friction
-        mode (a sliding joint reverses or stops, a stuck one breaks away) is cut where the
-        mode's slack, interpolated linearly, reaches zero: the reversing joint is set at rest
-        there, and the rest of the step starts in the mode of that state (mode_at decides
-        whether it sticks)."""
+        """One RK4 step of h in the friction mode of the start (EVENT_ITERATIONS and the module
+        doc). A step in which a stop engages or releases, or the friction mode ends (a sliding
+        joint reverses or stops, a stuck one breaks away), is cut at the first such event,
+        located by regula falsi (Illinois) on its function, just past it: a reversing joint is
+        set at rest there, and the rest of the step starts in the mode of that state (mode_at
+        decides whether it sticks). While a stop is engaged the step is at most contact_step."""
         mode = mode_at(q, v, tau)
         if friction and not any(mode):    # every joint stuck (v = 0, ddtheta = 0) for the held torque
             return q, v
@@ -266,39 +282,41 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             for _ in range(count):
                 q, v = advance(q, v, tau, h / count, depth)
             return q, v
-        if hard_stops and contacts(q) != contacts(q_end) and depth < EVENT_BISECTIONS:
-            q_mid, v_mid = advance(q, v, tau, 0.5 * h, depth + 1)
-            return advance(q_mid, v_mid, tau, 0.5 * h, depth + 1)
-        if not friction:
+        # event functions, oriented positive at the start: friction slacks, stop margins
+        stop_signs = [1.0 if m >= 0 else -1.0 for m in margins(q)]
+
+        def functions(q_: np.ndarray, v_: np.ndarray) -> list[float]:
+            return slack(q_, v_, tau, mode) + [m * sign for m, sign in zip(margins(q_), stop_signs)]
+
+        end = functions(q_end, v_end)
+        if not end or min(end) > 0 or depth >= MAX_EVENTS:
             return q_end, v_end
-        end = slack(q_end, v_end, tau, mode)
-        if min(end) > 0:
+        start = functions(q, v)
+        shares = [a / (a - b) if b <= 0 < a else (0.0 if b <= 0 and a > 0 else 1.0) for a, b in zip(start, end)]
+        first = min(range(len(shares)), key=shares.__getitem__)
+        share = shares[first]
+        if share >= 1.0:                # nothing crossed from inside (a function at 0 at the start)
             return q_end, v_end
-        start = slack(q, v, tau, mode)
-        shares = [a / (a - b) if b <= 0 < a else (0.0 if b <= 0 else 1.0) for a, b in zip(start, end)]
-        first = min(range(3), key=shares.__getitem__)
-        share = shares[first] if depth < EVENT_BISECTIONS else 1.0
         if share <= 0.0:                # the mode ended at the start already
             share, q_end, v_end = 0.0, q, v
-        elif share < 1.0:
-            # the Illinois variant of regula falsi on the first joint's slack, bracketed in
-            # [low, high] (slack > 0 at low, <= 0 at high); the step ends at high, just past the
-            # event, where the mode has ended (mode_at then releases or stops the joint)
+        else:
+            # the Illinois variant of regula falsi on that function, bracketed in [low, high]
+            # (> 0 at low, <= 0 at high); the step ends at high, just past the event
             low, high, at_low, at_high, side = 0.0, 1.0, start[first], end[first], 0
             for _ in range(EVENT_ITERATIONS):
                 q_try, v_try = rk4_step(lambda q_, v_: dynamics(q_, v_, tau, mode)[0], q, v, share * h)
-                value = slack(q_try, v_try, tau, mode)[first]
+                value = functions(q_try, v_try)[first]
                 if value > 0:
                     low, at_low = share, value
                     at_high, side = (at_high / 2 if side == 1 else at_high), 1
                 else:
                     high, at_high, q_end, v_end = share, value, q_try, v_try
                     at_low, side = (at_low / 2 if side == -1 else at_low), -1
-                if high - low <= EVENT_TOLERANCE:
+                if (high - low) * h <= EVENT_TOLERANCE:
                     break
                 share = low + (high - low) * at_low / (at_low - at_high)
             share = high
-        if mode[first]:                 # a sliding joint reversed or stopped there: at rest
+        if first < len(mode) and friction and mode[first]:     # a sliding joint reversed or stopped: at rest
             v_end = v_end.copy()
             v_end[first] = 0.0
         if share < 1.0:

@@ -106,12 +106,14 @@ def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: 
         value, gradient, curvature = 0.0, np.zeros(len(y)), np.zeros((len(y), len(y)))
         for basis, constant in blocks:
             j = constant + np.tensordot(y, basis, axes=1)
-            try:
+            try:                       # outside the domain (J not positive definite, to rounding)
                 root = np.linalg.cholesky(j)
+                inverse_basis = np.linalg.solve(j, basis)                  # J^-1 B_j, stacked
             except np.linalg.LinAlgError:
                 return None
+            if not np.isfinite(inverse_basis).all():
+                return None
             value -= 2 * np.log(np.diag(root)).sum()
-            inverse_basis = np.linalg.solve(j, basis)                      # J^-1 B_j, stacked
             gradient -= np.trace(inverse_basis, axis1=1, axis2=2)
             curvature += np.einsum("iab,jba->ij", inverse_basis, inverse_basis)
         if len(rows):
