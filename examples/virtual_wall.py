@@ -1,5 +1,6 @@
 """A virtual wall rendered at 1 kHz: force and penetration over time, and the highest
-stable wall stiffness against the sampling rate, compared with the passivity bound.
+stable wall stiffness against the sampling rate in both plants (phantom_pin.simulate and
+MuJoCo on the MJCF, phantom_pin.device.mujoco_plant), compared with the passivity bound.
 
 The wall is the floor y <= y_wall (frame s: y up) through the tip of the posture --posture.
 The controller (sampled at the rate, zero-order hold) renders F = K * depth along +y while
@@ -34,8 +35,20 @@ DURATION, SWEEP_DURATION, WINDOW = 0.5, 0.4, 0.1   # s: the plotted runs, the sw
 GRID = 250.0 * np.sqrt(2.0) ** np.arange(13)         # N/m, 250 .. 16000
 
 
-def wall_run(device: Device, posture: np.ndarray, stiffness: float, rate: float, duration: float):
-    """One run: (result, penetration (K,) m, wall force (K,) N, stable?)."""
+PLANTS = ("simulate", "mujoco")
+
+
+def run_plant(plant: str, start, duration, controller, rate, device):
+    """phantom_pin.simulate, or the same loop on the MJCF in MuJoCo (its step at most 1 / rate)."""
+    if plant == "simulate":
+        return simulate(start, duration, controller, rate=rate, device=device)
+    from phantom_pin.device.mujoco_plant import simulate_mujoco
+    return simulate_mujoco(start, duration, controller, rate=rate, device=device, timestep=min(1e-3, 1 / rate))
+
+
+def wall_run(device: Device, posture: np.ndarray, stiffness: float, rate: float, duration: float,
+             plant: str = "simulate"):
+    """One run in ``plant`` (PLANTS): (result, penetration (K,) m, wall force (K,) N, stable?)."""
     phantom = device.phantom
     surface = phantom.forward_kinematics(posture)[:3, 3]             # on the floor (m, frame s)
     start = phantom.inverse_kinematics(surface - (PUSH / stiffness + OFFSET) * NORMAL)
@@ -47,17 +60,18 @@ def wall_run(device: Device, posture: np.ndarray, stiffness: float, rate: float,
         jacobian = pose[:3, :3] @ phantom.body_jacobian(theta)[:3]  # Device.tip_jacobian, one fk fewer
         return phantom.gravity(theta) + jacobian.T @ (force * NORMAL)
 
-    result = simulate(start, duration, controller, rate=rate, device=device)
+    result = run_plant(plant, start, duration, controller, rate, device)
     depth = (surface - result.tip) @ NORMAL
     first, last = depth[result.t < WINDOW], depth[result.t > duration - WINDOW]
     return result, depth, stiffness * np.maximum(depth, 0.0), bool(np.ptp(last) <= 0.5 * np.ptp(first))
 
 
-def highest_stable(device: Device, posture: np.ndarray, rate: float) -> float:
-    """The last stiffness of GRID (N/m) before the first unstable one; 0 if GRID[0] is unstable."""
+def highest_stable(device: Device, posture: np.ndarray, rate: float, plant: str = "simulate") -> float:
+    """The last stiffness of GRID (N/m) before the first unstable one in ``plant``; 0 if GRID[0]
+    is unstable."""
     best = 0.0
     for stiffness in GRID:
-        if not wall_run(device, posture, stiffness, rate, SWEEP_DURATION)[3]:
+        if not wall_run(device, posture, stiffness, rate, SWEEP_DURATION, plant)[3]:
             break
         best = stiffness
     return best
@@ -71,6 +85,9 @@ def main(argv: list[str] | None = None) -> None:
                      help="the two walls plotted over time at 1 kHz (N/m)")
     cli.add_argument("--rates", type=float, nargs="+", default=[250.0, 500.0, 1000.0, 2000.0],
                      help="sampling rates of the stability sweep (Hz)")
+    cli.add_argument("--plants", nargs="+", choices=PLANTS, default=list(PLANTS),
+                     help="the simulators of the sweep: phantom_pin.simulate and MuJoCo on the MJCF (default both; "
+                          "MuJoCo needs the interop extra)")
     args = cli.parse_args(argv)
     if min(args.stiffness) <= 0 or min(args.rates) <= 0:
         raise PhantomPinError("--stiffness, --rates: expected positive numbers")
@@ -103,17 +120,21 @@ def main(argv: list[str] | None = None) -> None:
         axis.legend()
 
     rates = np.array(sorted(args.rates))
-    measured = np.array([highest_stable(device, posture, rate) for rate in rates])
-    sweep_axis.loglog(rates, measured, "o-", label="highest stable K (simulated)")
+    measured = {plant: np.array([highest_stable(device, posture, rate, plant) for rate in rates])
+                for plant in args.plants}
+    names = {"simulate": "phantom_pin.simulate", "mujoco": "MuJoCo"}
+    for (plant, values), style in zip(measured.items(), ("o-", "s--")):
+        sweep_axis.loglog(rates, values, style, label=f"highest stable K ({names[plant]})")
     sweep_axis.loglog(rates, 2 * damping * rates, "--", label="passivity bound 2 b / T, b = viscous")
     sweep_axis.set(xlabel="sampling rate [Hz]", ylabel="wall stiffness K [N/m]")
     sweep_axis.legend()
     figure.savefig(figure_path, dpi=120)
     print(f"wrote {figure_path}")
     print(f"tip damping along the normal: viscous b_n = {damping:.4g} N s/m; tip mass {tip_mass:.4f} kg")
-    for rate, k in zip(rates, measured):
-        print(f"rate {rate:g} Hz: highest stable K = {k:g} N/m; passivity bound {2 * damping * rate:.4g} "
-              f"N/m (viscous)")
+    for k, rate in enumerate(rates):
+        print(f"rate {rate:g} Hz: highest stable K = " + ", ".join(f"{values[k]:g} N/m ({plant})"
+                                                                   for plant, values in measured.items())
+              + f"; passivity bound {2 * damping * rate:.4g} N/m (viscous)")
 
 
 if __name__ == "__main__":

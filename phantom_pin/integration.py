@@ -10,12 +10,26 @@ import numpy as np
 def rk4_step(acceleration: Callable[[np.ndarray, np.ndarray], np.ndarray], q: np.ndarray, v: np.ndarray,
              h: float) -> tuple[np.ndarray, np.ndarray]:
     """(q, v) after one classical RK4 step of h (s) of q'' = acceleration(q, v) (positions
-    in rad, rates in rad/s, accelerations in rad/s^2); the inputs are not changed."""
-    a1 = acceleration(q, v)
-    q2, v2 = q + 0.5 * h * v, v + 0.5 * h * a1
-    a2 = acceleration(q2, v2)
-    q3, v3 = q + 0.5 * h * v2, v + 0.5 * h * a2
-    a3 = acceleration(q3, v3)
-    q4, v4 = q + h * v3, v + h * a3
-    a4 = acceleration(q4, v4)
-    return q + h / 6 * (v + 2 * v2 + 2 * v3 + v4), v + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+    in rad, rates in rad/s, accelerations in rad/s^2); the inputs are not changed. The stages'
+    arithmetic runs on Python floats (for the 3-vectors of the arm, NumPy's per-operation cost
+    exceeded the acceleration's; benchmarks/bench_plants.py); ``acceleration`` gets arrays and
+    returns an array or a sequence of floats."""
+    half, sixth = 0.5 * h, h / 6.0
+    qs, vs = q.tolist(), v.tolist()
+    a1 = _floats(acceleration(q, v))
+    q2 = [x + half * y for x, y in zip(qs, vs)]
+    v2 = [x + half * y for x, y in zip(vs, a1)]
+    a2 = _floats(acceleration(np.array(q2), np.array(v2)))
+    q3 = [x + half * y for x, y in zip(qs, v2)]
+    v3 = [x + half * y for x, y in zip(vs, a2)]
+    a3 = _floats(acceleration(np.array(q3), np.array(v3)))
+    q4 = [x + h * y for x, y in zip(qs, v3)]
+    v4 = [x + h * y for x, y in zip(vs, a3)]
+    a4 = _floats(acceleration(np.array(q4), np.array(v4)))
+    return (np.array([x + sixth * (b + 2 * c + 2 * d + e) for x, b, c, d, e in zip(qs, vs, v2, v3, v4)]),
+            np.array([x + sixth * (b + 2 * c + 2 * d + e) for x, b, c, d, e in zip(vs, a1, a2, a3, a4)]))
+
+
+def _floats(values: object) -> list[float] | tuple[float, ...]:
+    """An acceleration as Python floats (an array's tolist, or the sequence itself)."""
+    return values.tolist() if isinstance(values, np.ndarray) else values

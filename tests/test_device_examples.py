@@ -39,8 +39,12 @@ def test_virtual_wall_settles_by_hookes_law_and_beats_the_passivity_bound(tmp_pa
     (settled, hooke), = numbers(r"K = 1000 N/m: stable; last 0.1 s: penetration (\S+) mm \(F/K = (\S+) mm\)", out)
     assert hooke == 1.0 and abs(settled - hooke) < 0.02                   # mm (measured 0.996)
     assert "K = 2000 N/m: unstable" in out
-    sweep = numbers(r"rate (\S+) Hz: highest stable K = (\S+) N/m; passivity bound (\S+) N/m \(viscous\)", out)
-    assert [rate for rate, _, _ in sweep] == [500, 1000]
+    sweep = numbers(r"rate (\S+) Hz: highest stable K = (\S+) N/m \(simulate\), (\S+) N/m \(mujoco\); "
+                    r"passivity bound (\S+) N/m \(viscous\)", out)
+    assert [rate for rate, _, _, _ in sweep] == [500, 1000]
+    # the two plants' maps agree (measured: equal on the grid at 250-2000 Hz)
+    assert all(ours == mujoco for _, ours, mujoco, _ in sweep)
+    sweep = [(rate, ours, bound) for rate, ours, _, bound in sweep]
     # passivity is sufficient: every passive wall is stable, so the measured limit is above it
     assert all(measured > bound for _, measured, bound in sweep)
     assert sweep[1][1] > sweep[0][1]                                      # faster sampling, stiffer wall

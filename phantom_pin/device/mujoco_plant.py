@@ -12,18 +12,20 @@ import math
 import numpy as np
 
 from phantom_pin.device.device import Device
-from phantom_pin.device.simulation import MAX_SAMPLES, Controller, SimulationResult, _checked, arguments
+from phantom_pin.device.simulation import MAX_SAMPLES, Controller, SimulationResult, _checked, _positive, arguments
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 
 
 def simulate_mujoco(theta0: object, duration: float, controller: Controller | None = None, *,
-                    dtheta0: object = None, rate: float = 1000.0, device: Device | None = None) -> SimulationResult:
+                    dtheta0: object = None, rate: float = 1000.0, device: Device | None = None,
+                    timestep: float | None = None) -> SimulationResult:
     """Run ``controller(t, theta, dtheta) -> tau`` (s, rad, rad/s -> N m at the joints) against
     the MuJoCo model of ``device`` (default: the shipped one) from ``theta0`` (rad; at rest, or
     ``dtheta0`` rad/s), at ``rate`` Hz with a zero-order hold, for ``duration`` s. The command
     goes to the MJCF's motors as ctrl = tau / gear; MuJoCo clips it at their ctrlrange
     (actuation.yaml's saturation policy, as simulate). MuJoCo steps the MJCF's timestep
-    (config/mjcf.yaml), 1 / (rate x timestep) steps per sample, which must be a whole number.
+    (config/mjcf.yaml), or ``timestep`` (s), 1 / (rate x timestep) steps per sample, which must be
+    a whole number.
     The result's theta and dtheta are MuJoCo's joint1..3; ``tau`` the applied torques."""
     try:
         import mujoco
@@ -33,11 +35,13 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     theta, velocity, duration, rate, device = arguments(theta0, dtheta0, duration, rate, controller, device)
     description = device.phantom.description
     model = mujoco.MjModel.from_xml_string(description.mjcf)
+    if timestep is not None:
+        model.opt.timestep = _positive(timestep, "timestep")
     data = mujoco.MjData(model)
     steps = 1.0 / (rate * model.opt.timestep)
     if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-        raise InvalidInputError(f"rate: {rate:g} Hz is not the MJCF's 1 / timestep ({1 / model.opt.timestep:g} Hz) "
-                                "divided by a whole number")
+        raise InvalidInputError(f"rate: {rate:g} Hz is not 1 / timestep ({1 / model.opt.timestep:g} Hz) divided by a "
+                                "whole number; pass timestep")
     steps = int(round(steps))
     samples = math.floor(duration * rate * (1 + 1e-12)) + 1
     if not 2 <= samples <= MAX_SAMPLES:

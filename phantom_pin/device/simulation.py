@@ -186,7 +186,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     data = model.createData()
     policy = device.config.actuation.saturation if saturation is True else saturation
     actuation = device.config.actuation
-    peak = np.array(actuation.peak if policy == "peak" else actuation.effort)       # N m, the clip
+    peak_list = list(actuation.peak if policy == "peak" else actuation.effort)       # N m, the clip
     bounds = list(zip(device._stop_lower.tolist(), device._stop_upper.tolist()))
     stop_force = device.config.limits.stops.force
     law = device.config.actuation.friction
@@ -195,6 +195,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     # Stop coordinates c = theta1, theta2, theta3, theta2 - theta3 with their gradients
     # dc/dtheta (the rows of STOP_COORDINATES): Device.stop_torque, in scalars for speed.
     stops = [(0, None, *bounds[0]), (1, None, *bounds[1]), (2, None, *bounds[2]), (1, 2, *bounds[3])]
+    (lo0, hi0), (lo1, hi1), (lo2, hi2), (lo3, hi3) = bounds
 
     def dynamics(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> tuple:
         """(ddtheta, friction holding each stuck joint) in the friction ``mode`` (per joint +1 or
@@ -202,26 +203,35 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         whatever torque that takes). M^-1 (tau - friction + stops - C dtheta - N):
         Phantom.forward_dynamics plus Device.friction and Device.stop_torque, without their
         per-call checks."""
-        qs, vs, total = q.tolist(), v.tolist(), list(tau)
+        # unrolled: this runs four times per RK4 step (Python's cost dominates Pinocchio's here)
+        q0, q1, q2 = q.tolist()
+        v0, v1, v2 = v.tolist()
+        t0, t1, t2 = tau
         if friction:
-            total = [total[i] - viscous * vs[i] - coulomb * mode[i] for i in range(3)]
+            m0, m1, m2 = mode
+            t0 -= viscous * v0 + coulomb * m0
+            t1 -= viscous * v1 + coulomb * m1
+            t2 -= viscous * v2 + coulomb * m2
         if hard_stops:
-            for i, j, lo, hi in stops:
-                c, rate = (qs[i], vs[i]) if j is None else (qs[i] - qs[j], vs[i] - vs[j])
-                depth = c - hi if c > hi else c - lo if c < lo else 0.0
-                if depth:
-                    force = stop_force(depth, rate)
-                    total[i] -= force
-                    if j is not None:
-                        total[j] += force
-        bias = pin.nonLinearEffects(model, data, q, v).tolist()
-        rhs = (total[0] - bias[0], total[1] - bias[1], total[2] - bias[2])
+            if not lo0 <= q0 <= hi0:
+                t0 -= stop_force(q0 - (hi0 if q0 > hi0 else lo0), v0)
+            if not lo1 <= q1 <= hi1:
+                t1 -= stop_force(q1 - (hi1 if q1 > hi1 else lo1), v1)
+            if not lo2 <= q2 <= hi2:
+                t2 -= stop_force(q2 - (hi2 if q2 > hi2 else lo2), v2)
+            c = q1 - q2
+            if not lo3 <= c <= hi3:
+                force = stop_force(c - (hi3 if c > hi3 else lo3), v1 - v2)
+                t1 -= force
+                t2 += force
+        b0, b1, b2 = pin.nonLinearEffects(model, data, q, v).tolist()
+        rhs = (t0 - b0, t1 - b1, t2 - b2)
         mass = pin.crba(model, data, q).tolist()
         if not friction or all(mode):
             solution = solve_spd(mass, rhs)
             if solution is None:  # M(theta) includes the rotors: positive definite at every finite theta
                 raise _Diverged
-            return np.array(solution), ()
+            return solution, ()
         return _constrained(mass, rhs, mode)
 
     def mode_at(q: np.ndarray, v: np.ndarray, tau: list[float]) -> tuple:
@@ -277,21 +287,23 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         if friction and not any(mode):    # every joint stuck (v = 0, ddtheta = 0) for the held torque
             return q, v
         q_end, v_end = rk4_step(lambda q_, v_: dynamics(q_, v_, tau, mode)[0], q, v, h)
-        if hard_stops and h > contact_step * (1 + 1e-9) and (any(contacts(q)) or any(contacts(q_end))):
+        start_margins, end_margins = margins(q), margins(q_end)
+        if hard_stops and h > contact_step * (1 + 1e-9) and min(start_margins + end_margins) < 0:
             count = math.ceil(h / contact_step * (1 - 1e-12))    # a stop engaged: its substeps
             for _ in range(count):
                 q, v = advance(q, v, tau, h / count, depth)
             return q, v
         # event functions, oriented positive at the start: friction slacks, stop margins
-        stop_signs = [1.0 if m >= 0 else -1.0 for m in margins(q)]
+        stop_signs = [1.0 if m >= 0 else -1.0 for m in start_margins]
 
-        def functions(q_: np.ndarray, v_: np.ndarray) -> list[float]:
-            return slack(q_, v_, tau, mode) + [m * sign for m, sign in zip(margins(q_), stop_signs)]
+        def functions(q_: np.ndarray, v_: np.ndarray, known: list[float] | None = None) -> list[float]:
+            stop_part = margins(q_) if known is None else known
+            return slack(q_, v_, tau, mode) + [m * sign for m, sign in zip(stop_part, stop_signs)]
 
-        end = functions(q_end, v_end)
+        end = functions(q_end, v_end, end_margins)
         if not end or min(end) > 0 or depth >= MAX_EVENTS:
             return q_end, v_end
-        start = functions(q, v)
+        start = functions(q, v, start_margins)
         shares = [a / (a - b) if b <= 0 < a else (0.0 if b <= 0 and a > 0 else 1.0) for a, b in zip(start, end)]
         first = min(range(len(shares)), key=shares.__getitem__)
         share = shares[first]
@@ -329,14 +341,13 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         previous = np.rint((theta - velocity * period) * counts_per_radian) / counts_per_radian
     out_theta, out_dtheta = np.empty((samples, 3)), np.empty((samples, 3))
     commanded, applied = np.zeros((samples, 3)), np.zeros((samples, 3))
-    zero = np.zeros(3)
     for k in range(samples):
         if progress is not None:
             progress(k / samples)
         out_theta[k], out_dtheta[k] = theta, velocity
         t = k / rate  # as result.t: 9 / 1000 is 0.009, 9 * 0.001 is 0.009000000000000001
         if controller is None:
-            tau = zero
+            tau = [0.0, 0.0, 0.0]
         else:
             if quantization:
                 measured = np.rint(theta * counts_per_radian) / counts_per_radian
@@ -346,10 +357,10 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                 seen, seen_rate = theta.copy(), velocity.copy()
             tau = _checked(controller(t, seen, seen_rate), t)
             commanded[k] = tau
-            if saturation:
-                tau = np.clip(tau, -peak, peak)
+            tau = tau.tolist()
+            if saturation:              # the clip, in floats (np.clip costs more than the plant's step)
+                tau = [-p if x < -p else p if x > p else x for x, p in zip(tau, peak_list)]
             applied[k] = tau
-        tau = tau.tolist()
         if k == samples - 1:
             break
         # the stiff stops need their substeps only while engaged (advance); elsewhere
@@ -373,7 +384,7 @@ class _Diverged(Exception):
     """The integrated state left the finite numbers (inside simulate)."""
 
 
-def _constrained(mass: list[list[float]], rhs: tuple, mode: tuple) -> tuple[np.ndarray, list[float]]:
+def _constrained(mass: list[list[float]], rhs: tuple, mode: tuple) -> tuple[list[float], list[float]]:
     """(ddtheta, the torques holding the stuck joints) of M ddtheta = rhs + f with ddtheta_i = 0
     and f_i free where mode[i] == 0 (stuck), f_i = 0 elsewhere: M_LL a_L = rhs_L, f_S = M_SL a_L -
     rhs_S. ``mass`` is the 3x3 M (nested lists)."""
@@ -390,7 +401,7 @@ def _constrained(mass: list[list[float]], rhs: tuple, mode: tuple) -> tuple[np.n
         a[i] = (m22 * rhs[i] - m12 * rhs[j]) / det
         a[j] = (m11 * rhs[j] - m12 * rhs[i]) / det
     held = [sum(mass[min(s, k)][max(s, k)] * a[k] for k in free) - rhs[s] for s in stuck]
-    return np.array(a), held
+    return a, held
 
 
 def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool) -> str:
