@@ -234,6 +234,16 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             return solution, ()
         return _constrained(mass, rhs, mode)
 
+    last: list = [None, None]          # the last (key, result) of held(): a step's end is the next one's start
+
+    def held(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> list[float]:
+        """The torques holding the stuck joints of ``mode`` at a state (dynamics' second part),
+        the last one remembered: the end of a step is where the next one starts."""
+        key = (q.tobytes(), v.tobytes(), tuple(tau), mode)
+        if last[0] != key:
+            last[0], last[1] = key, dynamics(q, v, tau, mode)[1]
+        return last[1]
+
     def mode_at(q: np.ndarray, v: np.ndarray, tau: list[float]) -> tuple:
         """The friction mode at a state: a moving joint slides; a joint at rest sticks if the
         torque that holds it is within the Coulomb torque, else it breaks away in the
@@ -242,12 +252,12 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             return (1, 1, 1)
         mode = [1 if x > 0 else -1 if x < 0 else 0 for x in v.tolist()]
         while 0 in mode:
-            _, held = dynamics(q, v, tau, tuple(mode))
+            holding = held(q, v, tau, tuple(mode))
             stuck = [i for i in range(3) if mode[i] == 0]
-            worst = max(range(len(stuck)), key=lambda k: abs(held[k]))
-            if abs(held[worst]) < coulomb:        # at the Coulomb torque it breaks away
+            worst = max(range(len(stuck)), key=lambda k: abs(holding[k]))
+            if abs(holding[worst]) < coulomb:        # at the Coulomb torque it breaks away
                 break
-            mode[stuck[worst]] = -1 if held[worst] > 0 else 1
+            mode[stuck[worst]] = -1 if holding[worst] > 0 else 1
         return tuple(mode)
 
     def slack(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> list[float]:
@@ -257,8 +267,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         if not friction:
             return []
         vs = v.tolist()
-        held = iter(dynamics(q, v, tau, mode)[1] if not all(mode) else ())
-        return [vs[i] * m if m else coulomb - abs(next(held)) for i, m in enumerate(mode)]
+        holding = iter(held(q, v, tau, mode) if not all(mode) else ())
+        return [vs[i] * m if m else coulomb - abs(next(holding)) for i, m in enumerate(mode)]
 
     def margins(q: np.ndarray) -> list[float]:
         """Each stop coordinate's distance inside its range (rad; < 0 while the stop is engaged);
@@ -369,7 +379,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         try:
             for _ in range(count):
                 theta, velocity = advance(theta, velocity, tau, period / count, 0)
-            if not (np.isfinite(theta).all() and np.isfinite(velocity).all()):
+            if not math.isfinite(sum(theta.tolist()) + sum(velocity.tolist())):   # NaN or inf anywhere
                 raise _Diverged
         except _Diverged:
             raise InvalidInputError(_divergence(t, out_dtheta[0], applied[:k + 1], saturation)) from None
@@ -424,7 +434,7 @@ def _checked(tau: object, t: float) -> np.ndarray:
         array = None if np.iscomplexobj(tau) else np.array(tau, dtype=float)
     except (TypeError, ValueError):
         array = None
-    if array is None or array.shape != (3,) or not np.isfinite(array).all():
+    if array is None or array.shape != (3,) or not math.isfinite(sum(array.tolist())):
         raise InvalidInputError(f"controller: returned {tau!r} at t = {t:.6g} s; "
                                 f"expected three finite joint torques (N m), shape (3,)")
     return array
