@@ -99,7 +99,10 @@ def _info(args: argparse.Namespace, phantom: Phantom) -> int:
               f"{_vector(lk['inertia'], '{:.3e}')}" for lk in links]
     lines += ["", "rotor inertia: not public (no armature; the links carry the rotors)" if actuation.motor is None
               else f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
-    lines.insert(0, f"model {phantom.config.name}")
+    given = getattr(args, "overrides", None) or {}
+    data["overrides"] = len(given)
+    lines.insert(0, f"model {phantom.config.name}" + (f", with {len(given)} overridden number(s) (--params/--set)"
+                                                       if given else ""))
     data["device"], device_lines = device_cli.info(phantom)  # stops, friction, motor, encoder
     lines += ["", *device_lines]
     _print(args, data, "\n".join(lines))

@@ -390,3 +390,20 @@ def test_every_command_takes_the_overrides(capsys, tmp_path):
     assert code == 0 and "all checks pass" in out
     code, _, err = run(capsys, "dynamics", "--theta", "0", "0", "0", "--set", "foo=1")
     assert code == 2 and err.count("\n") == 1 and "foo" in err
+
+
+def test_info_says_when_overrides_apply(tmp_path, capsys):
+    """A review found `info --params id.yaml` printing `model premium_1_5` as for the shipped
+    model: the first line counts the overridden numbers (JSON: ``overrides``), and the joints'
+    numbers are the overlay's."""
+    from phantom_pin.cli import main
+
+    overlay = tmp_path / "id.yaml"
+    overlay.write_text("l1: 0.2\nactuation.friction.coulomb: 0.02\n")
+    assert main(["info", "--params", str(overlay)]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == "model premium_1_5, with 2 overridden number(s) (--params/--set)"
+    assert main(["info", "--params", str(overlay), "--set", "l2=0.21", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["overrides"] == 3 and data["device"]["friction"]["coulomb"] == 0.02
+    assert main(["info", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["overrides"] == 0
