@@ -122,12 +122,17 @@ class Actuation:
     peak: tuple[float, float, float]
     saturation: str = "continuous"
 
+    def limit(self, policy: str) -> tuple[float, float, float]:
+        """Each joint's torque limit (N m) of a saturation ``policy`` (SATURATIONS): "continuous",
+        the motors' rating (``effort``), or "peak", their stall torque (``peak``)."""
+        return self.effort if policy == "continuous" else self.peak
+
     @property
     def saturation_torque(self) -> tuple[float, float, float]:
-        """Where the simulators clip a commanded joint torque (N m), by ``saturation`` (SATURATIONS):
-        "continuous", the motors' rating (``effort``, the default), or "peak", their stall torque
-        (``peak``); the same in phantom_pin.simulate and the MJCF's ctrlrange and forcerange."""
-        return self.effort if self.saturation == "continuous" else self.peak
+        """Where the simulators clip a commanded joint torque (N m): ``limit`` of ``saturation``
+        (the default "continuous"), the same in phantom_pin.simulate and the MJCF's ctrlrange and
+        forcerange."""
+        return self.limit(self.saturation)
 
     @property
     def rotor(self) -> tuple[float, tuple[float, float, float]]:

@@ -210,10 +210,10 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     motor = config.actuation.motor
     for index, (name, transmission) in enumerate(transmissions.items()):
         ratio = float(transmission.find("actuator/mechanicalReduction").text)
-        # the saturation policy's torque at the motor shaft (the joint's without motor data: gear 1)
-        torque = config.actuation.saturation_torque[index] / (1.0 if motor is None else ratio)
-        if motor is not None:           # the data sheet's number itself, not a quotient's rounding
-            torque = motor.max_continuous_torque if config.actuation.saturation == "continuous" else motor.stall_torque
+        # the saturation policy's torque at the motor shaft: the data sheet's number itself (not a
+        # quotient's rounding), or the joint's without motor data (gear 1)
+        torque = config.actuation.saturation_torque[index] if motor is None else \
+            motor.max_continuous_torque if config.actuation.saturation == "continuous" else motor.stall_torque
         ET.SubElement(actuator, "motor", {"name": transmission.find("actuator").get("name"),
                                           "joint": name, "gear": _num(ratio),
                                           "ctrlrange": _vec([-torque, torque]),

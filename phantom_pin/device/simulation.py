@@ -184,9 +184,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
 
     model = device.phantom.model
     data = model.createData()
-    policy = device.config.actuation.saturation if saturation is True else saturation
     actuation = device.config.actuation
-    peak_list = list(actuation.peak if policy == "peak" else actuation.effort)       # N m, the clip
+    peak_list = list(actuation.limit(actuation.saturation if saturation is True else saturation))  # N m, the clip
     bounds = list(zip(device._stop_lower.tolist(), device._stop_upper.tolist()))
     stop_force = device.config.limits.stops.force
     law = device.config.actuation.friction
@@ -281,10 +280,6 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             c = qs[i] if j is None else qs[i] - qs[j]
             out.append(min(c - lo, hi - c))
         return out
-
-    def contacts(q: np.ndarray) -> list[bool]:
-        """Which stops are engaged at q."""
-        return [m < 0 for m in margins(q)]
 
     def advance(q: np.ndarray, v: np.ndarray, tau: list[float], h: float, depth: int) -> tuple:
         """One RK4 step of h in the friction mode of the start (EVENT_ITERATIONS and the module

@@ -34,7 +34,7 @@ from phantom_pin.config import Friction
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log, LogError
-from phantom_pin.identification.structures import STRUCTURES, Structure
+from phantom_pin.identification.structures import STRUCTURES, Structure, friction_block
 
 #: Fewest periods of the cutoff the log must span (the filter's transients and edges).
 MIN_CYCLES = 10.0
@@ -168,7 +168,7 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Sa
     edge = int(np.ceil(EDGE * rate))
     step = max(1, int(rate / (5 * cutoff)))
     keep = slice(edge, len(log.t) - edge, step)
-    friction = columns[keep][:, None, :] * np.tile(np.eye(3), 2)          # (N, 3, 6): diagonal blocks
+    friction = friction_block(columns[keep])
     span = max(1, int(round(rate / cutoff)))
     slow = scipy.ndimage.maximum_filter1d((np.abs(dtheta) < MIN_SPEED).astype(np.uint8), 2 * span + 1, axis=0)
     return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau[keep], friction, ~slow[keep].astype(bool))

@@ -113,7 +113,7 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
     numbers, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
     called with the share of the SLSQP iterations done. ``model``: the Phantom (or its
     Description, then loaded once more into Pinocchio) whose configuration is excited."""
-    from phantom_pin.identification.structures import General, Report
+    from phantom_pin.identification.structures import General, Report, friction_block
 
     _check_arguments(period=period, harmonics=harmonics, samples=samples, margin=margin, torque_share=torque_share,
                      restarts=restarts, iterations=iterations, seed=seed, amplitude_weight=amplitude_weight)
@@ -145,8 +145,7 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
             memo.clear()
             states = Fourier.from_free(free, harmonics, period)(at)
             rates = states[1]
-            smooth = None if exact else (np.concatenate([rates, np.tanh(rates / SMOOTH_SPEED)], axis=-1)[:, None, :]
-                                         * np.tile(np.eye(3), 2))
+            smooth = None if exact else friction_block(np.concatenate([rates, np.tanh(rates / SMOOTH_SPEED)], axis=-1))
             phi, tau0 = general.regressor_of(*states, smooth)
             memo[key] = states, phi.reshape(-1, len(beta)), phi @ beta + tau0
         return memo[key]

@@ -60,10 +60,6 @@ class Structure:
     def motor(self) -> bool:
         return self.config.actuation.motor is not None
 
-    def friction_columns(self, dtheta: object) -> np.ndarray:
-        """The regressor's friction columns (..., 3, 6) at rates ``dtheta`` (rad/s), unfiltered."""
-        return self.regressor(np.zeros_like(dtheta), dtheta, np.zeros_like(dtheta))[..., self.regressor.friction]
-
     def nearest(self, target: np.ndarray, weights: np.ndarray, prior_weight: float) -> np.ndarray:
         """physical.nearest: the consistent x whose base parameters are nearest to ``target`` in
         the metric W^T W (``weights``: the inverse covariance's root)."""
@@ -212,6 +208,12 @@ class Report(Structure):
 
 
 STRUCTURES = {"general": General, "report": Report}
+
+
+def friction_block(columns: np.ndarray) -> np.ndarray:
+    """The friction columns (N, 3, 6) that ``regressor_of`` takes, from per-sample values (N, 6):
+    viscous1..3 then coulomb1..3, each on its own joint's row (diagonal blocks)."""
+    return np.asarray(columns)[:, None, :] * np.tile(np.eye(3), 2)
 
 
 def _unit(name: str) -> str:
