@@ -34,3 +34,20 @@ def test_motor_offsets_are_from_the_shoulder_in_the_urdf_and_in_the_yaml_comment
         assert [motor[key] if a == axis else 0.0 for a in range(3)] in origins
         comment = re.search(rf"{key}:[^#]*#(.*)", text).group(1)
         assert "from the shoulder" in comment and "centre of mass" not in comment, comment
+
+
+def test_simulation_doc_quotes_the_shipped_friction_and_stops():
+    """docs/simulation.md argues from the Premium 1.5's numbers; they must be the YAML's: the
+    friction levels, the stop model, and the LuGre bristle stiffness below which presliding
+    (Fc / sigma0) exceeds one encoder count of joint 1 (2 pi / (1024 * 4 * ratio))."""
+    from phantom_pin import Device
+
+    text = " ".join((ROOT / "docs" / "simulation.md").read_text().split())   # lines joined
+    device = Device()
+    friction, stops = device.config.actuation.friction, device.config.limits.stops
+    assert f"viscous {friction.viscous:g} N m s/rad, Coulomb {friction.coulomb:g} N m" in text
+    assert f"K = {stops.stiffness:g} N m/rad, B = {stops.damping:g} N m s/rad" in text
+    count = device.encoder_resolution[0]
+    quoted = re.search(r"\(([0-9.e-]+) rad at joint 1\) unless σ0 < (\d+) N m/rad", text)
+    assert abs(float(quoted[1]) / count - 1) < 5e-3                      # rounded to 3 digits
+    assert int(quoted[2]) == round(friction.coulomb / count)

@@ -30,16 +30,20 @@ def _stacked(result):
     return np.stack(result) if isinstance(result, tuple) else result
 
 
-def test_crba_binding_returns_the_full_symmetric_matrix(phantom, states):
-    """Phantom.mass_matrix returns pin.crba's result as it is: the binding fills the lower
+@pytest.mark.parametrize("convention", ["default", "WORLD"])
+def test_crba_binding_returns_the_full_symmetric_matrix(phantom, states, convention):
+    """Phantom.mass_matrix returns pin.crba's result as it is, and simulate's plant reads crba in
+    the WORLD convention (the faster one, DEVELOPERS.md) as it is: the binding fills the lower
     triangle (data.M holds only the upper one). Bit-identical to the symmetrised matrix over
-    every state; a Pinocchio returning the upper triangle alone fails here (and against
-    closed_form in test_model.py)."""
+    every state and within 1e-13 of the closed form (eqs 81-85); a Pinocchio returning the
+    upper triangle alone fails here (and against closed_form in test_model.py)."""
     data = phantom.model.createData()
+    extra = () if convention == "default" else (pin.Convention.WORLD,)
     for theta in states[0]:
-        m = pin.crba(phantom.model, data, theta)
+        m = pin.crba(phantom.model, data, theta, *extra)
         assert m[1, 2] != 0
         np.testing.assert_array_equal(m, np.triu(m) + np.triu(m, 1).T)
+        assert relative_error(m, cf.mass_matrix(theta, REPORT)) < 1e-13
 
 
 @pytest.mark.parametrize("method, count", METHODS)

@@ -3,8 +3,10 @@ hold, driving the plant rigid body + rotors + friction + hard stops + torque sat
 
 from __future__ import annotations
 
+import array
 import dataclasses
 import functools
+import itertools
 import math
 from typing import Callable
 
@@ -21,8 +23,8 @@ from phantom_pin.validation import as_state
 #: Most samples one call may produce (duration * rate + 1).
 MAX_SAMPLES = 1_000_000
 #: Most RK4 steps one call may take (sample periods x substeps): about 4 minutes at the
-#: measured 60 microseconds per step with friction and stops (README, "Speed").
-MAX_STEPS = 4_000_000
+#: measured 30 microseconds per step with friction and stops (DEVELOPERS.md).
+MAX_STEPS = 8_000_000
 #: RK4 substep h (while a stop is engaged) is chosen so that h * OMEGA <= OSCILLATION_SCALE and
 #: h * RATE <= DAMPING_SCALE, OMEGA and RATE the fastest natural frequency (rad/s) and damping
 #: rate (1/s) of the plant's linearised stops (see _substeps). Measured (DEVELOPERS.md): a 0.5 s
@@ -193,18 +195,19 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
 
     # Stop coordinates c = theta1, theta2, theta3, theta2 - theta3 with their gradients
     # dc/dtheta (the rows of STOP_COORDINATES): Device.stop_torque, in scalars for speed.
-    stops = [(0, None, *bounds[0]), (1, None, *bounds[1]), (2, None, *bounds[2]), (1, 2, *bounds[3])]
     (lo0, hi0), (lo1, hi1), (lo2, hi2), (lo3, hi3) = bounds
+    position, rate_vector = np.zeros(3), np.zeros(3)      # Pinocchio's inputs, filled in place
 
-    def dynamics(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> tuple:
-        """(ddtheta, friction holding each stuck joint) in the friction ``mode`` (per joint +1 or
-        -1: sliding that way, Coulomb friction against it; 0: stuck, ddtheta = 0, held by
-        whatever torque that takes). M^-1 (tau - friction + stops - C dtheta - N):
-        Phantom.forward_dynamics plus Device.friction and Device.stop_torque, without their
-        per-call checks."""
-        # unrolled: this runs four times per RK4 step (Python's cost dominates Pinocchio's here)
-        q0, q1, q2 = q.tolist()
-        v0, v1, v2 = v.tolist()
+    def dynamics(q: list[float], v: list[float], tau: list[float], mode: tuple, holding: bool = False):
+        """ddtheta (rad/s^2) in the friction ``mode`` (per joint +1 or -1: sliding that way,
+        Coulomb friction against it; 0: stuck, ddtheta = 0, held by whatever torque that takes);
+        with ``holding``, (ddtheta, the friction torque holding each stuck joint, N m).
+        M^-1 (tau - friction + stops - C dtheta - N): Phantom.forward_dynamics plus
+        Device.friction and Device.stop_torque, without their per-call checks."""
+        # unrolled on Python floats: this runs four times per RK4 step, and Python's cost per
+        # operation is what remains beside Pinocchio's (benchmarks/bench_plants.py)
+        q0, q1, q2 = q
+        v0, v1, v2 = v
         t0, t1, t2 = tau
         if friction:
             m0, m1, m2 = mode
@@ -223,33 +226,38 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                 force = stop_force(c - (hi3 if c > hi3 else lo3), v1 - v2)
                 t1 -= force
                 t2 += force
-        b0, b1, b2 = pin.nonLinearEffects(model, data, q, v).tolist()
+        position[0], position[1], position[2] = q0, q1, q2
+        rate_vector[0], rate_vector[1], rate_vector[2] = v0, v1, v2
+        b0, b1, b2 = pin.nonLinearEffects(model, data, position, rate_vector).tolist()
         rhs = (t0 - b0, t1 - b1, t2 - b2)
-        mass = pin.crba(model, data, q).tolist()
+        mass = pin.crba(model, data, position, pin.Convention.WORLD).tolist()    # DEVELOPERS.md
         if not friction or all(mode):
             solution = solve_spd(mass, rhs)
             if solution is None:  # M(theta) includes the rotors: positive definite at every finite theta
                 raise _Diverged
-            return solution, ()
-        return _constrained(mass, rhs, mode)
+            return (solution, ()) if holding else solution
+        return _constrained(mass, rhs, mode, holding)
 
-    last: list = [None, None]          # the last (key, result) of held(): a step's end is the next one's start
+    last: list = [None, None, None, None, None]   # held()'s last (q, v, tau, mode, result)
 
-    def held(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> list[float]:
+    def held(q: list[float], v: list[float], tau: list[float], mode: tuple) -> list[float]:
         """The torques holding the stuck joints of ``mode`` at a state (dynamics' second part),
-        the last one remembered: the end of a step is where the next one starts."""
-        key = (q.tobytes(), v.tobytes(), tuple(tau), mode)
-        if last[0] != key:
-            last[0], last[1] = key, dynamics(q, v, tau, mode)[1]
-        return last[1]
+        the last one remembered: the end of a step is where the next one starts, and a joint
+        held still is held at the same state sample after sample."""
+        if not (last[0] == q and last[1] == v and last[2] == tau and last[3] == mode):
+            last[:] = q, v, tau, mode, dynamics(q, v, tau, mode, True)[1]
+        return last[4]
 
-    def mode_at(q: np.ndarray, v: np.ndarray, tau: list[float]) -> tuple:
+    def mode_at(q: list[float], v: list[float], tau: list[float]) -> tuple:
         """The friction mode at a state: a moving joint slides; a joint at rest sticks if the
         torque that holds it is within the Coulomb torque, else it breaks away in the
         direction the net torque pushes it (released one at a time, the most overloaded first)."""
         if not friction:
             return (1, 1, 1)
-        mode = [1 if x > 0 else -1 if x < 0 else 0 for x in v.tolist()]
+        v0, v1, v2 = v
+        if v0 and v1 and v2:
+            return (1 if v0 > 0 else -1, 1 if v1 > 0 else -1, 1 if v2 > 0 else -1)
+        mode = [1 if x > 0 else -1 if x < 0 else 0 for x in v]
         while 0 in mode:
             holding = held(q, v, tau, tuple(mode))
             stuck = [i for i in range(3) if mode[i] == 0]
@@ -259,29 +267,26 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             mode[stuck[worst]] = -1 if holding[worst] > 0 else 1
         return tuple(mode)
 
-    def slack(q: np.ndarray, v: np.ndarray, tau: list[float], mode: tuple) -> list[float]:
+    def slack(q: list[float], v: list[float], tau: list[float], mode: tuple) -> list[float]:
         """How far the friction mode holds at a state, per joint (> 0 while it does): a sliding
         joint's rate along its direction (rad/s), a stuck joint's Coulomb torque less the torque
         that holds it (N m); empty without friction."""
         if not friction:
             return []
-        vs = v.tolist()
         holding = iter(held(q, v, tau, mode) if not all(mode) else ())
-        return [vs[i] * m if m else coulomb - abs(next(holding)) for i, m in enumerate(mode)]
+        return [x * m if m else coulomb - abs(next(holding)) for x, m in zip(v, mode)]
 
-    def margins(q: np.ndarray) -> list[float]:
+    def margins(q: list[float]) -> list[float]:
         """Each stop coordinate's distance inside its range (rad; < 0 while the stop is engaged);
         empty without stops."""
         if not hard_stops:
             return []
-        qs = q.tolist()
-        out = []
-        for i, j, lo, hi in stops:
-            c = qs[i] if j is None else qs[i] - qs[j]
-            out.append(min(c - lo, hi - c))
-        return out
+        q0, q1, q2 = q
+        c = q1 - q2
+        return [q0 - lo0 if q0 - lo0 < hi0 - q0 else hi0 - q0, q1 - lo1 if q1 - lo1 < hi1 - q1 else hi1 - q1,
+                q2 - lo2 if q2 - lo2 < hi2 - q2 else hi2 - q2, c - lo3 if c - lo3 < hi3 - c else hi3 - c]
 
-    def advance(q: np.ndarray, v: np.ndarray, tau: list[float], h: float, depth: int) -> tuple:
+    def advance(q: list[float], v: list[float], tau: list[float], h: float, depth: int) -> tuple:
         """One RK4 step of h in the friction mode of the start (EVENT_ITERATIONS and the module
         doc). A step in which a stop engages or releases, or the friction mode ends (a sliding
         joint reverses or stops, a stuck one breaks away), is cut at the first such event,
@@ -291,7 +296,11 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         mode = mode_at(q, v, tau)
         if friction and not any(mode):    # every joint stuck (v = 0, ddtheta = 0) for the held torque
             return q, v
-        q_end, v_end = rk4_step(lambda q_, v_: dynamics(q_, v_, tau, mode)[0], q, v, h)
+
+        def acceleration(q_: list[float], v_: list[float]) -> tuple:
+            return dynamics(q_, v_, tau, mode)
+
+        q_end, v_end = rk4_step(acceleration, q, v, h)
         start_margins, end_margins = margins(q), margins(q_end)
         if hard_stops and h > contact_step * (1 + 1e-9) and min(start_margins + end_margins) < 0:
             count = math.ceil(h / contact_step * (1 - 1e-12))    # a stop engaged: its substeps
@@ -301,7 +310,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         # event functions, oriented positive at the start: friction slacks, stop margins
         stop_signs = [1.0 if m >= 0 else -1.0 for m in start_margins]
 
-        def functions(q_: np.ndarray, v_: np.ndarray, known: list[float] | None = None) -> list[float]:
+        def functions(q_: list[float], v_: list[float], known: list[float] | None = None) -> list[float]:
             stop_part = margins(q_) if known is None else known
             return slack(q_, v_, tau, mode) + [m * sign for m, sign in zip(stop_part, stop_signs)]
 
@@ -321,7 +330,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             # (> 0 at low, <= 0 at high); the step ends at high, just past the event
             low, high, at_low, at_high, side = 0.0, 1.0, start[first], end[first], 0
             for _ in range(EVENT_ITERATIONS):
-                q_try, v_try = rk4_step(lambda q_, v_: dynamics(q_, v_, tau, mode)[0], q, v, share * h)
+                q_try, v_try = rk4_step(acceleration, q, v, share * h)
                 value = functions(q_try, v_try)[first]
                 if value > 0:
                     low, at_low = share, value
@@ -334,7 +343,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                 share = low + (high - low) * at_low / (at_low - at_high)
             share = high
         if first < len(mode) and friction and mode[first]:     # a sliding joint reversed or stopped: at rest
-            v_end = v_end.copy()
+            v_end = list(v_end)
             v_end[first] = 0.0
         if share < 1.0:
             return advance(q_end, v_end, tau, (1.0 - share) * h, depth + 1)
@@ -344,28 +353,31 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     counts_per_radian = device._counts_per_radian
     if quantization:
         previous = np.rint((theta - velocity * period) * counts_per_radian) / counts_per_radian
-    out_theta, out_dtheta = np.empty((samples, 3)), np.empty((samples, 3))
-    commanded, applied = np.zeros((samples, 3)), np.zeros((samples, 3))
+    theta, velocity = theta.tolist(), velocity.tolist()          # the state, Python floats
+    # the samples, flat buffers of doubles (appending costs less than a NumPy row assignment)
+    out_theta, out_dtheta, commanded, applied = (array.array("d") for _ in range(4))
+    zero = [0.0, 0.0, 0.0]
     for k in range(samples):
         if progress is not None:
             progress(k / samples)
-        out_theta[k], out_dtheta[k] = theta, velocity
+        out_theta.extend(theta)
+        out_dtheta.extend(velocity)
         t = k / rate  # as result.t: 9 / 1000 is 0.009, 9 * 0.001 is 0.009000000000000001
         if controller is None:
-            tau = [0.0, 0.0, 0.0]
+            tau = zero
+            commanded.extend(zero)
         else:
             if quantization:
-                measured = np.rint(theta * counts_per_radian) / counts_per_radian
+                measured = np.rint(np.array(theta) * counts_per_radian) / counts_per_radian
                 seen, seen_rate = measured, (measured - previous) * rate
                 previous = measured
             else:
-                seen, seen_rate = theta.copy(), velocity.copy()
-            tau = _checked(controller(t, seen, seen_rate), t)
-            commanded[k] = tau
-            tau = tau.tolist()
+                seen, seen_rate = np.array(theta), np.array(velocity)
+            tau = _checked(controller(t, seen, seen_rate), t).tolist()
+            commanded.extend(tau)
             if saturation:              # the clip, in floats (np.clip costs more than the plant's step)
                 tau = [-p if x < -p else p if x > p else x for x, p in zip(tau, peak_list)]
-            applied[k] = tau
+        applied.extend(tau)
         if k == samples - 1:
             break
         # the stiff stops need their substeps only while engaged (advance); elsewhere
@@ -374,39 +386,52 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         try:
             for _ in range(count):
                 theta, velocity = advance(theta, velocity, tau, period / count, 0)
-            if not math.isfinite(sum(theta.tolist()) + sum(velocity.tolist())):   # NaN or inf anywhere
+            if not math.isfinite(sum(theta) + sum(velocity)):   # NaN or inf anywhere
                 raise _Diverged
         except _Diverged:
-            raise InvalidInputError(_divergence(t, out_dtheta[0], applied[:k + 1], saturation)) from None
+            raise InvalidInputError(_divergence(t, _rows(out_dtheta)[0], _rows(applied), saturation)) from None
+    theta_out, applied_out = _rows(out_theta), _rows(applied)
     return SimulationResult(
-        t=np.arange(samples) / rate, theta=out_theta, dtheta=out_dtheta, tau=applied,
-        tau_commanded=commanded,
-        current=None if device.config.actuation.motor is None else device.motor_currents(applied),
-        tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=substeps)
+        t=np.arange(samples) / rate, theta=theta_out, dtheta=_rows(out_dtheta), tau=applied_out,
+        tau_commanded=_rows(commanded),
+        current=None if device.config.actuation.motor is None else device.motor_currents(applied_out),
+        tip=device.phantom.forward_kinematics(theta_out)[:, :3, 3], rate=rate, substeps=substeps)
+
+
+def _rows(buffer: array.array) -> np.ndarray:
+    """A flat buffer of doubles as a (K, 3) array of its own."""
+    return np.frombuffer(buffer, dtype=float).reshape(-1, 3).copy()
 
 
 class _Diverged(Exception):
     """The integrated state left the finite numbers (inside simulate)."""
 
 
-def _constrained(mass: list[list[float]], rhs: tuple, mode: tuple) -> tuple[list[float], list[float]]:
-    """(ddtheta, the torques holding the stuck joints) of M ddtheta = rhs + f with ddtheta_i = 0
-    and f_i free where mode[i] == 0 (stuck), f_i = 0 elsewhere: M_LL a_L = rhs_L, f_S = M_SL a_L -
-    rhs_S. ``mass`` is the 3x3 M (nested lists)."""
-    free = [i for i in range(3) if mode[i]]
-    stuck = [i for i in range(3) if not mode[i]]
+#: Per friction mode with a stuck joint: (the sliding joints, the stuck ones), in order.
+_PARTS = {mode: (tuple(i for i in range(3) if mode[i]), tuple(i for i in range(3) if not mode[i]))
+          for mode in itertools.product((-1, 0, 1), repeat=3) if not all(mode)}
+
+
+def _constrained(mass: list[list[float]], rhs: tuple, mode: tuple,
+                 holding: bool) -> list[float] | tuple[list[float], list[float]]:
+    """ddtheta of M ddtheta = rhs + f with ddtheta_i = 0 and f_i free where mode[i] == 0 (stuck),
+    f_i = 0 elsewhere: M_LL a_L = rhs_L; with ``holding``, (ddtheta, f_S = M_SL a_L - rhs_S).
+    ``mass`` is the full symmetric 3x3 M (nested lists: crba's, DEVELOPERS.md)."""
+    free, stuck = _PARTS[mode]
     a = [0.0, 0.0, 0.0]
-    if len(free) == 1:
+    if len(free) == 2:
+        i, j = free
+        m11, m12, m22 = mass[i][i], mass[i][j], mass[j][j]
+        r1, r2 = rhs[i], rhs[j]
+        det = m11 * m22 - m12 * m12
+        a[i] = (m22 * r1 - m12 * r2) / det
+        a[j] = (m11 * r2 - m12 * r1) / det
+    elif free:
         i = free[0]
         a[i] = rhs[i] / mass[i][i]
-    elif len(free) == 2:
-        i, j = free
-        m11, m12, m22 = mass[i][i], mass[min(i, j)][max(i, j)], mass[j][j]
-        det = m11 * m22 - m12 * m12
-        a[i] = (m22 * rhs[i] - m12 * rhs[j]) / det
-        a[j] = (m11 * rhs[j] - m12 * rhs[i]) / det
-    held = [sum(mass[min(s, k)][max(s, k)] * a[k] for k in free) - rhs[s] for s in stuck]
-    return a, held
+    if not holding:
+        return a
+    return a, [mass[s][0] * a[0] + mass[s][1] * a[1] + mass[s][2] * a[2] - rhs[s] for s in stuck]
 
 
 def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool) -> str:
