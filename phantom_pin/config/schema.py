@@ -179,11 +179,13 @@ class Stops:
         return (np.array([*lo, -self.coupled.theta3_minus_theta2_max]),
                 np.array([*hi, self.coupled.theta2_minus_theta3_max]))
 
-    def force(self, depth: np.ndarray | float, rate: np.ndarray | float) -> np.ndarray | float:
+    def force(self, depth: np.ndarray | float, rate: np.ndarray | float,
+              engaged: np.ndarray | bool | None = None) -> np.ndarray | float:
         """The hard-stop law: K depth + B rate (N m) of stop coordinates ``depth`` (rad, from
         penetration) beyond their stops at rates ``rate`` (rad/s); the damper acts only while
-        penetrating. Arrays or floats (the simulator's scalar loop)."""
-        return self.stiffness * depth + self.damping * rate * (depth != 0)
+        the stop is ``engaged``: by default while penetrating (depth != 0; the simulator says
+        which stops are engaged over a step). Arrays or floats (the simulator's scalar loop)."""
+        return self.stiffness * depth + self.damping * rate * ((depth != 0) if engaged is None else engaged)
 
     def penetration(self, theta: np.ndarray) -> np.ndarray:
         """Signed depth (rad) of each stop coordinate of postures (..., 3) beyond its stop:

@@ -198,10 +198,13 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     (lo0, hi0), (lo1, hi1), (lo2, hi2), (lo3, hi3) = bounds
     position, rate_vector = np.zeros(3), np.zeros(3)      # Pinocchio's inputs, filled in place
 
-    def dynamics(q: list[float], v: list[float], tau: list[float], mode: tuple, holding: bool = False):
+    def dynamics(q: list[float], v: list[float], tau: list[float], mode: tuple, contact: tuple | None,
+                 holding: bool = False):
         """ddtheta (rad/s^2) in the friction ``mode`` (per joint +1 or -1: sliding that way,
-        Coulomb friction against it; 0: stuck, ddtheta = 0, held by whatever torque that takes);
-        with ``holding``, (ddtheta, the friction torque holding each stuck joint, N m).
+        Coulomb friction against it; 0: stuck, ddtheta = 0, held by whatever torque that takes)
+        and the stops' ``contact`` (contact_at: each engaged stop's bound, its spring and damper
+        acting from it whichever side q is, so that a step is smooth up to the event that ends
+        it); with ``holding``, (ddtheta, the friction torque holding each stuck joint, N m).
         M^-1 (tau - friction + stops - C dtheta - N): Phantom.forward_dynamics plus
         Device.friction and Device.stop_torque, without their per-call checks."""
         # unrolled on Python floats: this runs four times per RK4 step, and Python's cost per
@@ -214,16 +217,16 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             t0 -= viscous * v0 + coulomb * m0
             t1 -= viscous * v1 + coulomb * m1
             t2 -= viscous * v2 + coulomb * m2
-        if hard_stops:
-            if not lo0 <= q0 <= hi0:
-                t0 -= stop_force(q0 - (hi0 if q0 > hi0 else lo0), v0)
-            if not lo1 <= q1 <= hi1:
-                t1 -= stop_force(q1 - (hi1 if q1 > hi1 else lo1), v1)
-            if not lo2 <= q2 <= hi2:
-                t2 -= stop_force(q2 - (hi2 if q2 > hi2 else lo2), v2)
-            c = q1 - q2
-            if not lo3 <= c <= hi3:
-                force = stop_force(c - (hi3 if c > hi3 else lo3), v1 - v2)
+        if contact is not None:
+            s0, s1, s2, s3 = contact
+            if s0 is not None:
+                t0 -= stop_force(q0 - s0, v0, True)
+            if s1 is not None:
+                t1 -= stop_force(q1 - s1, v1, True)
+            if s2 is not None:
+                t2 -= stop_force(q2 - s2, v2, True)
+            if s3 is not None:
+                force = stop_force(q1 - q2 - s3, v1 - v2, True)
                 t1 -= force
                 t2 += force
         position[0], position[1], position[2] = q0, q1, q2
@@ -238,17 +241,33 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             return (solution, ()) if holding else solution
         return _constrained(mass, rhs, mode, holding)
 
-    last: list = [None, None, None, None, None]   # held()'s last (q, v, tau, mode, result)
+    last: list = [None] * 6   # held()'s last (q, v, tau, mode, contact, result)
 
-    def held(q: list[float], v: list[float], tau: list[float], mode: tuple) -> list[float]:
+    def held(q: list[float], v: list[float], tau: list[float], mode: tuple, contact: tuple | None) -> list[float]:
         """The torques holding the stuck joints of ``mode`` at a state (dynamics' second part),
         the last one remembered: the end of a step is where the next one starts, and a joint
         held still is held at the same state sample after sample."""
-        if not (last[0] == q and last[1] == v and last[2] == tau and last[3] == mode):
-            last[:] = q, v, tau, mode, dynamics(q, v, tau, mode, True)[1]
-        return last[4]
+        if not (last[0] == q and last[1] == v and last[2] == tau and last[3] == mode and last[4] == contact):
+            last[:] = q, v, tau, mode, contact, dynamics(q, v, tau, mode, contact, True)[1]
+        return last[5]
 
-    def mode_at(q: list[float], v: list[float], tau: list[float]) -> tuple:
+    def contact_at(q: list[float], v: list[float], margin: list[float]) -> tuple | None:
+        """The stops engaged at a state, as each stop coordinate's bound (rad) where engaged and
+        None where not; None if none is (or without stops). ``margin``: margins(q). A stop is
+        engaged beyond its bound, and on it exactly if moving outwards (the step that located
+        its contact may end on the boundary to the last bit)."""
+        if not hard_stops or min(margin) > 0:
+            return None
+        q0, q1, q2 = q
+        v0, v1, v2 = v
+        out = []
+        for c, rate, lo, hi, m in ((q0, v0, lo0, hi0, margin[0]), (q1, v1, lo1, hi1, margin[1]),
+                                   (q2, v2, lo2, hi2, margin[2]), (q1 - q2, v1 - v2, lo3, hi3, margin[3])):
+            lower = c - lo < hi - c
+            out.append((lo if lower else hi) if m < 0 or (m == 0 and (rate < 0 if lower else rate > 0)) else None)
+        return None if out == [None] * 4 else tuple(out)
+
+    def mode_at(q: list[float], v: list[float], tau: list[float], contact: tuple | None) -> tuple:
         """The friction mode at a state: a moving joint slides; a joint at rest sticks if the
         torque that holds it is within the Coulomb torque, else it breaks away in the
         direction the net torque pushes it (released one at a time, the most overloaded first)."""
@@ -259,7 +278,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             return (1 if v0 > 0 else -1, 1 if v1 > 0 else -1, 1 if v2 > 0 else -1)
         mode = [1 if x > 0 else -1 if x < 0 else 0 for x in v]
         while 0 in mode:
-            holding = held(q, v, tau, tuple(mode))
+            holding = held(q, v, tau, tuple(mode), contact)
             stuck = [i for i in range(3) if mode[i] == 0]
             worst = max(range(len(stuck)), key=lambda k: abs(holding[k]))
             if abs(holding[worst]) < coulomb:        # at the Coulomb torque it breaks away
@@ -267,13 +286,13 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
             mode[stuck[worst]] = -1 if holding[worst] > 0 else 1
         return tuple(mode)
 
-    def slack(q: list[float], v: list[float], tau: list[float], mode: tuple) -> list[float]:
+    def slack(q: list[float], v: list[float], tau: list[float], mode: tuple, contact: tuple | None) -> list[float]:
         """How far the friction mode holds at a state, per joint (> 0 while it does): a sliding
         joint's rate along its direction (rad/s), a stuck joint's Coulomb torque less the torque
         that holds it (N m); empty without friction."""
         if not friction:
             return []
-        holding = iter(held(q, v, tau, mode) if not all(mode) else ())
+        holding = iter(held(q, v, tau, mode, contact) if not all(mode) else ())
         return [x * m if m else coulomb - abs(next(holding)) for x, m in zip(v, mode)]
 
     def margins(q: list[float]) -> list[float]:
@@ -287,32 +306,36 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                 q2 - lo2 if q2 - lo2 < hi2 - q2 else hi2 - q2, c - lo3 if c - lo3 < hi3 - c else hi3 - c]
 
     def advance(q: list[float], v: list[float], tau: list[float], h: float, depth: int) -> tuple:
-        """One RK4 step of h in the friction mode of the start (EVENT_ITERATIONS and the module
-        doc). A step in which a stop engages or releases, or the friction mode ends (a sliding
-        joint reverses or stops, a stuck one breaks away), is cut at the first such event,
-        located by regula falsi (Illinois) on its function, just past it: a reversing joint is
-        set at rest there, and the rest of the step starts in the mode of that state (mode_at
-        decides whether it sticks). While a stop is engaged the step is at most contact_step."""
-        mode = mode_at(q, v, tau)
+        """One RK4 step of h in the friction mode and the stops' contact of the start
+        (EVENT_ITERATIONS and the module doc). A step in which a stop engages or releases, or the
+        friction mode ends (a sliding joint reverses or stops, a stuck one breaks away), is cut at
+        the first such event, located by regula falsi (Illinois) on its function, just past it:
+        a reversing joint is set at rest there, and the rest of the step starts in the modes of
+        that state (mode_at decides whether it sticks). While a stop is engaged the step is at
+        most contact_step."""
+        start_margins = margins(q)
+        contact = contact_at(q, v, start_margins)
+        mode = mode_at(q, v, tau, contact)
         if friction and not any(mode):    # every joint stuck (v = 0, ddtheta = 0) for the held torque
             return q, v
 
         def acceleration(q_: list[float], v_: list[float]) -> tuple:
-            return dynamics(q_, v_, tau, mode)
+            return dynamics(q_, v_, tau, mode, contact)
 
         q_end, v_end = rk4_step(acceleration, q, v, h)
-        start_margins, end_margins = margins(q), margins(q_end)
+        end_margins = margins(q_end)
         if hard_stops and h > contact_step * (1 + 1e-9) and min(start_margins + end_margins) < 0:
             count = math.ceil(h / contact_step * (1 - 1e-12))    # a stop engaged: its substeps
             for _ in range(count):
                 q, v = advance(q, v, tau, h / count, depth)
             return q, v
-        # event functions, oriented positive at the start: friction slacks, stop margins
-        stop_signs = [1.0 if m >= 0 else -1.0 for m in start_margins]
+        # event functions, positive while the start's modes hold: friction slacks, stop margins
+        # (a free stop's margin, an engaged one's depth)
+        stop_signs = [1.0] * len(start_margins) if contact is None else [1.0 if c is None else -1.0 for c in contact]
 
         def functions(q_: list[float], v_: list[float], known: list[float] | None = None) -> list[float]:
             stop_part = margins(q_) if known is None else known
-            return slack(q_, v_, tau, mode) + [m * sign for m, sign in zip(stop_part, stop_signs)]
+            return slack(q_, v_, tau, mode, contact) + [m * sign for m, sign in zip(stop_part, stop_signs)]
 
         end = functions(q_end, v_end, end_margins)
         if not end or min(end) > 0 or depth >= MAX_EVENTS:
@@ -369,7 +392,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         else:
             if quantization:
                 measured = np.rint(np.array(theta) * counts_per_radian) / counts_per_radian
-                seen, seen_rate = measured, (measured - previous) * rate
+                seen, seen_rate = measured.copy(), (measured - previous) * rate   # a copy: the controller's
                 previous = measured
             else:
                 seen, seen_rate = np.array(theta), np.array(velocity)
