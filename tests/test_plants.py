@@ -6,7 +6,7 @@ bounds below are the measured agreement (in the comments), with some margin."""
 import numpy as np
 import pytest
 
-from phantom_pin import Device, describe, simulate
+from phantom_pin import Device, InvalidInputError, describe, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 
 DEVICE = Device(describe())
@@ -50,14 +50,20 @@ def test_a_pd_hold_with_gravity_compensation_sticks_inside_the_friction_band():
     assert np.abs(ours.theta - mujoco.theta).max() < 2e-3                      # measured 1.3e-3 rad
 
 
+@pytest.mark.parametrize("stops", [{}, {"stops.stiffness": 100.0, "stops.damping": 1.0}])
 @pytest.mark.parametrize("theta0", [[0.0, 0.3, 0.4], [0.3, 0.8, 0.4]])
-def test_a_free_fall_onto_the_stops_agrees(theta0):
+def test_a_free_fall_onto_the_stops_agrees(theta0, stops):
     """Unpowered from rest: the arm falls onto the parallelogram's stop and bounces along it.
-    MuJoCo's limits (mjcf.yaml's stop_solref and stop_solimp, calibrated against simulate's
-    spring-damper) follow simulate within 0.048 rad over 1.5 s (MuJoCo's default limits: 0.33)."""
-    ours, mujoco = both(np.array(theta0), 1.5, None)
-    assert np.abs(ours.theta - mujoco.theta).max() < 0.06
-    bound = DEVICE.config.limits.stops.coupled.theta3_minus_theta2_max
+    MuJoCo's limits (the configuration's K and B per mjcf.yaml's stop_inertia, with its
+    stop_solimp: a fit to simulate's spring-damper) follow simulate within 0.048 rad over 1.5 s
+    with the shipped stops (MuJoCo's default limits: 0.33), and within 0.054 rad with stops ten
+    times stiffer and damper (before the MJCF took K and B, its limits stayed those fitted to the
+    shipped stops: 0.33 rad)."""
+    device = Device(describe(overrides=stops)) if stops else DEVICE
+    ours = simulate(np.array(theta0), 1.5, None, device=device)
+    mujoco = simulate_mujoco(np.array(theta0), 1.5, None, device=device)
+    assert np.abs(ours.theta - mujoco.theta).max() < 0.065
+    bound = device.config.limits.stops.coupled.theta3_minus_theta2_max
     for result in (ours, mujoco):                                             # both hit the stop
         assert (result.theta[:, 2] - result.theta[:, 1]).max() > bound
 
@@ -94,3 +100,17 @@ def test_both_saturate_at_the_same_torque():
     ours, mujoco = both(START, 0.01, lambda t, q, v: [5.0, -5.0, 5.0])
     np.testing.assert_allclose(ours.tau, mujoco.tau, rtol=1e-12)
     np.testing.assert_allclose(ours.tau[0], DEVICE.continuous_torque * [1, -1, 1], rtol=1e-12)
+
+
+@pytest.mark.parametrize("plant", [simulate, simulate_mujoco])
+def test_both_refuse_a_diverging_state_and_a_start_a_turn_beyond_the_stops(plant, tmp_path, monkeypatch):
+    """1e4 rad/s at the start diverges in both: an InvalidInputError naming the cause, no result.
+    MuJoCo by itself warns, writes MUJOCO_LOG.TXT into the working directory, resets the model
+    to its initial state and goes on (before: theta 0.1, -1551, 0 rad, returned as a result);
+    simulate_mujoco writes no log. A start 28 rad beyond the stops is refused by both."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InvalidInputError, match="^dtheta0: 1e\\+04 rad/s|^controller or dtheta0: .* diverged"):
+        plant([0.1, 0.3, 0.4], 0.01, None, dtheta0=[1e4, 0.0, 0.0], device=DEVICE)
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(InvalidInputError, match="^theta0: .* beyond the stops, more than a turn"):
+        plant([30.0, 0.3, 0.4], 0.01, None, device=DEVICE)

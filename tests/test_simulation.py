@@ -145,6 +145,8 @@ def test_saturation_clips_at_the_configurations_policy():
     np.testing.assert_allclose(result.current[0], [0.129 / 0.0234, -0.129 / 0.0234, 0.5 / (11.6 * 0.0234)])
     unclipped = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.5], saturation=False)
     np.testing.assert_allclose(unclipped.tau, unclipped.tau_commanded)
+    numpy_true = simulate(START, 0.01, lambda t, q, dq: [5.0, -5.0, 0.2], saturation=np.True_)
+    np.testing.assert_allclose(numpy_true.tau[0], [continuous[0], -continuous[1], 0.2], rtol=1e-15)  # was the peak
 
 
 def test_gravity_compensation_holds_the_arm_still():

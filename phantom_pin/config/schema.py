@@ -231,7 +231,8 @@ class MujocoSettings:
     """The MJCF's timestep (s) and integrator, the mimic equalities' solref (time constant
     in timesteps, damping ratio) and solimp (dmin, dmax, width), the joints' dry friction's
     solref (time constant in timesteps, damping ratio), the stops' (joint and tendon limits')
-    solref (time constant s, damping ratio) and solimp, and the scene."""
+    ``stop_inertia`` (kg m^2: their solref in MuJoCo's direct form is (-K, -B) / stop_inertia,
+    K and B the configuration's stops) and solimp, and the scene."""
 
     timestep: float
     integrator: str
@@ -240,7 +241,7 @@ class MujocoSettings:
     equality_solimp: tuple[float, float, float]
     friction_solref_timesteps: float
     friction_solref_damping_ratio: float
-    stop_solref: tuple[float, float]
+    stop_inertia: float
     stop_solimp: tuple[float, float, float]
     scene: Scene
 
@@ -442,7 +443,7 @@ def _mujoco(r: _Reader) -> MujocoSettings:
                           r.vector(arg, "equality_solimp", length=3),
                           r.number(arg, "friction_solref_timesteps", positive=True),
                           r.number(arg, "friction_solref_damping_ratio", positive=True),
-                          r.vector(arg, "stop_solref", length=2), r.vector(arg, "stop_solimp", length=3), scene)
+                          r.number(arg, "stop_inertia", positive=True), r.vector(arg, "stop_solimp", length=3), scene)
 
 
 def _sources(r: _Reader) -> dict[str, str]:

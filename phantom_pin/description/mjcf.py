@@ -117,6 +117,11 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     stop_ranges = {f"{prefix}joint{j + 1}": (device_stops.lower[j], device_stops.upper[j]) for j in range(3)}
     settings = config.mujoco
     stops = config.limits.stops.coupled
+    # the stops' spring and damper in solref's direct form (-stiffness, -damping), per unit of
+    # mjcf.yaml's stop_inertia: MuJoCo's limits are stiff per unit of acceleration, not torque
+    stop_soft = {"solreflimit": _vec([-device_stops.stiffness / settings.stop_inertia,
+                                      -device_stops.damping / settings.stop_inertia]),
+                 "solimplimit": _vec(settings.stop_solimp)}
     urdf = ET.fromstring(urdf_xml)
     srdf = ET.fromstring(srdf_xml)
     mimics = read_mimic_tags(urdf_xml)
@@ -160,7 +165,6 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
             if joint.get("type") == "revolute":
                 friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
                                         settings.friction_solref_damping_ratio])
-                stop_soft = {"solreflimit": _vec(settings.stop_solref), "solimplimit": _vec(settings.stop_solimp)}
                 ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
                                                                joint.get("name") in mimics, friction_solref,
                                                                stop_ranges.get(joint.get("name")), stop_soft))
@@ -194,7 +198,7 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     tendon = ET.SubElement(ET.SubElement(mujoco, "tendon"), "fixed", {
         "name": f"{prefix}parallelogram",
         "range": _vec([-stops.theta3_minus_theta2_max, stops.theta2_minus_theta3_max]),
-        "solreflimit": _vec(settings.stop_solref), "solimplimit": _vec(settings.stop_solimp)})
+        **stop_soft})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint2", "coef": "1"})
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint3", "coef": "-1"})
 

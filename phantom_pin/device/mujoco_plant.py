@@ -60,24 +60,33 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     low, high = model.actuator_ctrlrange[actuators, 0], model.actuator_ctrlrange[actuators, 1]
     data.qpos[qpos] = coupling.configuration(theta)
     data.qvel[dofs] = coupling.tangent(velocity)
-    mujoco.mj_forward(model, data)
     out_theta, out_dtheta = np.empty((samples, 3)), np.empty((samples, 3))
     commanded, applied = np.zeros((samples, 3)), np.zeros((samples, 3))
-    for k in range(samples):
-        t = k / rate
-        out_theta[k], out_dtheta[k] = data.qpos[primary_q], data.qvel[primary_v]
-        if controller is not None:
-            commanded[k] = _checked(controller(t, out_theta[k].copy(), out_dtheta[k].copy()), t)
-        ctrl = np.clip(commanded[k] / gear, low, high)
-        applied[k] = ctrl * gear
-        if k == samples - 1:
-            break
-        data.ctrl[actuators] = ctrl
-        for _ in range(steps):
-            mujoco.mj_step(model, data)
-        if not np.isfinite(data.qpos).all():
-            raise InvalidInputError(f"controller or dtheta0: MuJoCo's state diverged between t = {t:.6g} s and the "
-                                    "next sample")
+    # MuJoCo meets a diverging state with a warning (printed, and appended to MUJOCO_LOG.TXT in
+    # the working directory), resets the model and goes on; here it ends the run instead.
+    diverged = [int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQVEL),
+                int(mujoco.mjtWarning.mjWARN_BADQACC)]
+    previous_handler = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)     # counted in data.warning, read below
+    try:
+        mujoco.mj_forward(model, data)
+        for k in range(samples):
+            t = k / rate
+            out_theta[k], out_dtheta[k] = data.qpos[primary_q], data.qvel[primary_v]
+            if controller is not None:
+                commanded[k] = _checked(controller(t, out_theta[k].copy(), out_dtheta[k].copy()), t)
+            ctrl = np.clip(commanded[k] / gear, low, high)
+            applied[k] = ctrl * gear
+            if k == samples - 1:
+                break
+            data.ctrl[actuators] = ctrl
+            for _ in range(steps):
+                mujoco.mj_step(model, data)
+            if any(data.warning[w].number for w in diverged) or not np.isfinite(data.qpos).all():
+                raise InvalidInputError(f"controller or dtheta0: MuJoCo's state diverged between t = {t:.6g} s "
+                                        "and the next sample")
+    finally:
+        mujoco.set_mju_user_warning(previous_handler)
     return SimulationResult(
         t=np.arange(samples) / rate, theta=out_theta, dtheta=out_dtheta, tau=applied, tau_commanded=commanded,
         current=None if device.config.actuation.motor is None else device.motor_currents(applied),

@@ -84,8 +84,9 @@ def _positive(value: object, name: str) -> float:
 
 def arguments(theta0: object, dtheta0: object, duration: object, rate: object, controller: object,
               device: object) -> tuple[np.ndarray, np.ndarray, float, float, Device]:
-    """The arguments a plant's run shares, checked (InvalidInputError naming the bad one):
-    (theta0, dtheta0 or zeros, duration, rate, the Device or the shipped one)."""
+    """The arguments a plant's run shares, checked (InvalidInputError naming the bad one; theta0
+    more than a turn beyond the stops is no posture of the arm): (theta0, dtheta0 or zeros,
+    duration, rate, the Device or the shipped one)."""
     theta = as_state(theta0, "theta0").copy()
     velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
     duration, rate = _positive(duration, "duration"), _positive(rate, "rate")
@@ -95,6 +96,10 @@ def arguments(theta0: object, dtheta0: object, duration: object, rate: object, c
         device = default_device()
     elif not isinstance(device, Device):
         raise InvalidInputError(f"device: expected a phantom_pin.Device or None, got {device!r}")
+    beyond = float(np.abs(device.config.limits.stops.penetration(theta)).max())
+    if beyond > 2 * math.pi:
+        raise InvalidInputError(f"theta0: {theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a "
+                                "turn: no posture of the arm")
     return theta, velocity, duration, rate, device
 
 
@@ -152,15 +157,13 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     for name, flag in (("friction", friction), ("hard_stops", hard_stops), ("quantization", quantization)):
         if not isinstance(flag, (bool, np.bool_)):
             raise InvalidInputError(f"{name}: expected True or False, got {flag!r}")
-    if not isinstance(saturation, (bool, np.bool_)) and saturation not in SATURATIONS:
+    if isinstance(saturation, (bool, np.bool_)):
+        saturation = bool(saturation)       # np.True_ is not True
+    elif saturation not in SATURATIONS:
         raise InvalidInputError(f"saturation: expected True, False, 'continuous' or 'peak', got {saturation!r}")
     theta, velocity, duration, rate, device = arguments(theta0, dtheta0, duration, rate, controller, device)
     if quantization:
         device._require("encoder", "quantization")
-    beyond = float(np.abs(device.config.limits.stops.penetration(theta)).max())
-    if beyond > 2 * math.pi:
-        raise InvalidInputError(f"theta0: {theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a "
-                                "turn: no posture of the arm")
     samples = math.floor(duration * rate * (1 + 1e-12)) + 1
     if samples < 2:
         raise InvalidInputError(f"duration: {duration} s is shorter than one sample period (1 / rate = {1 / rate} s)")
