@@ -50,6 +50,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=3)
     args = parser.parse_args()
+    if args.rounds < 1:
+        parser.error(f"--rounds: expected an integer >= 1, got {args.rounds}")
     print(f"{platform.machine()}, Python {platform.python_version()}, {os.cpu_count()} cores; "
           f"{DURATION:g} s simulated per run, median of {args.rounds} rounds")
     print(f"{'scenario':50} {'simulate':>10} {'MuJoCo':>10} {'ratio':>7}   (s of wall time per simulated s)")

@@ -22,6 +22,8 @@ exceed the bound.
 
 from __future__ import annotations
 
+import math
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -39,11 +41,13 @@ PLANTS = ("simulate", "mujoco")
 
 
 def run_plant(plant: str, start, duration, controller, rate, device):
-    """phantom_pin.simulate, or the same loop on the MJCF in MuJoCo (its step at most 1 / rate)."""
+    """phantom_pin.simulate, or the same loop on the MJCF in MuJoCo (its step the longest that
+    divides the period 1 / rate and is at most the MJCF's 1 ms)."""
     if plant == "simulate":
         return simulate(start, duration, controller, rate=rate, device=device)
     from phantom_pin.device.mujoco_plant import simulate_mujoco
-    return simulate_mujoco(start, duration, controller, rate=rate, device=device, timestep=min(1e-3, 1 / rate))
+    steps = max(1, math.ceil(1.0 / (rate * 1e-3) * (1 - 1e-12)))   # MuJoCo steps per sample
+    return simulate_mujoco(start, duration, controller, rate=rate, device=device, timestep=1.0 / (rate * steps))
 
 
 def wall_run(device: Device, posture: np.ndarray, stiffness: float, rate: float, duration: float,
@@ -89,8 +93,9 @@ def main(argv: list[str] | None = None) -> None:
                      help="the simulators of the sweep: phantom_pin.simulate and MuJoCo on the MJCF (default both; "
                           "MuJoCo needs the interop extra)")
     args = cli.parse_args(argv)
-    if min(args.stiffness) <= 0 or min(args.rates) <= 0:
-        raise PhantomPinError("--stiffness, --rates: expected positive numbers")
+    for name, values in (("--stiffness", args.stiffness), ("--rates", args.rates)):
+        if not all(math.isfinite(x) and x > 0 for x in values):
+            raise PhantomPinError(f"{name}: expected finite numbers > 0, got {' '.join(map(str, values))}")
     figure_path = common.output(args, "virtual_wall.png")
     device = Device()
     posture = np.array(args.posture)

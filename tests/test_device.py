@@ -256,6 +256,8 @@ def test_reachable_is_forward_kinematics_inside_the_stops(device):
     assert device.reachable(shoulder + [0.0, 0.0, 0.3])        # 0.3 m in front, at shoulder height
     assert not device.reachable(shoulder + [0.0, 0.0, -0.3])   # 0.3 m behind: needs theta2 >= 146 deg
     assert device.reachable(shoulder + [[0.0, 0.0, 0.3], [0.0, 0.0, -0.3]]).tolist() == [True, False]
+    grid = shoulder + np.array([[[0.0, 0.0, 0.3], [0.0, 0.0, -0.3]]] * 2)        # (2, 2, 3): before, (4,)
+    assert device.reachable(grid).tolist() == [[True, False]] * 2
 
 
 @pytest.mark.parametrize("call, argument", [
@@ -264,6 +266,9 @@ def test_reachable_is_forward_kinematics_inside_the_stops(device):
     (lambda d: d.joint_torques([1e308, 0, 0]), "currents"),
     (lambda d: d.stop_energy([1e200, 0, 0]), "theta"),
     (lambda d: d.tip_force_capacity([[0.1, 0.3, 0.4]] * 2, [[0.0, 1.0, 0.0]] * 3), "theta"),  # before: NumPy's error
+    (lambda d: d.stop_torque([1e308, 0, 0], [0, 0, 0]), "theta, dtheta"),       # before: -inf, nan, nan
+    (lambda d: d.available_torque([0.1, 0.3, 0.4], None), "continuous"),        # before: the peak torque
+    (lambda d: d.tip_force_capacity([0.1, 0.3, 0.4], [0, 0, 1], "yes"), "continuous"),  # before: continuous
 ])
 def test_huge_or_mismatched_input_is_refused_naming_the_argument(device, call, argument):
     with pytest.raises(InvalidInputError, match=f"^{argument}"):

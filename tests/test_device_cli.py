@@ -30,6 +30,7 @@ def test_simulate_json_is_the_python_result(tmp_path, capsys):
     for name in ("t", "theta", "dtheta", "tau", "tau_commanded", "current", "tip"):
         np.testing.assert_array_equal(data[name], getattr(expected, name))
     assert data["units"]["theta"] == "rad" and data["settings"]["substeps"] == expected.substeps
+    assert data["settings"]["saturation"] == "continuous"        # the policy applied (before: null)
 
 
 def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(capsys):
@@ -63,6 +64,12 @@ def test_simulate_keeps_files_and_writes_nothing_on_failure(tmp_path, capsys):
     (["--theta0", *START, "--duration", "1", "--controller", "pd"], "invalid choice"),
     (["--theta0", *START], "required: --duration"),
     (["--duration", "1"], "required: --theta0"),
+    (["--theta0", *START, "--duration", "1", "--no-saturation", "--saturation", "peak"], "not allowed with"),
+    (["--theta0", *START, "--duration", "1", "-o", ""], "error: --output: empty; give a file name"),
+    (["--theta0", *START, "--duration", "1", "-o", ".", "--force"], "error: --output: . is a folder"),
+    (["--theta0", *START, "--duration", "1", "-o", "missing/x.json"], "error: --output: folder missing does not"),
+    (["--trajectory", "t.csv", "--rate", "500"], "error: --rate: --trajectory sets it"),
+    (["--trajectory", "t.csv", "--dtheta0", "0", "0", "0"], "error: --dtheta0: --trajectory sets it"),
 ])
 def test_simulate_bad_arguments_give_one_line_and_exit_code_2(capsys, argv, message):
     code, _, err = run(capsys, "simulate", *argv)
@@ -85,3 +92,5 @@ def test_simulate_warns_once_when_it_starts_inside_a_stop(capsys):
     assert main(["simulate", "--theta0", "3", "0", "0", "--duration", "0.01"]) == 0
     err = capsys.readouterr().err
     assert err == "phantom-pin: warning: --theta0 [3.0, 0.0, 0.0] rad starts beyond the stops, which push it back\n"
+    assert main(["simulate", "--theta0", "3", "0", "0", "--duration", "0.01", "--no-hard-stops"]) == 0
+    assert capsys.readouterr().err == ""                            # no stops, no warning (before: the same)

@@ -33,7 +33,7 @@ def test_below_the_breakaway_torque_the_arm_holds_in_both(share):
 
 def test_above_the_breakaway_torque_both_move_alike():
     """Twice the Coulomb torque: joint 1 runs into its stop in both (1.249 rad in 1 s, within
-    6e-5 rad of each other)."""
+    2.0e-4 rad of each other)."""
     ours, mujoco = both(START, 1.0, lambda t, q, v: GRAVITY(q) + [2 * COULOMB, 0.0, 0.0])
     assert ours.theta[-1, 0] - START[0] > 1.0
     assert np.abs(ours.theta[-1] - mujoco.theta[-1]).max() < 5e-4              # measured 2.0e-4
@@ -114,3 +114,16 @@ def test_both_refuse_a_diverging_state_and_a_start_a_turn_beyond_the_stops(plant
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(InvalidInputError, match="^theta0: .* beyond the stops, more than a turn"):
         plant([30.0, 0.3, 0.4], 0.01, None, device=DEVICE)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"timestep": 5e-324}, "^timestep: inf MuJoCo steps"),                      # was OverflowError
+    ({"timestep": 1e-12}, "^timestep: 1e\\+09 MuJoCo steps of 1e-12 s per sample"),  # ran for hours
+    ({"timestep": 3e-4}, "^timestep: 1000 Hz is not 1 / timestep \\(3333.33 Hz\\) divided by a whole number$"),
+    ({"rate": 300.0}, "^rate: 300 Hz is not 1 / timestep \\(1000 Hz\\) .*; pass timestep$"),
+])
+def test_simulate_mujoco_refuses_bad_steps_naming_them(kwargs, message):
+    """Found by a bad-input pass: a tiny timestep overflowed or ran without bound, a timestep
+    not dividing the period was blamed on the rate."""
+    with pytest.raises(InvalidInputError, match=message):
+        simulate_mujoco(START, 0.01, None, device=DEVICE, **kwargs)

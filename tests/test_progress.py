@@ -48,8 +48,9 @@ def test_check_shows_progress_on_a_terminal_unless_quiet(capsys, monkeypatch):
 
 
 def test_long_work_reports_its_share_done():
-    """simulate once per sample, excite's optimiser once per SLSQP iteration, estimate at its
-    stages: shares in [0, 1], never decreasing."""
+    """simulate once per sample and 1 at the end (before, the bar stopped at 99.8 %), excite's
+    optimiser once per SLSQP iteration, estimate at its stages: shares in [0, 1], never
+    decreasing."""
     import numpy as np
 
     from phantom_pin import describe, simulate
@@ -57,7 +58,7 @@ def test_long_work_reports_its_share_done():
 
     shares = []
     result = simulate([0.0, 0.3, 0.4], 0.05, progress=shares.append)
-    assert len(shares) == len(result.t) and shares[0] == 0 and shares[-1] == (len(result.t) - 1) / len(result.t)
+    assert len(shares) == len(result.t) + 1 and shares[0] == 0 and shares[-2:] == [50 / 51, 1.0]
     seen = []
     excitation.optimise(describe(), 5.0, 3, samples=30, iterations=4, restarts=2, progress=seen.append)
     for values in (shares, seen):

@@ -258,6 +258,29 @@ def test_a_complex_torque_is_refused():
 
 
 @pytest.mark.parametrize("kwargs, message", [
+    ({"duration": 2**2000}, "^duration: expected a finite number > 0, got 1148130695"),    # was OverflowError
+    ({"rate": 2**2000}, "^rate: expected a finite number > 0"),
+    ({"duration": 1e306, "rate": 1e-306}, "^rate: 1e-306 Hz needs inf RK4 steps"),       # was OverflowError
+    ({"controller": lambda t, q, v: ["1", "2", "3"]}, "^controller: returned \\['1'"),   # was read as numbers
+    ({"controller": lambda t, q, v: np.array(["2020-01-01"] * 3, dtype="datetime64[D]")}, "^controller: returned"),
+    ({"progress": 1}, "^progress: expected a callable"),                                  # was TypeError
+    ({"substeps": 10**7}, "^substeps: 0.01 s at 1000 Hz needs 1e\\+08 RK4 steps"),        # was blamed on rate
+    ({"rate": 1.0, "duration": 3.0, "substeps": 1}, "^substeps: 1 gives RK4 steps of 1 s at 1 Hz, longer than"),
+])
+def test_bad_arguments_are_refused_naming_them(kwargs, message):
+    """Found by a bad-input pass: each raised something else or was silently accepted."""
+    arguments = {"duration": 0.01, **kwargs}
+    with pytest.raises(InvalidInputError, match=message):
+        simulate(START, arguments.pop("duration"), arguments.pop("controller", None), **arguments)
+
+
+def test_a_huge_finite_torque_is_a_number():
+    """1e308 N m on each joint is finite (the check summed them and overflowed); it is clipped."""
+    result = simulate(START, 0.002, lambda t, q, v: [1e308] * 3)
+    assert result.tau_commanded[0, 0] == 1e308 and np.abs(result.tau).max() < 1.0
+
+
+@pytest.mark.parametrize("kwargs, message", [
     ({"dtheta0": [1e6, 0.0, 0.0]},
      "^dtheta0: 1e\\+06 rad/s is far beyond any joint speed of the arm; the state diverged"),
     ({"controller": lambda t, theta, dtheta: np.array([1e300, 0.0, 0.0]), "saturation": False},

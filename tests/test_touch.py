@@ -97,13 +97,16 @@ def test_a_device_without_motor_data_says_what_it_lacks(touch):
                        (lambda: touch.continuous_torque, "continuous_torque"),
                        (lambda: touch.encoder_counts([0.1, 0.2, 0.3]), "encoder_counts"),
                        (lambda: touch.encoder_theta([1, 2, 3]), "encoder_theta"),
-                       (lambda: touch.encoder_resolution, "encoder_resolution"),
-                       (lambda: touch.available_torque([0.1, 0.2, 0.3]), "continuous_torque")):
+                       (lambda: touch.encoder_resolution, "encoder_resolution")):
         with pytest.raises(MissingDataError, match=f"^{name}: model touch has no (motor|encoder) data \\(not public"):
             call()
     assert isinstance(MissingDataError("x"), ValueError)
-    lower, upper = touch.available_torque([0.1, 0.2, 0.3], continuous=False)  # the joint limits still hold
-    np.testing.assert_allclose(upper - lower, 2 * touch.peak_torque, rtol=1e-15)
+    # its one limit, joint_torque_limit, holds for both policies, as in simulate's saturation (before,
+    # the default continuous=True raised while simulate clipped at that limit)
+    for continuous in (True, False):
+        lower, upper = touch.available_torque([0.1, 0.2, 0.3], continuous=continuous)
+        np.testing.assert_allclose(upper - lower, 2 * touch.peak_torque, rtol=1e-15)
+    np.testing.assert_array_equal(touch.saturation_torque, touch.peak_torque)
 
 
 def test_simulating_a_touch_saturates_at_its_limits_and_has_no_currents(touch):

@@ -19,6 +19,7 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification.simulation import KD, KP
 from phantom_pin.progress import Progress
+from phantom_pin.validation import output_path
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = ("theta0", "dtheta0", "duration", "rate", "quantization")
@@ -34,8 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                                               "(friction, stops, saturation), as JSON or CSV")
     command.add_argument("--theta0", metavar="T", help="initial posture (rad); required without --trajectory",
                          **three)
-    command.add_argument("--dtheta0", default=[0.0, 0.0, 0.0], metavar="W", help="initial rates (rad/s)",
-                         **three)
+    command.add_argument("--dtheta0", metavar="W", help="initial rates (rad/s, default 0 0 0)", **three)
     command.add_argument("--duration", type=float, help="simulated time (s); required without --trajectory")
     command.add_argument("--trajectory", type=Path,
                          help="track excite's CSV: its torque as feed-forward plus PD "
@@ -45,18 +45,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                          help="the --trajectory file's columns: the report's theta (rad) and N m (default), or "
                               "OpenHaptics' joint angles (rad) and joint torques (mN m), as excite writes "
                               "them with --convention openhaptics; the output is in the report's terms")
-    command.add_argument("--rate", type=float, default=1000.0, help="controller rate (Hz, default 1000)")
+    command.add_argument("--rate", type=float, help="controller rate (Hz, default 1000)")
     command.add_argument("--controller", choices=["none", "gravity"], default="none",
                          help="zero torque (default), or gravity compensation N(theta) from the Phantom")
-    command.add_argument("--no-friction", action="store_true")
-    command.add_argument("--no-hard-stops", action="store_true")
-    command.add_argument("--no-saturation", action="store_true")
-    command.add_argument("--saturation", choices=("continuous", "peak"),
-                         help="clip commands at the motors' continuous or peak torque (default: actuation.yaml's "
-                              "saturation, as the MJCF)")
+    command.add_argument("--no-friction", action="store_true", help="no joint friction (viscous and Coulomb)")
+    command.add_argument("--no-hard-stops", action="store_true", help="no stops (the joints turn freely)")
+    clip = command.add_mutually_exclusive_group()
+    clip.add_argument("--no-saturation", action="store_true", help="apply commands unclipped")
+    clip.add_argument("--saturation", choices=("continuous", "peak"),
+                      help="clip commands at the motors' continuous or peak torque (default: actuation.yaml's "
+                           "saturation, as the MJCF)")
     command.add_argument("--quantization", action="store_true",
-                         help="the controller sees encoder counts (and their backward difference)")
-    command.add_argument("--format", choices=["json", "csv"], default="json")
+                         help="the controller sees the angles rounded to encoder counts (rad) and their backward "
+                              "difference")
+    command.add_argument("--format", choices=["json", "csv"], default="json", help="output format (default json)")
     command.add_argument("--output", "-o", help="file to write (default: standard output)")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
 
@@ -68,9 +70,9 @@ def _tracking(args: argparse.Namespace):
 
     if args.convention != "report" and args.trajectory is None:
         raise PhantomPinError("--convention: it reads --trajectory; give one")
-    for name in ("theta0", "duration"):
+    for name in ("theta0", "dtheta0", "duration", "rate"):
         if getattr(args, name) is not None:
-            raise PhantomPinError(f"--{name}: --trajectory sets it (its first state and its duration)")
+            raise PhantomPinError(f"--{name}: --trajectory sets it (its first state, its duration and its rate)")
     if args.controller != "none":
         raise PhantomPinError("--controller: --trajectory is the controller")
     t, theta, dtheta, _, tau = io.read_trajectory(args.trajectory)
@@ -83,9 +85,9 @@ def _tracking(args: argparse.Namespace):
 
 def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
     """Run ``phantom-pin simulate``: nothing is written unless the simulation succeeds."""
-    output = Path(args.output) if args.output else None
-    if output is not None and output.exists() and not args.force:
-        raise PhantomPinError(f"--output: {output} exists; add --force to overwrite it")
+    if args.output == "":
+        raise PhantomPinError("--output: empty; give a file name (or no --output for standard output)")
+    output = None if args.output is None else output_path(args.output, args.force, "--output", "--force")
     device = Device(phantom)
     controller = None
     if args.trajectory is not None or args.convention != "report":
@@ -95,6 +97,8 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
         for name in ("theta0", "duration"):
             if getattr(args, name) is None:
                 raise PhantomPinError(f"--{name}: required: --{name} (or --trajectory)")
+        args.dtheta0 = [0.0, 0.0, 0.0] if args.dtheta0 is None else args.dtheta0
+        args.rate = 1000.0 if args.rate is None else args.rate
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
             return phantom.gravity(theta)
@@ -112,12 +116,13 @@ def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
         raise
     finally:
         bar.close()
-    if not device.within_limits(args.theta0):  # after the run: a refused one prints its error alone
+    if not args.no_hard_stops and not device.within_limits(args.theta0):  # after the run: a refused one alone
         print(f"phantom-pin: warning: --theta0 {args.theta0} rad starts beyond the stops, which push it back",
               file=sys.stderr)
     settings = {key: getattr(args, key) for key in ("theta0", "dtheta0", "duration", "rate", "controller",
                                                     "no_friction", "no_hard_stops", "no_saturation", "saturation",
                                                     "quantization")}
+    settings["saturation"] = False if args.no_saturation else args.saturation or device.config.actuation.saturation
     settings["substeps"] = result.substeps
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
     text = _json(result, settings) if args.format == "json" else _csv(result)

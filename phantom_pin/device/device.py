@@ -79,7 +79,8 @@ class Device:
 
     def reachable(self, position: object) -> bool | np.ndarray:
         """True where the tip can reach ``position`` (m, the report's frame s) with every joint
-        inside the real stops: a bool for one position (3,), an (N,) bool array for (N, 3).
+        inside the real stops: a bool for one position (3,), a bool array of the batch's shape
+        for (..., 3).
 
         Candidates are the report's inverse kinematics (eqs 11-20, closed_form, with this
         device's Phantom parameters) on both elbow branches, and the same with axis 1 turned
@@ -87,6 +88,7 @@ class Device:
         tip at the same point), each also shifted by 2 pi in theta2 and theta3.
         """
         target, batch = as_states(position, "position")
+        shape = target.shape[:-1]
         target = target.reshape(-1, 3)
         p = self.config.kinematics
         shoulder = np.array([0.0, p.l2, -p.l1])  # in frame s (eqs 4-5)
@@ -102,7 +104,7 @@ class Device:
                 for theta in (front, back):
                     candidates = theta[:, None, :] + wraps           # (n, 9, 3)
                     found[shell] |= self.within_limits(candidates.reshape(-1, 3)).reshape(-1, 9).any(axis=1)
-        return found if batch else bool(found[0])
+        return found.reshape(shape) if batch else bool(found[0])
 
     def stop_energy(self, theta: object) -> np.ndarray:
         """Potential energy of the stop springs (J): K/2 * sum of squared penetrations of
@@ -127,7 +129,9 @@ class Device:
         q, _ = as_states(theta, "theta")
         v, _ = as_states(dtheta, "dtheta")
         same_batch(("theta", "dtheta"), q, v)
-        return self._stop_torque(q, v)
+        with np.errstate(over="ignore", invalid="ignore"):
+            torque = self._stop_torque(q, v)
+        return finite_result(torque, "theta, dtheta")
 
     def _stop_torque(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
         stops = self.config.limits.stops
@@ -171,8 +175,13 @@ class Device:
         torque, by actuation.yaml's ``saturation`` (config.Actuation.saturation_torque)."""
         return np.array(self.config.actuation.saturation_torque)
 
-    def _limit(self, continuous: bool) -> np.ndarray:
-        return self.continuous_torque if continuous else self.peak_torque
+    def _limit(self, continuous: object) -> np.ndarray:
+        """The continuous or the peak torque limit (N m), as the saturation policies read them
+        (config.Actuation.limit): a model without public motor data has one limit, its
+        joint_torque_limit, for both."""
+        if not isinstance(continuous, (bool, np.bool_)):
+            raise InvalidInputError(f"continuous: expected True or False, got {continuous!r}")
+        return np.array(self.config.actuation.limit("continuous" if continuous else "peak"))
 
     def motor_currents(self, tau: object) -> np.ndarray:
         """Winding currents (A) that give joint torques tau (N m): tau / (ratio * torque_constant).
@@ -198,8 +207,9 @@ class Device:
         Returns (lower, upper), each (..., 3): the motors can add any tau_render with
         lower <= tau_render <= upper while also compensating gravity N(theta), i.e.
         -limit - N <= tau_render <= limit - N, where limit is the continuous torque
-        (``continuous=True``) or the peak torque. Where gravity alone exceeds the limit,
-        upper < 0 or lower > 0.
+        (``continuous=True``) or the peak torque (a model without public motor data, the Touch:
+        its joint_torque_limit for both, as simulate's saturation). Where gravity alone exceeds
+        the limit, upper < 0 or lower > 0.
         """
         gravity = self.phantom.gravity(theta)
         limit = self._limit(continuous)

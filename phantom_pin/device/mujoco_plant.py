@@ -12,7 +12,15 @@ import math
 import numpy as np
 
 from phantom_pin.device.device import Device
-from phantom_pin.device.simulation import MAX_SAMPLES, Controller, SimulationResult, _checked, _positive, arguments
+from phantom_pin.device.simulation import (
+    MAX_SAMPLES,
+    MAX_STEPS,
+    Controller,
+    SimulationResult,
+    _checked,
+    _positive,
+    arguments,
+)
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 
 
@@ -38,15 +46,23 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     if timestep is not None:
         model.opt.timestep = _positive(timestep, "timestep")
     data = mujoco.MjData(model)
+    argument = "rate" if timestep is None else "timestep"
     steps = 1.0 / (rate * model.opt.timestep)
+    if steps > MAX_STEPS:
+        raise InvalidInputError(f"{argument}: {steps:.3g} MuJoCo steps of {model.opt.timestep:g} s per sample at "
+                                f"{rate:g} Hz, more than {MAX_STEPS:.0e}")
     if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-        raise InvalidInputError(f"rate: {rate:g} Hz is not 1 / timestep ({1 / model.opt.timestep:g} Hz) divided by a "
-                                "whole number; pass timestep")
+        raise InvalidInputError(f"{argument}: {rate:g} Hz is not 1 / timestep ({1 / model.opt.timestep:g} Hz) divided "
+                                "by a whole number" + ("; pass timestep" if timestep is None else ""))
     steps = int(round(steps))
     samples = math.floor(duration * rate * (1 + 1e-12)) + 1
     if not 2 <= samples <= MAX_SAMPLES:
         raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples; expected 2 to "
                                 f"{MAX_SAMPLES}")
+    if (samples - 1) * steps > MAX_STEPS:
+        raise InvalidInputError(f"{'duration' if steps == 1 else argument}: {duration:g} s at {rate:g} Hz needs "
+                                f"{(samples - 1) * steps:.3g} MuJoCo steps of {model.opt.timestep:g} s, more than "
+                                f"{MAX_STEPS:.0e} (minutes)")
     coupling = device.phantom.coupling
     names = coupling.tree.names[1:]
     qpos = [model.joint(name).qposadr[0] for name in names]

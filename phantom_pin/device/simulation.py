@@ -55,7 +55,8 @@ class SimulationResult:
     [t[k], t[k+1]) after saturation (the last row is never applied); ``current`` (K, 3) A:
     the winding currents of ``tau`` (None for a model without public motor data). ``tip``
     (K, 3) m: the tip position in the report's
-    frame s. ``rate`` Hz and ``substeps`` (RK4 steps per sample period) describe the run.
+    frame s. ``rate`` Hz and ``substeps`` (RK4 steps per sample period while a stop is
+    engaged, or in every period if given to simulate) describe the run.
     """
 
     t: np.ndarray
@@ -76,10 +77,17 @@ def default_device() -> Device:
 
 
 def _positive(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not math.isfinite(value) or value <= 0:
-        raise InvalidInputError(f"{name}: expected a finite number > 0, got {value!r}")
-    return float(value)
+    """``value`` as a finite float > 0, else InvalidInputError naming ``name`` (an integer
+    beyond the floats included)."""
+    try:
+        number = None if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            else float(value)
+    except OverflowError:
+        number = None
+    if number is None or not math.isfinite(number) or number <= 0:
+        shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
+        raise InvalidInputError(f"{name}: expected a finite number > 0, got {shown}")
+    return number
 
 
 def arguments(theta0: object, dtheta0: object, duration: object, rate: object, controller: object,
@@ -120,6 +128,7 @@ def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool,
     damping = (3 * stops.damping if hard_stops else 0.0) + (law.viscous if friction else 0.0)
     need = max(period * math.sqrt(stiffness / inertia) / OSCILLATION_SCALE,
                period * damping / inertia / DAMPING_SCALE)
+    need = min(need, 2.0 * MAX_STEPS)           # beyond the bound anyway (and no ceil of inf)
     return max(1, math.ceil(need * (1 - 1e-12)), math.ceil(period / MAX_STEP * (1 - 1e-12)))
 
 
@@ -145,9 +154,12 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     clipped to +-Device.saturation_torque (True: actuation.yaml's policy, "continuous" by
     default; "continuous" or "peak" to choose; False: no clipping), as the MJCF's ctrlrange.
     Between samples: fixed-step RK4, one step per period (at most MAX_STEP) away from the stops
-    and ``substeps`` per period while a stop is engaged (default from the stiffest term, see
-    _substeps: 1 at 1 kHz with the shipped numbers); a step in which a stop engages or
-    releases, or a friction mode ends, is cut at the event (regula falsi, MAX_EVENTS per step).
+    and, by default, more while a stop is engaged, from the stiffest term at theta0 (see
+    _substeps: at 1 kHz 1 or 2 for the Premium 1.5, 11 to 18 for the lighter Touch); an
+    explicit ``substeps`` is the number of steps in every period, and must keep them within
+    MAX_STEP. A step in which a stop engages or releases, or a friction mode ends, is cut at
+    the event (regula falsi, MAX_EVENTS per step). A run is refused beyond MAX_SAMPLES samples
+    or MAX_STEPS RK4 steps, counted as if every period were spent on a stop.
 
     ``device``: the Device to simulate (default: the shipped one, built once). ``progress``:
     called with the share of the samples done (0..1), for a progress bar.
@@ -171,21 +183,30 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples, "
                                 f"more than {MAX_SAMPLES}")
     period = 1.0 / rate
+    if progress is not None and not callable(progress):
+        raise InvalidInputError(f"progress: expected a callable (share done, 0..1) or None, got {progress!r}")
+    if period / MAX_STEP > MAX_STEPS:
+        raise InvalidInputError(f"rate: {rate:g} Hz needs {period / MAX_STEP:.3g} RK4 steps (at most {MAX_STEP:g} s "
+                                f"each) per sample period of {period:.3g} s, more than {MAX_STEPS:.0e}")
     fixed = substeps is not None
     free_substeps = max(1, math.ceil(period / MAX_STEP * (1 - 1e-12)))   # RK4 steps away from the stops
     if substeps is None:
         substeps = _substeps(device, theta, period, friction, hard_stops)
     elif isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
         raise InvalidInputError(f"substeps: expected an integer >= 1, got {substeps!r}")
+    elif substeps < free_substeps:
+        raise InvalidInputError(f"substeps: {substeps} gives RK4 steps of {period / substeps:.3g} s at {rate:g} Hz, "
+                                f"longer than {MAX_STEP:g} s (the free arm's accuracy); at least {free_substeps}")
     substeps = int(substeps)
     steps = (samples - 1) * substeps
     if steps > MAX_STEPS:
-        argument = "rate" if substeps > MAX_STEPS else "duration"
+        argument = "substeps" if fixed else "rate" if substeps > MAX_STEPS else "duration"
         raise InvalidInputError(
             f"{argument}: {duration:g} s at {rate:g} Hz needs {steps:.3g} RK4 steps ({samples - 1} periods x "
-            f"{substeps:.3g} substeps of {period / substeps:.2g} s, the step the stiffest term allows: the stops' "
-            f"{device.config.limits.stops.stiffness:g} N m/rad and the friction), more than {MAX_STEPS:.0e} "
-            f"(about 4 minutes)")
+            f"{substeps:.3g} substeps of {period / substeps:.2g} s"
+            + ("" if fixed else f", the step the stiffest term allows on a stop: its "
+               f"{device.config.limits.stops.stiffness:g} N m/rad and the friction; a run counted as if on one")
+            + f"), more than {MAX_STEPS:.0e} (about 4 minutes)")
 
     model = device.phantom.model
     data = model.createData()
@@ -416,6 +437,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                 raise _Diverged
         except _Diverged:
             raise InvalidInputError(_divergence(t, _rows(out_dtheta)[0], _rows(applied), saturation)) from None
+    if progress is not None:
+        progress(1.0)
     theta_out, applied_out = _rows(out_theta), _rows(applied)
     return SimulationResult(
         t=np.arange(samples) / rate, theta=theta_out, dtheta=_rows(out_dtheta), tau=applied_out,
@@ -474,13 +497,16 @@ def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: 
 
 
 def _checked(tau: object, t: float) -> np.ndarray:
-    """The controller's torque as a fresh (3,) float array; InvalidInputError otherwise (complex
-    values included: NumPy would drop their imaginary part with a warning)."""
+    """The controller's torque as a fresh (3,) float array; InvalidInputError otherwise: numbers
+    only (NumPy would read strings and dates as numbers, and drop a complex value's imaginary
+    part with a warning), finite."""
     try:
-        array = None if np.iscomplexobj(tau) else np.array(tau, dtype=float)
+        raw = np.asarray(tau)
+        array = raw.astype(float) if raw.dtype.kind in "iuf" and raw.shape == (3,) else None
     except (TypeError, ValueError):
         array = None
-    if array is None or array.shape != (3,) or not math.isfinite(sum(array.tolist())):
+    values = () if array is None else array.tolist()
+    if array is None or not all(math.isfinite(x) for x in values):
         raise InvalidInputError(f"controller: returned {tau!r} at t = {t:.6g} s; "
                                 f"expected three finite joint torques (N m), shape (3,)")
     return array
