@@ -285,3 +285,14 @@ def test_tip_force_capacity_of_a_huge_direction_and_along_the_straight_arm(devic
     along = closed_form.forward_kinematics(theta, REPORT)[:3, 3] - shoulder
     assert device.tip_force_capacity(theta, along) == np.inf
     assert np.isfinite(device.tip_force_capacity(theta, [0.0, 1.0, 0.0]))
+
+
+def test_huge_input_gives_results_or_errors_without_numpy_warnings(device):
+    """A bad-input pass: 1e308 leaked NumPy's "overflow encountered in multiply"."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert device.reachable([1e308] * 3) is False
+        with pytest.raises(InvalidInputError, match="^theta: too large"):
+            device.encoder_counts([1e308] * 3)

@@ -92,7 +92,8 @@ class Device:
         target = target.reshape(-1, 3)
         p = self.config.kinematics
         shoulder = np.array([0.0, p.l2, -p.l1])  # in frame s (eqs 4-5)
-        distance = np.linalg.norm(target - shoulder, axis=-1)
+        with np.errstate(over="ignore"):          # a huge target is simply out of reach (inf)
+            distance = np.linalg.norm(target - shoulder, axis=-1)
         shell = (distance > abs(p.l1 - p.l2)) & (distance < p.l1 + p.l2)
         found = np.zeros(len(target), dtype=bool)
         if shell.any():
@@ -265,7 +266,8 @@ class Device:
         from wherever it was switched on and needs a calibration offset."""
         self._require("encoder", "encoder_counts")
         q, _ = as_states(theta, "theta")
-        counts = np.rint(q * self._counts_per_radian)
+        with np.errstate(over="ignore"):          # refused below
+            counts = np.rint(q * self._counts_per_radian)
         if np.abs(counts).max() >= 2.0**62:
             raise InvalidInputError("theta: too large, its encoder counts overflow a 64-bit integer")
         return counts.astype(np.int64)
