@@ -122,6 +122,8 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     stop_soft = {"solreflimit": _vec([-device_stops.stiffness / settings.stop_inertia,
                                       -device_stops.damping / settings.stop_inertia]),
                  "solimplimit": _vec(settings.stop_solimp)}
+    friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
+                            settings.friction_solref_damping_ratio])
     urdf = ET.fromstring(urdf_xml)
     srdf = ET.fromstring(srdf_xml)
     mimics = read_mimic_tags(urdf_xml)
@@ -163,8 +165,6 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
         if joint is not None:
             _place(body, joint.find("origin"))
             if joint.get("type") == "revolute":
-                friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
-                                        settings.friction_solref_damping_ratio])
                 ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
                                                                joint.get("name") in mimics, friction_solref,
                                                                stop_ranges.get(joint.get("name")), stop_soft))

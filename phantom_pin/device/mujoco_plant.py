@@ -7,13 +7,10 @@ them). Needs MuJoCo (``pip install phantom_pin[interop]``).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import (
-    MAX_SAMPLES,
     MAX_STEPS,
     Controller,
     SimulationResult,
@@ -40,7 +37,8 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     except ImportError:
         raise MissingDataError("simulate_mujoco: MuJoCo is not installed (pip install phantom_pin[interop])") \
             from None
-    theta, velocity, duration, rate, device = arguments(theta0, dtheta0, duration, rate, controller, device)
+    theta, velocity, duration, rate, device, samples = arguments(theta0, dtheta0, duration, rate, controller,
+                                                                 device)
     description = device.phantom.description
     model = mujoco.MjModel.from_xml_string(description.mjcf)
     if timestep is not None:
@@ -55,10 +53,6 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
         raise InvalidInputError(f"{argument}: {rate:g} Hz is not 1 / timestep ({1 / model.opt.timestep:g} Hz) divided "
                                 "by a whole number" + ("; pass timestep" if timestep is None else ""))
     steps = int(round(steps))
-    samples = math.floor(duration * rate * (1 + 1e-12)) + 1
-    if not 2 <= samples <= MAX_SAMPLES:
-        raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples; expected 2 to "
-                                f"{MAX_SAMPLES}")
     if (samples - 1) * steps > MAX_STEPS:
         raise InvalidInputError(f"{'duration' if steps == 1 else argument}: {duration:g} s at {rate:g} Hz needs "
                                 f"{(samples - 1) * steps:.3g} MuJoCo steps of {model.opt.timestep:g} s, more than "

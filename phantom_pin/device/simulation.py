@@ -91,10 +91,11 @@ def _positive(value: object, name: str) -> float:
 
 
 def arguments(theta0: object, dtheta0: object, duration: object, rate: object, controller: object,
-              device: object) -> tuple[np.ndarray, np.ndarray, float, float, Device]:
+              device: object) -> tuple[np.ndarray, np.ndarray, float, float, Device, int]:
     """The arguments a plant's run shares, checked (InvalidInputError naming the bad one; theta0
-    more than a turn beyond the stops is no posture of the arm): (theta0, dtheta0 or zeros,
-    duration, rate, the Device or the shipped one)."""
+    more than a turn beyond the stops is no posture of the arm; 2 to MAX_SAMPLES samples):
+    (theta0, dtheta0 or zeros, duration, rate, the Device or the shipped one, the number of
+    samples floor(duration * rate) + 1)."""
     theta = as_state(theta0, "theta0").copy()
     velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
     duration, rate = _positive(duration, "duration"), _positive(rate, "rate")
@@ -108,12 +109,19 @@ def arguments(theta0: object, dtheta0: object, duration: object, rate: object, c
     if beyond > 2 * math.pi:
         raise InvalidInputError(f"theta0: {theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a "
                                 "turn: no posture of the arm")
-    return theta, velocity, duration, rate, device
+    samples = math.floor(duration * rate * (1 + 1e-12)) + 1
+    if samples < 2:
+        raise InvalidInputError(f"duration: {duration} s is shorter than one sample period (1 / rate = {1 / rate} s)")
+    if samples > MAX_SAMPLES:
+        raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples, "
+                                f"more than {MAX_SAMPLES}")
+    return theta, velocity, duration, rate, device, samples
 
 
 def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool, hard_stops: bool) -> int:
-    """RK4 substeps per sample period while a stop is engaged: period * OMEGA / OSCILLATION_SCALE
-    and period * RATE / DAMPING_SCALE rounded up, and at least ceil(period / MAX_STEP).
+    """RK4 substeps per sample period the stiff terms ask while a stop is engaged (simulate takes
+    at least its steps of MAX_STEP): period * OMEGA / OSCILLATION_SCALE and period * RATE /
+    DAMPING_SCALE rounded up, at least 1.
 
     OMEGA and RATE bound the stiff terms' linearised rates on the smallest joint inertia m (half
     the smallest eigenvalue of M(theta0), as M varies by about 15 % across the stops): the
@@ -129,7 +137,7 @@ def _substeps(device: Device, theta0: np.ndarray, period: float, friction: bool,
     need = max(period * math.sqrt(stiffness / inertia) / OSCILLATION_SCALE,
                period * damping / inertia / DAMPING_SCALE)
     need = min(need, 2.0 * MAX_STEPS)           # beyond the bound anyway (and no ceil of inf)
-    return max(1, math.ceil(need * (1 - 1e-12)), math.ceil(period / MAX_STEP * (1 - 1e-12)))
+    return max(1, math.ceil(need * (1 - 1e-12)))
 
 
 def simulate(theta0: object, duration: float, controller: Controller | None = None, *,
@@ -173,15 +181,10 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         saturation = bool(saturation)       # np.True_ is not True
     elif saturation not in SATURATIONS:
         raise InvalidInputError(f"saturation: expected True, False, 'continuous' or 'peak', got {saturation!r}")
-    theta, velocity, duration, rate, device = arguments(theta0, dtheta0, duration, rate, controller, device)
+    theta, velocity, duration, rate, device, samples = arguments(theta0, dtheta0, duration, rate, controller,
+                                                                 device)
     if quantization:
         device._require("encoder", "quantization")
-    samples = math.floor(duration * rate * (1 + 1e-12)) + 1
-    if samples < 2:
-        raise InvalidInputError(f"duration: {duration} s is shorter than one sample period (1 / rate = {1 / rate} s)")
-    if samples > MAX_SAMPLES:
-        raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples, "
-                                f"more than {MAX_SAMPLES}")
     period = 1.0 / rate
     if progress is not None and not callable(progress):
         raise InvalidInputError(f"progress: expected a callable (share done, 0..1) or None, got {progress!r}")
@@ -191,7 +194,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     fixed = substeps is not None
     free_substeps = max(1, math.ceil(period / MAX_STEP * (1 - 1e-12)))   # RK4 steps away from the stops
     if substeps is None:
-        substeps = _substeps(device, theta, period, friction, hard_stops)
+        substeps = max(free_substeps, _substeps(device, theta, period, friction, hard_stops))
     elif isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
         raise InvalidInputError(f"substeps: expected an integer >= 1, got {substeps!r}")
     elif substeps < free_substeps:
