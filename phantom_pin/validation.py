@@ -20,21 +20,20 @@ def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, boo
     try:
         array = np.asarray(value)
         if array.dtype.kind == "c":
-            raise InvalidInputError(f"{name}: expected real numbers, got complex values")
+            raise InvalidInputError("expected real numbers, got complex values", argument=name)
         if array.dtype.kind not in "biufO":  # strings, bytes, dates
             raise TypeError(array.dtype)
         array = array.astype(float, copy=False)
     except (TypeError, ValueError) as error:
         if isinstance(error, InvalidInputError):
             raise
-        raise InvalidInputError(f"{name}: expected numbers, got {value!r}") from error
+        raise InvalidInputError(f"expected numbers, got {value!r}", argument=name) from error
     if array.ndim == 0 or array.shape[-1] != width:
-        raise InvalidInputError(
-            f"{name}: expected shape ({width},) or (N, {width}), got {array.shape}")
+        raise InvalidInputError(f"expected shape ({width},) or (N, {width}), got {array.shape}", argument=name)
     if array.size == 0:
-        raise InvalidInputError(f"{name}: expected at least one state, got shape {array.shape}")
+        raise InvalidInputError(f"expected at least one state, got shape {array.shape}", argument=name)
     if not np.isfinite(array).all():
-        raise InvalidInputError(f"{name}: contains NaN or inf")
+        raise InvalidInputError("contains NaN or inf", argument=name)
     return array, array.ndim > 1
 
 
@@ -42,7 +41,7 @@ def as_state(value: object, name: str) -> np.ndarray:
     """Return ``value`` as one float vector of shape (3,); as_states' checks, and no batch."""
     array, batch = as_states(value, name)
     if batch:
-        raise InvalidInputError(f"{name}: expected one vector, shape (3,), got {array.shape}")
+        raise InvalidInputError(f"expected one vector, shape (3,), got {array.shape}", argument=name)
     return array
 
 
@@ -59,7 +58,7 @@ def finite_result(result: np.ndarray, names: str) -> np.ndarray:
     NaN or inf, which finite inputs produce only by overflowing (for example rates of
     1e200 rad/s, whose squares exceed the largest float)."""
     if not np.isfinite(result).all():
-        raise InvalidInputError(f"{names}: too large, the result overflows to inf or NaN")
+        raise InvalidInputError("too large, the result overflows to inf or NaN", argument=names)
     return result
 
 
@@ -83,9 +82,9 @@ def output_path(path: object, force: bool, name: str, force_hint: str = "force=T
     (``force_hint`` says how to ask for overwriting)."""
     output = Path(path)
     if output.is_dir():
-        raise InvalidInputError(f"{name}: {output} is a folder; give a file name")
+        raise InvalidInputError(f"{output} is a folder; give a file name", argument=name)
     if not output.parent.is_dir():
-        raise InvalidInputError(f"{name}: folder {output.parent} does not exist")
+        raise InvalidInputError(f"folder {output.parent} does not exist", argument=name)
     if output.exists() and not force:
-        raise InvalidInputError(f"{name}: {output} exists; use {force_hint} to overwrite it")
+        raise InvalidInputError(f"{output} exists; use {force_hint} to overwrite it", argument=name)
     return output

@@ -106,3 +106,30 @@ def light_grey(pixels: np.ndarray) -> bool:
 
 def red(pixels: np.ndarray) -> bool:
     return bool(np.any((pixels[:, 0] > 140) & (pixels[:, 1] < 90) & (pixels[:, 2] < 90)))
+
+
+def _sdformat() -> bool:
+    found = shutil.which("g++") and shutil.which("pkg-config")
+    return bool(found) and subprocess.run(["pkg-config", "--exists", "sdformat12"]).returncode == 0
+
+
+#: The Debian packages some tests need (pytest markers), how to tell they are there, and the
+#: one line said when one is missing: the test fails with it (CI installs them all and runs
+#: every test; nothing is skipped).
+REQUIREMENTS = {
+    "chromium": (lambda: bool(shutil.which("chromium")),
+                 "Debian's chromium renders the viewer's HTML: apt-get install chromium (.ci/run installs it)"),
+    "sdformat": (_sdformat, "Gazebo's URDF parser is missing: apt-get install libsdformat-dev g++ pkg-config "
+                            "(.ci/run installs them)"),
+    "colcon": (lambda: bool(shutil.which("colcon", path="/usr/bin") and shutil.which("cmake")),
+               "Debian's colcon and ament_cmake build the ROS 2 package: apt-get install colcon "
+               "python3-colcon-cmake ament-cmake cmake (.ci/run installs them)"),
+}
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    for marker in item.iter_markers():
+        if marker.name in REQUIREMENTS:
+            present, missing = REQUIREMENTS[marker.name]
+            if not present():
+                pytest.fail(missing, pytrace=False)

@@ -115,6 +115,7 @@ def test_trajectory_torques_follow_the_minimum_jerk_path_and_the_closed_form(tmp
     assert np.abs(r["torque"] - expected).max() < 1e-9 * np.abs(expected).max()
 
 
+@pytest.mark.chromium
 def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
     """The page renders the arm at one of the sweep's postures (the browser's clock decides
     which; test_viewer checks the timing of animations): at that posture the black tip ball is

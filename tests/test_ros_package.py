@@ -13,8 +13,13 @@ import types
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import pytest
+
 from phantom_pin.config import MODELS
 from phantom_pin.paths import DESCRIPTION_DIR
+
+#: Debian's python, which has ament_package (python3-ament-package, with ament-cmake).
+SYSTEM_PYTHON = "/usr/bin/python3"
 
 
 def test_every_installed_folder_exists_and_holds_files():
@@ -87,18 +92,24 @@ def test_launch_file_shows_each_committed_robot(monkeypatch):
     assert argument.default_value == "phantom_1_5"
 
 
+@pytest.mark.colcon
 def test_colcon_builds_and_installs_the_package_and_xacro_reproduces_the_urdfs(tmp_path):
     """Debian's colcon and ament_cmake (.ci/run installs them) build the package; the installed
     tree holds every installed folder's files unchanged, and plain xacro on each installed
-    top-level xacro gives the committed URDF (comments aside: xacro's banner names its input)."""
+    top-level xacro gives the committed URDF (comments aside: xacro's banner names its input).
+
+    Built as from an activated virtual environment (VIRTUAL_ENV set, its python first on PATH,
+    as `. .venv/bin/activate && pytest` runs it): CMake's FindPython would then take the venv's
+    python, which lacks ament_package, so the build names /usr/bin/python3 (Debian's, which has
+    it) for CMake and puts /usr/bin first on PATH."""
     colcon = shutil.which("colcon", path="/usr/bin")
-    assert colcon, "Debian's colcon is needed: .ci/run installs colcon, python3-colcon-cmake, ament-cmake, cmake"
     shutil.copytree(DESCRIPTION_DIR, tmp_path / "src" / "phantom_description")
-    # ament_cmake runs /usr/bin/python3's ament_package: that python must come first on PATH
-    environment = {**os.environ, "PATH": "/usr/bin:" + os.environ["PATH"]}
+    venv = Path(sys.prefix)
+    environment = {**os.environ, "VIRTUAL_ENV": str(venv),
+                   "PATH": f"/usr/bin:{venv / 'bin'}:{os.environ['PATH']}"}
     build = subprocess.run([colcon, "build", "--base-paths", "src", "--build-base", "build",
-                            "--install-base", "install"], cwd=tmp_path, env=environment,
-                           capture_output=True, text=True)
+                            "--install-base", "install", "--cmake-args", f"-DPython3_EXECUTABLE={SYSTEM_PYTHON}"],
+                           cwd=tmp_path, env=environment, capture_output=True, text=True)
     assert build.returncode == 0, build.stdout + build.stderr
     share = tmp_path / "install" / "phantom_description" / "share" / "phantom_description"
     for folder in ("config", "launch", "mjcf", "srdf", "urdf"):

@@ -27,6 +27,7 @@ def tip_frame(viewer: Viewer, theta: np.ndarray) -> tuple[pin.SE3, pin.SE3]:
     return frame_pose(model, theta, "tip"), frame_pose(model, theta, "report_s")
 
 
+@pytest.mark.chromium
 def test_two_postures_are_visible_where_kinematics_put_them(viewer, tmp_path):
     images = {}
     for name, theta in (("resting", RESTING), ("raised", RAISED)):
@@ -41,6 +42,7 @@ def test_two_postures_are_visible_where_kinematics_put_them(viewer, tmp_path):
     assert changed.mean() > 0.01
 
 
+@pytest.mark.chromium
 def test_tip_frame_and_force_arrow_are_drawn(viewer, tmp_path):
     force = np.array([0.0, -2.0, 1.0])  # N, in frame s
     viewer.set_force(force)
@@ -54,6 +56,7 @@ def test_tip_frame_and_force_arrow_are_drawn(viewer, tmp_path):
     assert red(patch(image, tip.translation + tip.rotation @ [0.03, 0.0, 0.0]))  # the x axis
 
 
+@pytest.mark.chromium
 def test_animation_plays_in_the_exported_page(viewer, tmp_path):
     """Hold RESTING for 30 s, then move to RAISED: two seconds after loading, the page
     shows RESTING although the scene's own (static) state is the last posture."""

@@ -86,7 +86,7 @@ def _positive(value: object, name: str) -> float:
         number = None
     if number is None or not math.isfinite(number) or number <= 0:
         shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
-        raise InvalidInputError(f"{name}: expected a finite number > 0, got {shown}")
+        raise InvalidInputError(f"expected a finite number > 0, got {shown}", argument=name)
     return number
 
 
@@ -100,21 +100,23 @@ def arguments(theta0: object, dtheta0: object, duration: object, rate: object, c
     velocity = np.zeros(3) if dtheta0 is None else as_state(dtheta0, "dtheta0").copy()
     duration, rate = _positive(duration, "duration"), _positive(rate, "rate")
     if controller is not None and not callable(controller):
-        raise InvalidInputError(f"controller: expected a callable (t, theta, dtheta) -> tau, got {controller!r}")
+        raise InvalidInputError(f"expected a callable (t, theta, dtheta) -> tau, got {controller!r}",
+                                argument="controller")
     if device is None:
         device = default_device()
     elif not isinstance(device, Device):
-        raise InvalidInputError(f"device: expected a phantom_pin.Device or None, got {device!r}")
+        raise InvalidInputError(f"expected a phantom_pin.Device or None, got {device!r}", argument="device")
     beyond = float(np.abs(device.config.limits.stops.penetration(theta)).max())
     if beyond > 2 * math.pi:
-        raise InvalidInputError(f"theta0: {theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a "
-                                "turn: no posture of the arm")
+        raise InvalidInputError(f"{theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a "
+                                "turn: no posture of the arm", argument="theta0")
     samples = math.floor(duration * rate * (1 + 1e-12)) + 1
     if samples < 2:
-        raise InvalidInputError(f"duration: {duration} s is shorter than one sample period (1 / rate = {1 / rate} s)")
+        raise InvalidInputError(f"{duration} s is shorter than one sample period (1 / rate = {1 / rate} s)",
+                                argument="duration")
     if samples > MAX_SAMPLES:
-        raise InvalidInputError(f"duration: {duration} s at {rate} Hz gives {samples} samples, "
-                                f"more than {MAX_SAMPLES}")
+        raise InvalidInputError(f"{duration} s at {rate} Hz gives {samples} samples, "
+                                f"more than {MAX_SAMPLES}", argument="duration")
     return theta, velocity, duration, rate, device, samples
 
 
@@ -176,40 +178,44 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     """
     for name, flag in (("friction", friction), ("hard_stops", hard_stops), ("quantization", quantization)):
         if not isinstance(flag, (bool, np.bool_)):
-            raise InvalidInputError(f"{name}: expected True or False, got {flag!r}")
+            raise InvalidInputError(f"expected True or False, got {flag!r}", argument=name)
     if isinstance(saturation, (bool, np.bool_)):
         saturation = bool(saturation)       # np.True_ is not True
     elif saturation not in SATURATIONS:
-        raise InvalidInputError(f"saturation: expected True, False, 'continuous' or 'peak', got {saturation!r}")
+        raise InvalidInputError(f"expected True, False, 'continuous' or 'peak', got {saturation!r}",
+                                argument="saturation")
     theta, velocity, duration, rate, device, samples = arguments(theta0, dtheta0, duration, rate, controller,
                                                                  device)
     if quantization:
         device._require("encoder", "quantization")
     period = 1.0 / rate
     if progress is not None and not callable(progress):
-        raise InvalidInputError(f"progress: expected a callable (share done, 0..1) or None, got {progress!r}")
+        raise InvalidInputError(f"expected a callable (share done, 0..1) or None, got {progress!r}",
+                                argument="progress")
     if period / MAX_STEP > MAX_STEPS:
-        raise InvalidInputError(f"rate: {rate:g} Hz needs {period / MAX_STEP:.3g} RK4 steps (at most {MAX_STEP:g} s "
-                                f"each) per sample period of {period:.3g} s, more than {MAX_STEPS:.0e}")
+        raise InvalidInputError(f"{rate:g} Hz needs {period / MAX_STEP:.3g} RK4 steps (at most {MAX_STEP:g} s "
+                                f"each) per sample period of {period:.3g} s, more than {MAX_STEPS:.0e}",
+                                argument="rate")
     fixed = substeps is not None
     free_substeps = max(1, math.ceil(period / MAX_STEP * (1 - 1e-12)))   # RK4 steps away from the stops
     if substeps is None:
         substeps = max(free_substeps, _substeps(device, theta, period, friction, hard_stops))
     elif isinstance(substeps, bool) or not isinstance(substeps, (int, np.integer)) or substeps < 1:
-        raise InvalidInputError(f"substeps: expected an integer >= 1, got {substeps!r}")
+        raise InvalidInputError(f"expected an integer >= 1, got {substeps!r}", argument="substeps")
     elif substeps < free_substeps:
-        raise InvalidInputError(f"substeps: {substeps} gives RK4 steps of {period / substeps:.3g} s at {rate:g} Hz, "
-                                f"longer than {MAX_STEP:g} s (the free arm's accuracy); at least {free_substeps}")
+        raise InvalidInputError(f"{substeps} gives RK4 steps of {period / substeps:.3g} s at {rate:g} Hz, "
+                                f"longer than {MAX_STEP:g} s (the free arm's accuracy); at least {free_substeps}",
+                                argument="substeps")
     substeps = int(substeps)
     steps = (samples - 1) * substeps
     if steps > MAX_STEPS:
         argument = "substeps" if fixed else "rate" if substeps > MAX_STEPS else "duration"
         raise InvalidInputError(
-            f"{argument}: {duration:g} s at {rate:g} Hz needs {steps:.3g} RK4 steps ({samples - 1} periods x "
+            f"{duration:g} s at {rate:g} Hz needs {steps:.3g} RK4 steps ({samples - 1} periods x "
             f"{substeps:.3g} substeps of {period / substeps:.2g} s"
             + ("" if fixed else f", the step the stiffest term allows on a stop: its "
                f"{device.config.limits.stops.stiffness:g} N m/rad and the friction; a run counted as if on one")
-            + f"), more than {MAX_STEPS:.0e} (about 4 minutes)")
+            + f"), more than {MAX_STEPS:.0e} (about 4 minutes)", argument=argument)
 
     model = device.phantom.model
     data = model.createData()
@@ -510,6 +516,6 @@ def _checked(tau: object, t: float) -> np.ndarray:
         array = None
     values = () if array is None else array.tolist()
     if array is None or not all(math.isfinite(x) for x in values):
-        raise InvalidInputError(f"controller: returned {tau!r} at t = {t:.6g} s; "
-                                f"expected three finite joint torques (N m), shape (3,)")
+        raise InvalidInputError(f"returned {tau!r} at t = {t:.6g} s; "
+                                f"expected three finite joint torques (N m), shape (3,)", argument="controller")
     return array

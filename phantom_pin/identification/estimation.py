@@ -149,9 +149,9 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Sa
     with unit coefficients), edges cut, decimated (module doc, step 1); ``timing`` (TIMINGS)."""
     rate = log.rate
     if not 0 < cutoff * RATE_PER_CUTOFF <= rate:
-        raise LogError(f"cutoff: {cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
+        raise LogError(f"{cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
                        f"(this one: {rate:.4g} Hz; central differences need {RATE_PER_CUTOFF:g} samples per "
-                       "second per hertz of cutoff); lower --cutoff or log faster")
+                       "second per hertz of cutoff); lower --cutoff or log faster", argument="cutoff")
     sos = scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
     theta = scipy.signal.sosfiltfilt(sos, log.theta, axis=0)
     tau = scipy.signal.sosfiltfilt(sos, log.tau, axis=0)
@@ -233,22 +233,23 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
             progress(share)
 
     if not isinstance(log, Log):
-        raise InvalidInputError(f"log: expected a phantom_pin.identification.Log (read_log), got {log!r}")
+        raise InvalidInputError(f"expected a phantom_pin.identification.Log (read_log), got {log!r}", argument="log")
     if not isinstance(phantom, Phantom):
-        raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, got {phantom!r}")
+        raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
     for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
-            raise InvalidInputError(f"{name}: expected a finite number > 0, got {value!r}")
+            raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
     if progress is not None and not callable(progress):
-        raise InvalidInputError(f"progress: expected a callable (share) or None, got {progress!r}")
+        raise InvalidInputError(f"expected a callable (share) or None, got {progress!r}", argument="progress")
     duration = float(log.t[-1] - log.t[0])
     if cutoff * duration < MIN_CYCLES:
-        raise LogError(f"cutoff: {cutoff:g} Hz is too low for a {duration:.3g} s log (the filter needs at least "
-                       f"{MIN_CYCLES:g} of its periods in the log: {MIN_CYCLES / duration:.3g} Hz or more)")
+        raise LogError(f"{cutoff:g} Hz is too low for a {duration:.3g} s log (the filter needs at least "
+                       f"{MIN_CYCLES:g} of its periods in the log: {MIN_CYCLES / duration:.3g} Hz or more)",
+                       argument="cutoff")
     if timing not in TIMINGS:
-        raise InvalidInputError(f"timing: expected one of {', '.join(TIMINGS)}, got {timing!r}")
+        raise InvalidInputError(f"expected one of {', '.join(TIMINGS)}, got {timing!r}", argument="timing")
     if structure not in STRUCTURES:
-        raise InvalidInputError(f"structure: expected one of {', '.join(STRUCTURES)}, got {structure!r}")
+        raise InvalidInputError(f"expected one of {', '.join(STRUCTURES)}, got {structure!r}", argument="structure")
     constant = [f"tau{j + 1}" for j in range(3) if np.ptp(log.tau[:, j]) == 0]
     if constant:
         raise LogError(f"{', '.join(constant)}: constant torque{'s' if len(constant) > 1 else ''} over the whole "

@@ -10,6 +10,7 @@ import re
 import signal
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import meshcat
@@ -78,6 +79,7 @@ class Viewer:
 
     def __init__(self, robot: pin.RobotWrapper | None = None) -> None:
         self.robot = load() if robot is None else robot
+        self._guarded = False  # within stop_on_signals
         self.server = MeshcatServer()
         try:
             with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL
@@ -207,28 +209,48 @@ class Viewer:
         output.write_text(_in_order(self.scene.static_html()), encoding="utf-8")
         return output
 
-    def wait(self) -> None:
-        """Block until Ctrl-C (SIGINT) or SIGTERM, keeping the live viewer served; raise
-        PhantomPinError if the server process ends first.
+    @contextlib.contextmanager
+    def stop_on_signals(self) -> Iterator[None]:
+        """A block that the first SIGINT (Ctrl-C) or SIGTERM ends quietly, wherever it is in
+        the block; a later signal within it is ignored, so that clean-up in the block (for
+        example ``close()`` in a ``finally``) runs to its end.
 
-        In the main thread it listens to both signals itself while it waits, even where the
-        parent started it with SIGINT ignored (as background jobs and some CI shells do, and
-        as Python then leaves it), and restores the previous handlers afterwards."""
+        In the main thread it installs its own handlers, even where the parent started the
+        process with SIGINT ignored (as background jobs and some CI shells do, and as Python
+        then leaves it), and restores the previous ones when the block ends. Elsewhere it
+        installs nothing (Python delivers signals to the main thread only). Nested in
+        another such block, it leaves the signals to the outer one."""
+        if self._guarded:
+            yield
+            return
+        fired = False
+
         def interrupt(*_: object) -> None:
-            raise KeyboardInterrupt
+            nonlocal fired
+            if not fired:
+                fired = True
+                raise KeyboardInterrupt
 
         handlers = {}
         if threading.current_thread() is threading.main_thread():
             handlers = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+        self._guarded = True
         try:
-            while self.server.running:
-                time.sleep(0.5)
+            yield
         except KeyboardInterrupt:
-            return
+            pass
         finally:
+            self._guarded = False
             for sig, handler in handlers.items():
                 signal.signal(sig, handler)
-        raise PhantomPinError(f"the meshcat server stopped (exit code {self.server.process.returncode})")
+
+    def wait(self) -> None:
+        """Block until Ctrl-C (SIGINT) or SIGTERM, keeping the live viewer served (within
+        ``stop_on_signals``); raise PhantomPinError if the server process ends first."""
+        with self.stop_on_signals():
+            while self.server.running:
+                time.sleep(0.5)
+            raise PhantomPinError(f"the meshcat server stopped (exit code {self.server.process.returncode})")
 
     def close(self) -> None:
         """Stop the meshcat server; idempotent."""

@@ -1,6 +1,4 @@
-"""The device's part of the phantom-pin command line: `simulate`, and the device data of `info`.
-
-phantom_pin.cli registers these; the handlers live here."""
+"""The device's commands of ``phantom-pin``: ``simulate``, and the device data of ``info``."""
 
 from __future__ import annotations
 
@@ -9,30 +7,36 @@ import dataclasses
 import json
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from phantom_pin import drivers
+from phantom_pin.cli.common import output, phantom, warn
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification.simulation import KD, KP
+from phantom_pin.identification import io
+from phantom_pin.identification.simulation import KD, KP, tracking
 from phantom_pin.progress import Progress
-from phantom_pin.validation import output_path
 
 #: simulate()'s arguments that are options of the command (its errors name them).
-OPTIONS = ("theta0", "dtheta0", "duration", "rate", "quantization")
+OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization")}
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}
+#: The output formats, by the file's extension.
+FORMATS = {".json": "json", ".csv": "csv"}
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:
-    """Register ``phantom-pin simulate``."""
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    """``phantom-pin simulate``."""
     three = {"nargs": 3, "type": float}
     command = sub.add_parser("simulate", help="a controller sampled at --rate driving the device "
                                               "(friction, stops, saturation), as JSON or CSV")
+    command.set_defaults(run=simulate_command, options=OPTIONS)
     command.add_argument("--theta0", metavar="T", help="initial posture (rad); required without --trajectory",
                          **three)
     command.add_argument("--dtheta0", metavar="W", help="initial rates (rad/s, default 0 0 0)", **three)
@@ -41,12 +45,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                          help="track excite's CSV: its torque as feed-forward plus PD "
                               f"({KP:g} N m/rad, {KD:g} N m s/rad), from its first state, "
                               "at its rate, for its duration; the CSV output is a log that identify reads")
-    command.add_argument("--convention", choices=["report", "openhaptics"], default="report",
+    command.add_argument("--convention", choices=["report", "openhaptics"],
                          help="the --trajectory file's columns: the report's theta (rad) and N m (default), or "
                               "OpenHaptics' joint angles (rad) and joint torques (mN m), as excite writes "
                               "them with --convention openhaptics; the output is in the report's terms")
     command.add_argument("--rate", type=float, help="controller rate (Hz, default 1000)")
-    command.add_argument("--controller", choices=["none", "gravity"], default="none",
+    command.add_argument("--controller", choices=["none", "gravity"],
                          help="zero torque (default), or gravity compensation N(theta) from the Phantom")
     command.add_argument("--no-friction", action="store_true", help="no joint friction (viscous and Coulomb)")
     command.add_argument("--no-hard-stops", action="store_true", help="no stops (the joints turn freely)")
@@ -58,82 +62,104 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--quantization", action="store_true",
                          help="the controller sees the angles rounded to encoder counts (rad) and their backward "
                               "difference")
-    command.add_argument("--format", choices=["json", "csv"], default="json", help="output format (default json)")
+    command.add_argument("--format", choices=["json", "csv"],
+                         help="output format (default: the --output file's extension, .json or .csv; json on "
+                              "standard output)")
     command.add_argument("--output", "-o", help="file to write (default: standard output)")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
 
 
-def _tracking(args: argparse.Namespace):
-    """The controller, start and timing that follow --trajectory: feed-forward plus PD."""
-    from phantom_pin import drivers
-    from phantom_pin.identification import io, simulation
+def _format(args: argparse.Namespace) -> str:
+    """The output format: --format, else the --output file's extension, else json; a
+    mismatch between the two is refused before the run."""
+    if args.output is None:
+        return args.format or "json"
+    by_extension = FORMATS.get(Path(args.output).suffix.lower())
+    if args.format is None:
+        if by_extension is None:
+            raise PhantomPinError(f"{args.output} has no .json or .csv extension; give --format json or csv",
+                                  argument="--output")
+        return by_extension
+    if by_extension is not None and by_extension != args.format:
+        raise PhantomPinError(f"{args.format} into {args.output}, a {Path(args.output).suffix} file; give one "
+                              f"format", argument="--format")
+    return args.format
 
-    if args.convention != "report" and args.trajectory is None:
-        raise PhantomPinError("--convention: it reads --trajectory; give one")
+
+@dataclasses.dataclass(frozen=True)
+class _Run:
+    """What one simulate command runs: its start (rad, rad/s), duration (s), rate (Hz) and controller."""
+
+    theta0: list[float]
+    dtheta0: list[float]
+    duration: float
+    rate: float
+    controller: Callable[[float, np.ndarray, np.ndarray], object] | None
+
+
+def _tracking(args: argparse.Namespace) -> _Run:
+    """The controller, start and timing that follow --trajectory: feed-forward plus PD."""
     for name in ("theta0", "dtheta0", "duration", "rate"):
         if getattr(args, name) is not None:
-            raise PhantomPinError(f"--{name}: --trajectory sets it (its first state, its duration and its rate)")
-    if args.controller != "none":
-        raise PhantomPinError("--controller: --trajectory is the controller")
+            raise PhantomPinError("--trajectory sets it (its first state, its duration and its rate)",
+                                  argument="--" + name)
+    if args.controller is not None:
+        raise PhantomPinError("--trajectory is the controller", argument="--controller")
     t, theta, dtheta, _, tau = io.read_trajectory(args.trajectory)
     if args.convention == "openhaptics":  # a linear map: rates as angles
         theta, dtheta = drivers.theta_from_openhaptics(theta), drivers.theta_from_openhaptics(dtheta)
         tau = drivers.tau_from_openhaptics_torque(tau)
     rate = (len(t) - 1) / (t[-1] - t[0])
-    return simulation.tracking(t, theta, dtheta, tau), theta[0], dtheta[0], float(t[-1] - t[0]), rate
+    return _Run(theta[0].tolist(), dtheta[0].tolist(), float(t[-1] - t[0]), rate, tracking(t, theta, dtheta, tau))
 
 
-def simulate_command(args: argparse.Namespace, phantom: Phantom) -> int:
-    """Run ``phantom-pin simulate``: nothing is written unless the simulation succeeds."""
-    if args.output == "":
-        raise PhantomPinError("--output: empty; give a file name (or no --output for standard output)")
-    output = None if args.output is None else output_path(args.output, args.force, "--output", "--force")
-    device = Device(phantom)
+def _free(args: argparse.Namespace, robot: Phantom) -> _Run:
+    """The start, timing and controller of --theta0, --dtheta0, --duration, --rate and --controller."""
+    if args.convention is not None:
+        raise PhantomPinError("it reads --trajectory; give one", argument="--convention")
+    for name in ("theta0", "duration"):
+        if getattr(args, name) is None:
+            raise PhantomPinError(f"required: --{name} (or --trajectory)", argument="--" + name)
     controller = None
-    if args.trajectory is not None or args.convention != "report":
-        controller, theta0, dtheta0, duration, rate = _tracking(args)
-        args.theta0, args.dtheta0, args.duration, args.rate = theta0.tolist(), dtheta0.tolist(), duration, rate
-    else:
-        for name in ("theta0", "duration"):
-            if getattr(args, name) is None:
-                raise PhantomPinError(f"--{name}: required: --{name} (or --trajectory)")
-        args.dtheta0 = [0.0, 0.0, 0.0] if args.dtheta0 is None else args.dtheta0
-        args.rate = 1000.0 if args.rate is None else args.rate
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
-            return phantom.gravity(theta)
+            return robot.gravity(theta)
+    return _Run(args.theta0, [0.0, 0.0, 0.0] if args.dtheta0 is None else args.dtheta0, args.duration,
+                1000.0 if args.rate is None else args.rate, controller)
+
+
+def simulate_command(args: argparse.Namespace) -> int:
+    """Run ``phantom-pin simulate``: nothing is written unless the simulation succeeds."""
+    target = None if args.output is None else output(args)
+    form = _format(args)
+    robot = phantom(args)
+    device = Device(robot)
+    run = _tracking(args) if args.trajectory is not None else _free(args, robot)
     bar = Progress("simulate", 1.0, enabled=False if args.quiet else None)
     try:
-        result = simulate(args.theta0, args.duration, controller, dtheta0=args.dtheta0, rate=args.rate,
+        result = simulate(run.theta0, run.duration, run.controller, dtheta0=run.dtheta0, rate=run.rate,
                           friction=not args.no_friction, hard_stops=not args.no_hard_stops,
                           saturation=False if args.no_saturation else args.saturation or True,
-                          quantization=args.quantization, device=device,
-                          progress=bar.update)
-    except PhantomPinError as error:  # name the option, not simulate()'s argument
-        name, _, rest = str(error).partition(":")
-        if name in OPTIONS and rest:
-            raise PhantomPinError(f"--{name}:{rest}") from None
-        raise
+                          quantization=args.quantization, device=device, progress=bar.update)
     finally:
         bar.close()
-    if not args.no_hard_stops and not device.within_limits(args.theta0):  # after the run: a refused one alone
-        print(f"phantom-pin: warning: --theta0 {args.theta0} rad starts beyond the stops, which push it back",
-              file=sys.stderr)
-    settings = {key: getattr(args, key) for key in ("theta0", "dtheta0", "duration", "rate", "controller",
-                                                    "no_friction", "no_hard_stops", "no_saturation", "saturation",
-                                                    "quantization")}
+    if not args.no_hard_stops and not device.within_limits(run.theta0):  # after the run: a refused one alone
+        warn(f"--theta0 {run.theta0} rad starts beyond the stops, which push it back")
+    settings = dataclasses.asdict(run) | {key: getattr(args, key) for key in (
+        "controller", "no_friction", "no_hard_stops", "no_saturation", "saturation", "quantization")}
+    settings["controller"] = args.controller or "none"
     settings["saturation"] = False if args.no_saturation else args.saturation or device.config.actuation.saturation
     settings["substeps"] = result.substeps
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
-    text = _json(result, settings) if args.format == "json" else _csv(result)
-    if output is None:
+    text = _json(result, settings) if form == "json" else _csv(result)
+    if target is None:
         sys.stdout.write(text)
         return 0
     try:
-        output.write_text(text)
+        target.write_text(text)
     except OSError as error:
-        raise PhantomPinError(f"--output: cannot write {output} ({error.strerror})") from None
-    print(f"wrote {output} ({len(result.t)} samples)")
+        raise PhantomPinError(f"cannot write {target} ({error.strerror})", argument="--output") from None
+    print(f"wrote {target} ({len(result.t)} samples)")
     return 0
 
 

@@ -1,4 +1,4 @@
-"""The handlers of ``phantom-pin excite`` and ``phantom-pin identify`` (registered in cli.py)."""
+"""The identification's commands of ``phantom-pin``: excite and identify."""
 
 from __future__ import annotations
 
@@ -9,7 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
+from phantom_pin import drivers
+from phantom_pin.cli.common import description, overrides
+from phantom_pin.description.build import describe
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.identification import estimation, excitation, io
 from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
@@ -44,6 +49,7 @@ def _writable(path: Path) -> None:
 def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add the excite and identify subcommands to the phantom-pin parser."""
     excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
+    excite.set_defaults(run=excite_command)
     excite.add_argument("--output", "-o", required=True, type=Path)
     excite.add_argument("--duration", type=float, default=20.0,
                         help="seconds of trajectory, rounded up to whole periods (default 20)")
@@ -59,6 +65,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
+    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
@@ -75,12 +82,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                "or OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad) and joint torques (mN m)")
 
 
-def excite(args: argparse.Namespace, phantom) -> int:
-    """phantom-pin excite, for the configuration of ``phantom`` (--model or --config)."""
-    from phantom_pin import drivers
-    from phantom_pin.identification import excitation, io
-
-    description = phantom.description
+def excite_command(args: argparse.Namespace) -> int:
+    """phantom-pin excite, for the configuration of --model or --config (and the overrides)."""
     _refuse(args.output, args.force)
     for name in ("duration", "rate", "period"):
         value = getattr(args, name)
@@ -104,6 +107,8 @@ def excite(args: argparse.Namespace, phantom) -> int:
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1
     _writable(args.output)
+    made = description(args)
+    phantom = Phantom(made)
     times = np.arange(rows) / args.rate
     bar = Progress("excite", 1.0, enabled=False if args.quiet else None)
     try:
@@ -115,13 +120,13 @@ def excite(args: argparse.Namespace, phantom) -> int:
         bar.close()
     t = times
     theta, dtheta, ddtheta = result.trajectory(t)
-    tau = phantom.inverse_dynamics(theta, dtheta, ddtheta) + description.config.actuation.friction.torque(dtheta)
+    tau = phantom.inverse_dynamics(theta, dtheta, ddtheta) + made.config.actuation.friction.torque(dtheta)
     peak = np.abs(tau).max(axis=0)
     if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
         theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
         tau = drivers.openhaptics_torque_from_tau(tau)
     io.write_csv(args.output, io.TRAJECTORY_COLUMNS, np.column_stack([t, theta, dtheta, ddtheta, tau]))
-    effort = excitation.continuous_effort(description)
+    effort = excitation.continuous_effort(made)
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
           f"{args.harmonics} harmonics per joint" + (", in OpenHaptics' joint angles (rad) and joint torques "
                                                     "(mN m)" if args.convention == "openhaptics" else ""))
@@ -134,16 +139,15 @@ def excite(args: argparse.Namespace, phantom) -> int:
     return 0
 
 
-def identify(args: argparse.Namespace, phantom) -> int:
-    """phantom-pin identify, for the configuration of ``phantom`` (--model, --config, --params)."""
-    from phantom_pin.description.build import describe
-    from phantom_pin.identification import estimation, io
-
+def identify_command(args: argparse.Namespace) -> int:
+    """phantom-pin identify, for the configuration of --model or --config (and the overrides)."""
     _refuse(args.output, args.force)
     _writable(args.output)
+    given = overrides(args)
+    phantom = Phantom(description(args, given))
     if args.structure == "report" and phantom.config.report is None:
-        given = " with its --params/--set overrides" if getattr(args, "overrides", None) else ""
-        raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name}{given} "
+        how = " with its --params/--set overrides" if given else ""
+        raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name}{how} "
                               "gives its links in full (use --structure general)")
     if not (math.isfinite(args.cutoff) and args.cutoff > 0):
         raise PhantomPinError(f"--cutoff: expected a finite positive frequency (Hz), got {args.cutoff!r}")
@@ -152,15 +156,11 @@ def identify(args: argparse.Namespace, phantom) -> int:
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
                                   timing=args.torque_timing)
-    except PhantomPinError as error:                     # name the option, not estimate()'s argument
-        message = str(error)
-        raise PhantomPinError("--" + message if message.startswith("cutoff:") else message) from None
     finally:
         bar.close()
     if fit.problems and not args.force:
         more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
         raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--force writes it anyway)")
-    given = getattr(args, "overrides", {})
     keys, notes = io.overlay(fit, given)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)

@@ -1,0 +1,163 @@
+"""What every command of ``phantom-pin`` shares: the parser class, the model options
+(--model, --config, --params, --set) turned into a Description or a Phantom, output files,
+printing and warnings."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+from phantom_pin.config import DEFAULT, models, read_overrides
+from phantom_pin.description.build import Description, describe, description_of
+from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.validation import output_path, within_box
+
+#: The options that choose the model, accepted before or after the command (dest: option).
+MODEL_OPTIONS = {"model": "--model", "config": "--config", "params": "--params", "set": "--set"}
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (PhantomPinError, printed by main) and numbers with
+    exponents, such as -1e-3, taken as values rather than options."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        # argparse takes "-1e-3" for an option unless it looks like a negative number; its
+        # own pattern knows no exponents. No option of ours looks like a number.
+        self._negative_number_matcher = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+
+    def error(self, message: str) -> Any:  # reported by main as one line, exit code 2
+        raise PhantomPinError(f"{self.prog.removeprefix('phantom-pin').strip() or 'usage'}: {message}")
+
+
+class Once(argparse.Action):
+    """An option that may be given once: a second --model is refused, not silently taken."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
+                 option_string: str | None = None) -> None:
+        if given(namespace, self.dest):
+            raise PhantomPinError("given twice; give it once", argument=option_string)
+        setattr(namespace, "_given_" + self.dest, True)
+        setattr(namespace, self.dest, values)
+
+
+def given(args: argparse.Namespace, dest: str) -> bool:
+    """Whether the option of ``dest`` was given on the command line (not its default)."""
+    return bool(getattr(args, "_given_" + dest, False))
+
+
+def add_model_options(parser: argparse.ArgumentParser, suffix: str = "") -> None:
+    """--model, --config, --params and --set on ``parser``; ``suffix`` distinguishes the
+    copies after the command (their dests end with it and default to absent)."""
+    absent: dict[str, Any] = {"default": argparse.SUPPRESS} if suffix else {}
+    parser.add_argument("--model", dest="model" + suffix, action=Once, **(absent or {"default": DEFAULT}),
+                        help=f"a named configuration: {', '.join(models())} (default {DEFAULT})")
+    parser.add_argument("--config", dest="config" + suffix, type=Path, action=Once, **absent,
+                        help="instead of --model, a folder of parameter files (see robots/phantom_description/config)")
+    parser.add_argument("--params", dest="params" + suffix, type=Path, action=Once, **absent,
+                        help="a YAML file of overrides, e.g. identify's (applied before --set)")
+    parser.add_argument("--set", dest="set" + suffix, action="append", metavar="KEY=VALUE",
+                        **(absent or {"default": []}),
+                        help="override one number of the parameter files, e.g. l1=0.2096 or "
+                             "segment_a.mass=0.03 (SI units, rad); repeatable")
+
+
+def merge_model_options(args: argparse.Namespace, suffix: str) -> None:
+    """Fold the model options given after the command into those given before it; an option
+    given on both sides is refused, except --set, whose items add up."""
+    for dest, option in MODEL_OPTIONS.items():
+        after = args.__dict__.pop(dest + suffix, None)
+        if after is None:
+            continue
+        if dest == "set":
+            args.set = [*args.set, *after]
+        elif given(args, dest):
+            raise PhantomPinError("given before and after the command; give it once", argument=option)
+        else:
+            setattr(args, dest, after)
+
+
+def source(args: argparse.Namespace) -> str | Path:
+    """The model name or the configuration folder the command works on."""
+    if args.config is not None and args.model != DEFAULT:
+        raise PhantomPinError("--config: give --model or --config, not both")
+    if args.config is None and args.model not in models():
+        raise PhantomPinError(f"--model: {args.model!r} is not a model ({', '.join(models())}); "
+                              "use --config for a folder")
+    return args.config if args.config is not None else args.model
+
+
+def overrides(args: argparse.Namespace) -> dict[str, object]:
+    """The overrides of --params (a YAML file) and then --set KEY=VALUE."""
+    try:
+        given: dict[str, object] = dict(read_overrides(args.params)) if args.params else {}
+    except PhantomPinError as error:
+        raise PhantomPinError(str(error), argument="--params") from None
+    for item in args.set:
+        key, _, value = item.partition("=")
+        try:
+            given[key] = float(value)
+        except ValueError:
+            raise PhantomPinError(f"expected KEY=NUMBER, got {item!r}", argument="--set") from None
+    return given
+
+
+def description(args: argparse.Namespace, given: dict[str, object] | None = None, **kwargs: Any) -> Description:
+    """The Description of --model or --config with ``given`` overrides (default: those of
+    --params and --set); ``kwargs`` go to describe() (prefix, robot_file)."""
+    given = overrides(args) if given is None else given
+    if given or kwargs:
+        return describe(source(args), overrides=given, **kwargs)
+    return description_of(source(args), "--config" if args.config else "--model")
+
+
+def phantom(args: argparse.Namespace) -> Phantom:
+    """The Phantom of --model or --config with the overrides."""
+    return Phantom(description(args))
+
+
+def output(args: argparse.Namespace, option: str = "--output") -> Path:
+    """The file named by ``option`` (its dest in ``args``), checked before any work: not a
+    folder, its folder exists, not overwritten without --force."""
+    value = getattr(args, option.lstrip("-").replace("-", "_"))
+    if value is None or str(value) == "":
+        raise PhantomPinError("empty; give a file name", argument=option)
+    return output_path(value, args.force, option, "--force")
+
+
+def show(args: argparse.Namespace, data: dict, text: str) -> None:
+    """Print ``data`` as JSON with --json, else ``text``."""
+    print(json.dumps(data, indent=2, allow_nan=False) if getattr(args, "json", False) else text)
+
+
+def vector(values: Any, spec: str) -> str:
+    """``values`` formatted with ``spec`` as "[a b c]"."""
+    return "[" + " ".join(spec.format(v) for v in values) + "]"
+
+
+def warn(message: str) -> None:
+    """One warning line on standard error."""
+    print(f"phantom-pin: warning: {message}", file=sys.stderr)
+
+
+def warn_limits(theta: Any, lower: Any, upper: Any, what: str = "theta") -> None:
+    """One warning line on stderr if ``theta`` (rad) is outside the box limits."""
+    if not within_box(theta, lower, upper):
+        warn(f"{what} {vector(theta, '{:.6g}')} rad is outside the joint limits {vector(lower, '{:.6g}')}.."
+             f"{vector(upper, '{:.6g}')} rad (computed anyway)")
+
+
+def positive_integer(text: str) -> int:
+    """A count such as 1000 or 1e6 (a whole number >= 1)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value >= 1 and value.is_integer()):
+        raise argparse.ArgumentTypeError(f"expected a positive whole number, got {text!r}")
+    return int(value)

@@ -1,0 +1,210 @@
+"""The model's commands of ``phantom-pin``: info, check, fk, ik, dynamics, the generated files
+(urdf, srdf, mjcf, links) and show."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import webbrowser
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from phantom_pin import verification
+from phantom_pin.cli import device
+from phantom_pin.cli.common import description, output, overrides, phantom, positive_integer, show, vector, warn_limits
+from phantom_pin.config import DEFAULT, MODELS
+from phantom_pin.description.build import links_yaml
+from phantom_pin.dynamics.loader import load
+from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.progress import Progress
+
+THREE = {"nargs": 3, "type": float}
+def info(args: argparse.Namespace) -> int:
+    """Joints, links, rotor and device data of the model, with their sources."""
+    given = overrides(args)
+    robot = Phantom(description(args, given))
+    model, actuation = robot.model, robot.config.actuation
+    joints = [{"name": model.names[i], "lower": float(model.lowerPositionLimit[i - 1]),
+               "upper": float(model.upperPositionLimit[i - 1]),
+               "velocity": float(model.velocityLimit[i - 1]), "effort": float(model.effortLimit[i - 1]),
+               "armature": float(model.armature[i - 1]),
+               "ratio": None if actuation.ratios is None else actuation.ratios[i - 1]} for i in (1, 2, 3)]
+    tree = robot.coupling.tree
+    body: dict[int, str] = {}
+    for frame in tree.frames:  # the first body frame of a joint is its link
+        if frame.type == pin.FrameType.BODY:
+            body.setdefault(frame.parentJoint, frame.name)
+    links = [{"name": body[i], "mass": tree.inertias[i].mass,
+              "com": tree.inertias[i].lever.tolist(),
+              "inertia": [tree.inertias[i].inertia[j, k] for j, k in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))]}
+             for i in range(1, tree.njoints) if tree.inertias[i].mass > 0]
+    data: dict[str, Any] = {"model": robot.config.name, "joints": joints, "links": links,
+            "rotor_inertia": None if actuation.motor is None else actuation.motor.rotor_inertia}
+    lines = ["joint    lower[rad] upper[rad] vel[rad/s] effort[Nm] armature[kg m2] ratio"]
+    lines += [f"{j['name']:8} {j['lower']:10.3f} {j['upper']:10.3f} {j['velocity']:10.2f} "
+              f"{j['effort']:10.3f} {j['armature']:15.4e} "
+              f"{'-' if j['ratio'] is None else format(j['ratio'], '5.1f'):>5}" for j in joints]
+    width = max(len("link"), *(len(lk["name"]) for lk in links))
+    lines += ["", f"{'link':{width}} mass[kg]  com[m] (link frame)       inertia xx xy xz yy yz zz at the COM [kg m2]"]
+    lines += [f"{lk['name']:{width}} {lk['mass']:8.4f}  {vector(lk['com'], '{:7.4f}'):26}"
+              f"{vector(lk['inertia'], '{:.3e}')}" for lk in links]
+    lines += ["", "rotor inertia: not public (no armature; the links carry the rotors)" if actuation.motor is None
+              else f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
+    count = len(given)
+    data["overrides"] = count
+    lines.insert(0, f"model {robot.config.name}" + (f", with {count} overridden number(s) (--params/--set)"
+                                                     if count else ""))
+    data["device"], device_lines = device.info(robot)  # stops, friction, motor, encoder
+    lines += ["", *device_lines]
+    show(args, data, "\n".join(lines))
+    return 0
+
+
+
+
+def check(args: argparse.Namespace) -> int:
+    """phantom_pin.verification.check(), printed: exit code 1 when a comparison fails."""
+    bar = Progress("check", args.n, enabled=False if args.quiet else None)
+    try:
+        report = verification.check(phantom(args), args.n, args.seed, progress=bar.update)
+    finally:
+        bar.close()
+    text = [f"{args.n} random states (seed {args.seed}) inside the joint limits",
+            f"{'check':60} {'max error':>10} {'tolerance':>10}"]
+    text += [f"{r.check:60} {r.max_error:10.2e} {r.tolerance:10.0e}" if r.max_error is not None
+             else f"{r.check:60} {'n/a':>10}  (parameters are not the report's)" for r in report.rows]
+    text.append("all checks pass" if report.passed else "FAIL")
+    show(args, report.as_dict(), "\n".join(text))
+    return 0 if report.passed else 1
+
+
+def fk(args: argparse.Namespace) -> int:
+    """g_st at --theta, with a warning outside the joint limits."""
+    robot = phantom(args)
+    g = robot.forward_kinematics(args.theta)
+    warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+    show(args, {"g_st": g.tolist()},
+         f"tip position in s [m]: {np.array2string(g[:3, 3], precision=6)}\n"
+         f"g_st =\n{np.array2string(g, precision=6, suppress_small=True)}")
+    return 0
+
+
+def ik(args: argparse.Namespace) -> int:
+    """The theta that puts the tip at a position of frame s."""
+    robot = phantom(args)
+    theta = robot.inverse_kinematics(args.position, branch=args.branch)
+    warn_limits(theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit, "the solution theta")
+    show(args, {"theta": theta.tolist()}, f"theta [rad]: {np.array2string(theta, precision=9)}")
+    return 0
+
+
+def dynamics(args: argparse.Namespace) -> int:
+    """M, C, N and tau at one state."""
+    robot = phantom(args)
+    results = {"M": robot.mass_matrix(args.theta),
+               "C": robot.coriolis_matrix(args.theta, args.dtheta),
+               "N": robot.gravity(args.theta),
+               "tau": robot.inverse_dynamics(args.theta, args.dtheta, args.ddtheta)}
+    warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+    text = "\n".join(f"{k} =\n{np.array2string(v, precision=6)}" for k, v in results.items())
+    show(args, {k: v.tolist() for k, v in results.items()}, text)
+    return 0
+
+
+def write(args: argparse.Namespace) -> int:
+    """urdf, srdf, mjcf, links: the files of describe(--model or --config, --prefix, --params and --set)."""
+    target = output(args)
+    scene = output(args, "--scene") if args.kind == "mjcf" and args.scene is not None else None
+    if scene is not None and scene.resolve() == target.resolve():
+        raise PhantomPinError(f"{scene} is the --output file; the scene includes the model, give it its own file",
+                              argument="--scene")
+    # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
+    robot_file = target.name if scene is None else os.path.relpath(target.resolve(), scene.resolve().parent)
+    made = description(args, prefix=args.prefix, robot_file=robot_file)
+    robot = (made.model or MODELS[DEFAULT]).robot_name
+    texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
+    target.write_text(texts[args.kind])
+    print(f"wrote {target}")
+    if scene is not None:
+        scene.write_text(made.scene)
+        print(f"wrote {scene}")
+    return 0
+
+
+def show_command(args: argparse.Namespace) -> int:
+    """The arm in meshcat: a live viewer on 127.0.0.1 until Ctrl-C, or --html FILE."""
+    from phantom_pin.viewer import Viewer  # meshcat is only needed here
+
+    if args.html is not None:
+        output(args, "--html")
+    robot = load(description(args))
+    if args.theta is not None:
+        warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+    with Viewer(robot) as viewer:
+        if args.tip_force is not None:
+            viewer.set_force(args.tip_force)
+        viewer.show(robot.q0 if args.theta is None else args.theta)
+        if args.html is not None:
+            print(f"wrote {viewer.export_html(args.html, force=args.force)}")
+            return 0
+        with viewer.stop_on_signals():  # from before the URL is printed to after the server stopped
+            try:
+                print(f"meshcat viewer at {viewer.url} (Ctrl-C to stop)", flush=True)
+                if args.open:
+                    webbrowser.open(viewer.url)
+                viewer.wait()
+            finally:
+                viewer.close()
+    return 0
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    """info, check, fk, ik, dynamics, urdf, srdf, mjcf, links and show."""
+    command = sub.add_parser("info", help="joints, limits, links with mass, COM and inertia, rotor data, "
+                                          "the device's stops, friction, motor and encoder with sources")
+    command.set_defaults(run=info)
+    command.add_argument("--json", action="store_true", help="print JSON")
+    command = sub.add_parser("check", help="Phantom vs closed form vs the appendix at N random states")
+    command.add_argument("-n", type=positive_integer, default=1000,
+                         help=f"number of random states, e.g. 1000 or 1e6 (default 1000; evaluated "
+                              f"{verification.CHUNK} at a time, at most {verification.MAX_STATES:.0e})")
+    command.add_argument("--seed", type=int, default=0)
+    command.add_argument("--json", action="store_true", help="print JSON")
+    command.set_defaults(run=check, options={"states": "-n", "phantom": "--model"})
+    command = sub.add_parser("fk", help="g_st (eq. 10) at theta (rad)")
+    command.add_argument("theta", metavar="T", **THREE)
+    command.add_argument("--json", action="store_true", help="print JSON")
+    command.set_defaults(run=fk)
+    command = sub.add_parser("ik", help="theta (rad) that puts the tip at X Y Z (m, frame s)")
+    command.add_argument("position", metavar="P", **THREE)
+    command.add_argument("--branch", choices=["report", "other"], default="report")
+    command.add_argument("--json", action="store_true", help="print JSON")
+    command.set_defaults(run=ik)
+    command = sub.add_parser("dynamics", help="M, C, N and tau at a state")
+    command.add_argument("--theta", required=True, **THREE)
+    command.add_argument("--dtheta", default=[0.0, 0.0, 0.0], **THREE)
+    command.add_argument("--ddtheta", default=[0.0, 0.0, 0.0], **THREE)
+    command.add_argument("--json", action="store_true", help="print JSON")
+    command.set_defaults(run=dynamics)
+    for kind in ("urdf", "srdf", "mjcf", "links"):
+        command = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config"
+                                 if kind != "links" else "write the links in full (mass, COM, inertia; the "
+                                 "xacro's links_file) of --model or --config")
+        command.add_argument("--output", "-o", required=True)
+        command.add_argument("--prefix", default="")
+        command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
+        command.set_defaults(kind=kind, run=write)
+        if kind == "mjcf":
+            command.add_argument("--scene", help="also write a scene (floor, light, table) that "
+                                                 "includes the MJCF of --output (same folder)")
+    command = sub.add_parser("show", help="the arm in meshcat: a live viewer on 127.0.0.1, or --html FILE")
+    command.add_argument("--theta", metavar="T", help="posture (rad; default: the SRDF's resting)", **THREE)
+    command.add_argument("--tip-force", metavar="F", help="force on the tip (N, frame s), drawn as an arrow",
+                         **THREE)
+    command.add_argument("--html", help="write a self-contained HTML file instead of serving")
+    command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
+    command.add_argument("--open", action="store_true", help="open the live viewer in a browser")
+    command.set_defaults(run=show_command)
