@@ -96,3 +96,8 @@ def test_simulate_format_without_a_file_and_with_a_matching_extension(tmp_path, 
     code, _, _ = run(capsys, "simulate", "--theta0", "0.1", "0.3", "0.4", "--duration", "0.01", "--format", "json",
                      "-o", str(target))
     assert code == 0 and len(json.loads(target.read_text())["t"]) == 11
+
+
+def test_quiet_after_the_command_too(capsys):
+    code, out, err = run(capsys, "check", "-n", "10", "-q")
+    assert code == 0 and "all checks pass" in out and err == ""

@@ -94,3 +94,64 @@ def test_simulate_warns_once_when_it_starts_inside_a_stop(capsys):
     assert err == "phantom-pin: warning: --theta0 [3.0, 0.0, 0.0] rad starts beyond the stops, which push it back\n"
     assert main(["simulate", "--theta0", "3", "0", "0", "--duration", "0.01", "--no-hard-stops"]) == 0
     assert capsys.readouterr().err == ""                            # no stops, no warning (before: the same)
+
+
+def _trajectory(path, degrees=(), milliseconds=False, openhaptics=False):
+    """A smooth 3 s trajectory inside the stops at 1 kHz with its exact derivatives and the
+    report model's torque (N m), written as excite writes it; optionally with a unit slip."""
+    from phantom_pin import Phantom, drivers
+    from phantom_pin.identification import io
+
+    t = np.arange(3001) / 1000.0
+    w = 2 * np.pi / 3.0
+    centre, amplitude = np.array([0.0, 0.5, 0.4]), np.array([0.3, 0.2, 0.2])
+    theta = centre + amplitude * np.sin(w * t)[:, None] * (1 - np.cos(w * t))[:, None] / 2
+    # derivatives of a sin(wt)(1 - cos(wt))/2 = a (sin(wt) - sin(2wt)/2) / 2
+    dtheta = amplitude * (w * np.cos(w * t) - w * np.cos(2 * w * t))[:, None] / 2
+    ddtheta = amplitude * (-w**2 * np.sin(w * t) + 2 * w**2 * np.sin(2 * w * t))[:, None] / 2
+    tau = Phantom().inverse_dynamics(theta, dtheta, ddtheta)
+    if openhaptics:
+        theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
+        tau = drivers.openhaptics_torque_from_tau(tau)
+    columns = {"theta": theta, "dtheta": dtheta, "ddtheta": ddtheta}
+    for name in degrees:
+        columns[name] = np.degrees(columns[name])
+    io.write_csv(path, io.TRAJECTORY_COLUMNS, np.column_stack(
+        [t * 1000 if milliseconds else t, columns["theta"], columns["dtheta"], columns["ddtheta"], tau]))
+    return path
+
+
+@pytest.mark.parametrize("slip, message", [
+    ({"degrees": ("theta",)}, "rate of change of theta is 57.3 times dtheta (1 expected): the columns disagree; "
+                              "are the angles in degrees?"),
+    ({"milliseconds": True}, "rate of change of theta is 0.001 times dtheta (1 expected): the columns disagree; "
+                             "is t in ms?"),
+    ({"degrees": ("dtheta",)}, "the rate of change of theta is 0.01745 times dtheta"),
+    ({"degrees": ("theta", "dtheta", "ddtheta")}, "--trajectory: TRAJ: its first state: "),
+])
+def test_simulate_names_the_trajectory_file_for_its_unit_slips(tmp_path, capsys, slip, message):
+    """Before: a trajectory in degrees was blamed on --theta0 (not given), one in ms on --duration."""
+    traj = _trajectory(tmp_path / "traj.csv", **slip)
+    code, out, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(tmp_path / "log.csv"))
+    assert code == 2 and out == "" and err.count("\n") == 1 and message.replace("TRAJ", str(traj)) in err, err
+    assert not (tmp_path / "log.csv").exists()
+
+
+def test_simulate_tracks_a_consistent_trajectory_and_warns_when_openhaptics_is_read_as_the_report(tmp_path,
+                                                                                                  capsys):
+    """The same trajectory in the report's units tracks without a warning; in OpenHaptics' mN m
+    read as N m (no --convention) nearly every command saturates: a warning line that says so,
+    its share equal to the clipped samples of the written log (tau differs from tau_commanded)."""
+    traj, log = _trajectory(tmp_path / "traj.csv"), tmp_path / "log.csv"
+    code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log))
+    assert code == 0 and err == ""
+    traj = _trajectory(tmp_path / "oh.csv", openhaptics=True)
+    code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log), "--force")
+    data = np.loadtxt(log, delimiter=",", skiprows=1)
+    share = 100 * np.mean(np.any(data[:, 7:10] != data[:, 10:13], axis=1))
+    assert code == 0 and share > 50 and err == (
+        f"phantom-pin: warning: {share:.1f} % of the commanded torques exceeded the saturation and were clipped "
+        "(is the file in OpenHaptics' mN m? --convention openhaptics)\n")
+    code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log), "--force",
+                       "--convention", "openhaptics")
+    assert code == 0 and err == ""

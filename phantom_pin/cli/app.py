@@ -26,8 +26,10 @@ def parser() -> argparse.ArgumentParser:
     sub = top.add_subparsers(dest="command", required=True, parser_class=Parser)
     for concern in (model, device, identification):
         concern.add_parsers(sub)
-    for command in sub.choices.values():  # the model options after the command too
+    for command in sub.choices.values():  # the model options and --quiet after the command too
         add_model_options(command, AFTER)
+        command.add_argument("--quiet", "-q", action="store_true", default=argparse.SUPPRESS,
+                             help="no progress bar on stderr")
     return top
 
 

@@ -27,6 +27,12 @@ OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}
+#: simulate()'s arguments that --trajectory sets, with what of the file they are.
+TRAJECTORY_SETS = {"theta0": "its first state:", "dtheta0": "its first rates:", "duration": "its duration:",
+                   "rate": "its rate:"}
+#: Share of samples with a clipped command above which simulate warns (a tracking run that
+#: saturates this often follows nothing).
+SATURATED_SHARE = 0.1
 #: The output formats, by the file's extension.
 FORMATS = {".json": "json", ".csv": "csv"}
 
@@ -141,8 +147,18 @@ def simulate_command(args: argparse.Namespace) -> int:
                           friction=not args.no_friction, hard_stops=not args.no_hard_stops,
                           saturation=False if args.no_saturation else args.saturation or True,
                           quantization=args.quantization, device=device, progress=bar.update)
+    except PhantomPinError as error:  # what --trajectory sets is the file's, not an option's
+        if args.trajectory is None or error.argument not in TRAJECTORY_SETS:
+            raise
+        raise PhantomPinError(f"{args.trajectory}: {TRAJECTORY_SETS[error.argument]} {error.detail}",
+                              argument="--trajectory") from None
     finally:
         bar.close()
+    saturated = float(np.mean(np.any(result.tau != result.tau_commanded, axis=1)))
+    if saturated > SATURATED_SHARE:
+        hint = (" (is the file in OpenHaptics' mN m? --convention openhaptics)"
+                if args.trajectory is not None and args.convention is None else "")
+        warn(f"{100 * saturated:.1f} % of the commanded torques exceeded the saturation and were clipped{hint}")
     if not args.no_hard_stops and not device.within_limits(run.theta0):  # after the run: a refused one alone
         warn(f"--theta0 {run.theta0} rad starts beyond the stops, which push it back")
     settings = dataclasses.asdict(run) | {key: getattr(args, key) for key in (

@@ -139,8 +139,37 @@ def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
     step = np.diff(t)
     if len(t) < 2 or not (step > 0).all() or np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
         raise LogError(f"{path}: the times must increase at a fixed rate")
-    return (t, *(np.column_stack([column[f"{name}{j}"] for j in (1, 2, 3)])
-                 for name in ("theta", "dtheta", "ddtheta", "tau")))
+    theta, dtheta, ddtheta, tau = (np.column_stack([column[f"{name}{j}"] for j in (1, 2, 3)])
+                                   for name in ("theta", "dtheta", "ddtheta", "tau"))
+    _consistent(path, "theta", "dtheta", t, theta, dtheta)
+    _consistent(path, "dtheta", "ddtheta", t, dtheta, ddtheta)
+    return t, theta, dtheta, ddtheta, tau
+
+
+#: Largest relative disagreement between a trajectory's column and the rate of change of the
+#: one before it (central differences of a smooth trajectory sampled at 100 Hz or faster agree
+#: within 1e-3; a unit slip is a factor of 57.3 or 1000).
+DERIVATIVE_TOLERANCE = 0.01
+#: Unit slips recognised by the factor they leave between a column and its derivative.
+UNIT_SLIPS = ((180 / np.pi, "are the angles in degrees?"), (np.pi / 180, "are the rates in degrees?"),
+              (1e-3, "is t in ms?"), (1e3, "is t in s and the rest per ms?"))
+
+
+def _consistent(path: Path, name: str, rate_name: str, t: np.ndarray, values: np.ndarray,
+                rates: np.ndarray) -> None:
+    """Raise LogError unless ``rates`` is the rate of change of ``values`` (over ``t``, s): the
+    least-squares factor between the central differences and ``rates`` must be 1 within
+    DERIVATIVE_TOLERANCE; a known unit slip is named."""
+    if len(t) < 3 or not np.any(rates):
+        return
+    differences = np.gradient(values, t, axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        factor = float(np.sum(differences * rates) / np.sum(rates * rates))
+    if np.isfinite(factor) and abs(factor - 1) <= DERIVATIVE_TOLERANCE:
+        return
+    hint = next((text for slip, text in UNIT_SLIPS if abs(factor / slip - 1) < 0.05), "")
+    raise LogError(f"{path}: the rate of change of {name} is {factor:.4g} times {rate_name} (1 expected): the "
+                   f"columns disagree{'; ' + hint if hint else ''}")
 
 
 def read_log(path: Path | str, convention: str = "report") -> Log:
