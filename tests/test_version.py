@@ -1,0 +1,26 @@
+"""One version everywhere: pyproject.toml, the installed distribution, phantom_pin.__version__,
+the description's package.xml and the newest entry of both changelogs."""
+
+import re
+import tomllib
+import xml.etree.ElementTree as ET
+from importlib.metadata import version
+from pathlib import Path
+
+import phantom_pin
+from phantom_pin.paths import DESCRIPTION_DIR
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _newest(changelog: Path) -> str:
+    return re.search(r"^## (\d+\.\d+\.\d+)", changelog.read_text(), re.MULTILINE).group(1)
+
+
+def test_one_version_everywhere():
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    found = {"installed": version("phantom_pin"), "__version__": phantom_pin.__version__,
+             "package.xml": ET.parse(DESCRIPTION_DIR / "package.xml").getroot().findtext("version"),
+             "CHANGELOG.md": _newest(ROOT / "CHANGELOG.md"),
+             "description CHANGELOG.md": _newest(DESCRIPTION_DIR / "CHANGELOG.md")}
+    assert found == dict.fromkeys(found, declared)
