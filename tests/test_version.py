@@ -2,7 +2,6 @@
 the description's package.xml and the newest entry of both changelogs."""
 
 import re
-import tomllib
 import xml.etree.ElementTree as ET
 from importlib.metadata import version
 from pathlib import Path
@@ -18,7 +17,8 @@ def _newest(changelog: Path) -> str:
 
 
 def test_one_version_everywhere():
-    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    # [project]'s version line (tomllib is Python 3.11+; the package supports 3.10)
+    declared = re.search(r'^version = "([^"]+)"$', (ROOT / "pyproject.toml").read_text(), re.MULTILINE).group(1)
     found = {"installed": version("phantom_pin"), "__version__": phantom_pin.__version__,
              "package.xml": ET.parse(DESCRIPTION_DIR / "package.xml").getroot().findtext("version"),
              "CHANGELOG.md": _newest(ROOT / "CHANGELOG.md"),
