@@ -8,7 +8,7 @@ from typing import Callable, Sequence
 Vector = Sequence[float]
 
 
-def rk4_step(acceleration: Callable[[list[float], list[float]], Vector], q: Vector, v: Vector,
+def rk4_step(acceleration: Callable[[Vector, Vector], Vector], q: Vector, v: Vector,
              h: float) -> tuple[list[float], list[float]]:
     """(q, v) after one classical RK4 step of h (s) of q'' = acceleration(q, v), positions
     q (rad), rates v (rad/s) and accelerations (rad/s^2) of the three joints, as new lists;

@@ -3,6 +3,7 @@ a haptic-loop simulator (simulate). Numbers: the Config's ``actuation`` and ``li
 (config/NAME/actuation.yaml and joint_limits.yaml), with their sources."""
 
 from phantom_pin.device.device import Device
-from phantom_pin.device.simulation import SimulationResult, simulate
+from phantom_pin.device.run import SimulationResult
+from phantom_pin.device.simulation import simulate
 
 __all__ = ["Device", "SimulationResult", "simulate"]

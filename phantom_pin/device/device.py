@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
 from phantom_pin.config import Config
-from phantom_pin.config.schema import STOP_COORDINATES
+from phantom_pin.config.schema import STOP_COORDINATES, Motor
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
@@ -56,16 +57,16 @@ class Device:
         actuation = self.config.actuation
         #: joint angle = motor angle / ratio (the Phantom's actuation.yaml); None if not public
         self.ratios = None if actuation.ratios is None else np.array(actuation.ratios, dtype=float)
-        self._stop_lower, self._stop_upper = self.config.limits.stops.bounds()
         encoder = actuation.encoder
-        self._counts_per_radian = None if encoder is None else \
+        self._counts_per_radian = None if encoder is None or self.ratios is None else \
             self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
 
-    def _require(self, section: str, needed_by: str) -> None:
-        """MissingDataError unless the configuration has its ``section`` of actuation.yaml."""
+    def require(self, section: str, needed_by: str) -> None:
+        """MissingDataError naming ``needed_by`` unless the configuration has its ``section`` of
+        actuation.yaml ("motor", "encoder", "transmission_ratio", as config.Actuation names them)."""
         if getattr(self.config.actuation, section) is None:
-            raise MissingDataError(f"{needed_by}: model {self.config.name} has no {section} data "
-                                   f"({self.config.sources[section]})")
+            raise MissingDataError(f"model {self.config.name} has no {section} data ({self.config.sources[section]})",
+                                   argument=needed_by)
 
     # -- stops -----------------------------------------------------------------------
     def within_limits(self, theta: object) -> bool | np.ndarray:
@@ -74,8 +75,12 @@ class Device:
         theta3 - theta2 <= theta3_minus_theta2_max. A bool for one state (3,), an (N,) bool
         array for a batch (N, 3)."""
         q, batch = as_states(theta, "theta")
-        inside = np.all(self.config.limits.stops.penetration(q) == 0, axis=-1)
+        inside = self._inside(q)
         return inside if batch else bool(inside)
+
+    def _inside(self, theta: np.ndarray) -> np.ndarray:
+        """within_limits of postures (..., 3) rad, checked: a bool array (...)."""
+        return np.all(self.config.limits.stops.penetration(theta) == 0, axis=-1)
 
     def reachable(self, position: object) -> bool | np.ndarray:
         """True where the tip can reach ``position`` (m, the report's frame s) with every joint
@@ -104,7 +109,7 @@ class Device:
                                  np.pi - front[:, 1], -front[:, 2]], axis=-1)
                 for theta in (front, back):
                     candidates = theta[:, None, :] + wraps           # (n, 9, 3)
-                    found[shell] |= self.within_limits(candidates.reshape(-1, 3)).reshape(-1, 9).any(axis=1)
+                    found[shell] |= self._inside(candidates.reshape(-1, 3)).reshape(-1, 9).any(axis=1)
         return found.reshape(shape) if batch else bool(found[0])
 
     def stop_energy(self, theta: object) -> np.ndarray:
@@ -151,17 +156,14 @@ class Device:
         (config.Friction).
         """
         v, _ = as_states(dtheta, "dtheta")
-        return self._friction(v)
-
-    def _friction(self, dtheta: np.ndarray) -> np.ndarray:
-        return self.config.actuation.friction.torque(dtheta)
+        return np.asarray(self.config.actuation.friction.torque(v))
 
     # -- motors ----------------------------------------------------------------------
     @property
     def continuous_torque(self) -> np.ndarray:
         """Joint torque (N m) of each motor's max. continuous torque: max_continuous_torque * ratio.
         MissingDataError without public motor data."""
-        self._require("motor", "continuous_torque")
+        self.require("motor", "continuous_torque")
         return np.array(self.config.actuation.effort)
 
     @property
@@ -184,22 +186,28 @@ class Device:
             raise InvalidInputError(f"continuous: expected True or False, got {continuous!r}")
         return np.array(self.config.actuation.limit("continuous" if continuous else "peak"))
 
+    def _drive(self, needed_by: str) -> tuple[np.ndarray, Motor]:
+        """(the transmission ratios, the motor); MissingDataError naming ``needed_by`` without
+        public motor data (the Config gives the ratios and the motor together or neither)."""
+        self.require("motor", needed_by)
+        return cast(np.ndarray, self.ratios), cast(Motor, self.config.actuation.motor)
+
     def motor_currents(self, tau: object) -> np.ndarray:
         """Winding currents (A) that give joint torques tau (N m): tau / (ratio * torque_constant).
         MissingDataError without public motor data."""
-        self._require("motor", "motor_currents")
+        ratios, motor = self._drive("motor_currents")
         t, _ = as_states(tau, "tau")
         with np.errstate(over="ignore"):
-            currents = t / (self.ratios * self.config.actuation.motor.torque_constant)
+            currents = t / (ratios * motor.torque_constant)
         return finite_result(currents, "tau")
 
     def joint_torques(self, currents: object) -> np.ndarray:
         """Joint torques (N m) of winding currents (A): ratio * torque_constant * currents.
         MissingDataError without public motor data."""
-        self._require("motor", "joint_torques")
+        ratios, motor = self._drive("joint_torques")
         i, _ = as_states(currents, "currents")
         with np.errstate(over="ignore"):
-            torques = i * self.ratios * self.config.actuation.motor.torque_constant
+            torques = i * ratios * motor.torque_constant
         return finite_result(torques, "currents")
 
     def available_torque(self, theta: object, continuous: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -257,24 +265,31 @@ class Device:
     def encoder_resolution(self) -> np.ndarray:
         """Joint angle of one encoder count (rad): 2 pi / (ratio * cycles_per_revolution *
         counts_per_cycle), (3,). MissingDataError without public encoder data."""
-        self._require("encoder", "encoder_resolution")
-        return 1.0 / self._counts_per_radian
+        self.require("encoder", "encoder_resolution")
+        return 1.0 / self.counts_per_radian
+
+    @property
+    def counts_per_radian(self) -> np.ndarray:
+        """Encoder counts per radian of each joint: ratio * cycles_per_revolution *
+        counts_per_cycle / (2 pi), (3,). MissingDataError without public encoder data."""
+        self.require("encoder", "counts_per_radian")
+        return cast(np.ndarray, self._counts_per_radian)    # set with the encoder (which comes with the ratios)
 
     def encoder_counts(self, theta: object) -> np.ndarray:
         """Encoder counts (int64) at theta (rad): round(theta * ratio * cycles * counts_per_cycle
         / (2 pi)). Count 0 is the report's zero configuration; a real device reads counts
         from wherever it was switched on and needs a calibration offset."""
-        self._require("encoder", "encoder_counts")
+        self.require("encoder", "encoder_counts")
         q, _ = as_states(theta, "theta")
         with np.errstate(over="ignore"):          # refused below
-            counts = np.rint(q * self._counts_per_radian)
+            counts = np.rint(q * self.counts_per_radian)
         if np.abs(counts).max() >= 2.0**62:
             raise InvalidInputError("theta: too large, its encoder counts overflow a 64-bit integer")
         return counts.astype(np.int64)
 
     def encoder_theta(self, counts: object) -> np.ndarray:
         """Joint angles (rad) of encoder counts: counts * encoder_resolution."""
-        self._require("encoder", "encoder_theta")
+        self.require("encoder", "encoder_theta")
         c, _ = as_states(counts, "counts")
         return c * self.encoder_resolution
 

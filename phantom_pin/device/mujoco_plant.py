@@ -10,14 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from phantom_pin.device.device import Device
-from phantom_pin.device.simulation import (
-    MAX_STEPS,
-    Controller,
-    SimulationResult,
-    _checked,
-    _positive,
-    arguments,
-)
+from phantom_pin.device.run import MAX_STEPS, Controller, SimulationResult, arguments, command, positive
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 
 
@@ -42,7 +35,7 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     description = device.phantom.description
     model = mujoco.MjModel.from_xml_string(description.mjcf)
     if timestep is not None:
-        model.opt.timestep = _positive(timestep, "timestep")
+        model.opt.timestep = positive(timestep, "timestep")
     data = mujoco.MjData(model)
     argument = "rate" if timestep is None else "timestep"
     steps = 1.0 / (rate * model.opt.timestep)
@@ -84,7 +77,7 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
             t = k / rate
             out_theta[k], out_dtheta[k] = data.qpos[primary_q], data.qvel[primary_v]
             if controller is not None:
-                commanded[k] = _checked(controller(t, out_theta[k].copy(), out_dtheta[k].copy()), t)
+                commanded[k] = command(controller(t, out_theta[k].copy(), out_dtheta[k].copy()), t)
             ctrl = np.clip(commanded[k] / gear, low, high)
             applied[k] = ctrl * gear
             if k == samples - 1:

@@ -10,6 +10,8 @@ contain typos; the corrections, and their evidence, are listed in docs/errata.md
 
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
@@ -41,7 +43,18 @@ def forward_kinematics(theta: object, params: ReportParameters) -> np.ndarray:
     return g
 
 
-def inverse_kinematics(position: object, params: ReportParameters, branch: str = "report") -> np.ndarray:
+class Lengths(Protocol):
+    """What the inverse kinematics reads (m): the upper arm l1 and the forearm l2, of
+    ReportParameters or of a Config's Kinematics."""
+
+    @property
+    def l1(self) -> float: ...
+
+    @property
+    def l2(self) -> float: ...
+
+
+def inverse_kinematics(position: object, params: Lengths, branch: str = "report") -> np.ndarray:
     """Joint angles (rad) that put the tip at ``position`` (m, frame s), eqs 11-20.
 
     ``branch="report"`` is the report's elbow branch (gamma > 0, alpha > 0:
