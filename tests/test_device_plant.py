@@ -1,0 +1,150 @@
+"""device.plant.Plant, the simulator's plant, against the report's closed form (M, C, N) with the
+friction and stop laws and mahilab/Phantom's constants written here; a stuck joint against the
+Lagrange-multiplier form of the constraint (a 4x4 solve); the saturation clip against the data
+sheet's torques. And the device layer's promises: errors name their argument in the field, and
+no module reads another's private names or hides an import of the package inside a function."""
+
+import ast
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import REPORT
+from phantom_pin import Device, InvalidInputError, MissingDataError, closed_form, simulate
+from phantom_pin.device.plant import Plant
+
+DEG = math.pi / 180
+K_STOP, B_STOP = 10.0, 0.1                       # N m/rad, N m s/rad (mahilab's hard stop)
+VISCOUS, COULOMB = 5e-4, 0.01                    # N m s/rad, N m (mahilab's)
+UPPER_1, COUPLED_MAX = 90 * DEG, 65 * DEG        # joint 1's upper stop, theta2 - theta3 <= 65 deg
+RATIOS = np.array([13.3, 11.6, 11.6])            # the report (docs/errata.md E15)
+TAU_NOMINAL, TAU_STALL = 28.6e-3, 129e-3         # N m, maxon RE 25 data sheet
+ENCODER_CPR, QUADRATURE = 1024, 4                # HEDM-5500, decoded X4
+DEVICE_DIR = Path(__file__).resolve().parents[1] / "phantom_pin" / "device"
+
+
+@pytest.fixture(scope="module")
+def device():
+    return Device()
+
+
+def plant(device, **options):
+    settings = {"friction": True, "hard_stops": True, "saturation": True, "contact_step": 1e-3} | options
+    return Plant(device, **settings)
+
+
+def rhs(q, v, tau):
+    """tau - C(q, v) v - N(q) (N m), the report's closed form."""
+    return tau - closed_form.coriolis_matrix(q, v, REPORT) @ v - closed_form.gravity(q, REPORT)
+
+
+@pytest.mark.parametrize("stop", ["joint 1", "coupled"])
+def test_sliding_against_a_stop_is_the_closed_form_with_both_laws(device, stop):
+    """All joints sliding, one stop penetrated: M a = tau - viscous v - coulomb sign(v) + the stop's
+    -(K depth + B rate) along its coordinate."""
+    if stop == "joint 1":
+        q, gradient = np.array([UPPER_1 + 0.03, 0.3, 0.4]), np.array([1.0, 0.0, 0.0])
+        depth = q[0] - UPPER_1
+    else:
+        q, gradient = np.array([0.2, 1.3, 0.1]), np.array([0.0, 1.0, -1.0])
+        depth = q[1] - q[2] - COUPLED_MAX
+    assert depth > 0
+    v, tau = np.array([0.5, -0.3, 0.2]), np.array([0.05, -0.02, 0.03])
+    stop_torque = -(K_STOP * depth + B_STOP * gradient @ v) * gradient
+    expected = np.linalg.solve(closed_form.mass_matrix(q, REPORT),
+                               rhs(q, v, tau) - VISCOUS * v - COULOMB * np.sign(v) + stop_torque)
+    got = plant(device).acceleration(q.tolist(), v.tolist(), tau.tolist())
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)   # rad/s^2, measured 1.1e-13 on 613
+    free = plant(device, hard_stops=False).acceleration(q.tolist(), v.tolist(), tau.tolist())
+    assert np.abs(np.array(free) - expected).max() > 1e-3                # the stop does act
+
+
+@pytest.mark.parametrize("stuck", [(0,), (1,), (2,), (1, 2)])
+def test_stuck_joints_are_held_by_the_lagrange_multipliers_of_their_constraints(device, stuck):
+    """Joints at rest, each loaded 0.004 N m past gravity (below the Coulomb torque): [[M, E],
+    [E^T, 0]] [a; f] = [rhs; 0] (E their unit columns) gives their a = 0 and holding torques f
+    within +-coulomb; the others slide (with joint 1 stuck, the coupled pair 2 and 3)."""
+    q, v = np.array([0.1, 0.5, 0.6]), np.array([0.4, 0.35, -0.3])
+    e = np.eye(3)[:, list(stuck)]
+    v[list(stuck)] = 0.0
+    tau = closed_form.gravity(q, REPORT) + 0.004 * e.sum(axis=1)
+    force = rhs(q, v, tau) - VISCOUS * v - COULOMB * np.sign(v)
+    kkt = np.block([[closed_form.mass_matrix(q, REPORT), e], [e.T, np.zeros((len(stuck), len(stuck)))]])
+    solution = np.linalg.solve(kkt, np.concatenate([force, np.zeros(len(stuck))]))
+    assert np.abs(solution[3:]).max() < COULOMB                         # the state sticks indeed
+    got = plant(device).acceleration(q.tolist(), v.tolist(), tau.tolist())
+    assert all(got[i] == 0.0 for i in stuck)
+    np.testing.assert_allclose(got, solution[:3], rtol=1e-12, atol=1e-12)
+
+
+def test_beyond_the_coulomb_torque_a_joint_at_rest_breaks_away_along_its_load(device):
+    """Joint 2 at rest, loaded 0.02 N m past gravity (twice the Coulomb torque): it slides the way
+    the load pushes, with the Coulomb friction against it."""
+    q, v = np.array([0.1, 0.5, 0.6]), np.array([0.4, 0.0, -0.3])
+    tau = closed_form.gravity(q, REPORT) + np.array([0.0, 0.02, 0.0])
+    sign = np.sign(v) + np.array([0.0, 1.0, 0.0])
+    expected = np.linalg.solve(closed_form.mass_matrix(q, REPORT), rhs(q, v, tau) - VISCOUS * v - COULOMB * sign)
+    got = plant(device).acceleration(q.tolist(), v.tolist(), tau.tolist())
+    assert got[1] > 0
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_the_clip_is_the_data_sheet_torque_of_each_policy(device):
+    command = [3.0, -3.0, 0.01]                    # N m, beyond both limits on joints 1 and 2
+    continuous, peak = TAU_NOMINAL * RATIOS, TAU_STALL * RATIOS
+    np.testing.assert_allclose(plant(device).saturate(command), [continuous[0], -continuous[1], 0.01], rtol=1e-15)
+    np.testing.assert_allclose(plant(device, saturation="peak").saturate(command), [peak[0], -peak[1], 0.01],
+                               rtol=1e-15)
+    assert plant(device, saturation=False).saturate(command) == command
+
+
+def test_counts_per_radian_are_the_encoder_and_the_ratios(device):
+    np.testing.assert_allclose(device.counts_per_radian, ENCODER_CPR * QUADRATURE * RATIOS / (2 * math.pi),
+                               rtol=1e-15)
+    with pytest.raises(MissingDataError) as raised:
+        Device("touch").counts_per_radian
+    assert raised.value.argument == "counts_per_radian"
+
+
+@pytest.mark.parametrize("arguments, name", [
+    ({"duration": -1.0}, "duration"),
+    ({"rate": float("nan")}, "rate"),
+    ({"substeps": 0}, "substeps"),
+    ({"friction": "yes"}, "friction"),
+    ({"saturation": "stall"}, "saturation"),
+    ({"controller": lambda t, q, v: [1.0, 2.0]}, "controller"),
+    ({"theta0": [20.0, 0.0, 0.0]}, "theta0"),
+    ({"progress": 3}, "progress"),
+])
+def test_simulate_names_the_bad_argument_in_the_field(arguments, name):
+    settings = {"theta0": [0.0, 0.3, 0.4], "duration": 0.01} | arguments
+    with pytest.raises(InvalidInputError) as raised:
+        simulate(settings.pop("theta0"), settings.pop("duration"), **settings)
+    assert raised.value.argument == name and str(raised.value).startswith(f"{name}: ")
+
+
+def test_quantization_without_an_encoder_names_the_option():
+    with pytest.raises(MissingDataError) as raised:
+        simulate([0.2, 0.6, 0.8], 0.01, device=Device("touch"), quantization=True)
+    assert raised.value.argument == "quantization"
+
+
+def test_the_device_modules_keep_to_their_own_private_names_and_import_at_the_top():
+    """No attribute starting with one underscore read from anything but self or cls (another
+    class's private state), and no function-local import of phantom_pin (a hidden cycle)."""
+    found = []
+    for path in sorted(DEVICE_DIR.glob("*.py")):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__") \
+                    and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls")):
+                found.append(f"{path.name}:{node.lineno} reads .{node.attr}")
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for inner in ast.walk(node):
+                    names = [inner.module or ""] if isinstance(inner, ast.ImportFrom) else \
+                        [alias.name for alias in inner.names] if isinstance(inner, ast.Import) else []
+                    if any(name.split(".")[0] == "phantom_pin" for name in names):
+                        found.append(f"{path.name}:{inner.lineno} imports inside {node.name}")
+    assert found == []
