@@ -3,7 +3,7 @@ system (three joints)."""
 
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 Vector = Sequence[float]
 

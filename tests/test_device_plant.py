@@ -13,6 +13,7 @@ import pytest
 
 from conftest import REPORT
 from phantom_pin import Device, InvalidInputError, MissingDataError, closed_form, simulate
+from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.device.plant import Plant
 
 DEG = math.pi / 180
@@ -104,7 +105,7 @@ def test_counts_per_radian_are_the_encoder_and_the_ratios(device):
     np.testing.assert_allclose(device.counts_per_radian, ENCODER_CPR * QUADRATURE * RATIOS / (2 * math.pi),
                                rtol=1e-15)
     with pytest.raises(MissingDataError) as raised:
-        Device("touch").counts_per_radian
+        _ = Device("touch").counts_per_radian
     assert raised.value.argument == "counts_per_radian"
 
 
@@ -122,6 +123,16 @@ def test_simulate_names_the_bad_argument_in_the_field(arguments, name):
     settings = {"theta0": [0.0, 0.3, 0.4], "duration": 0.01} | arguments
     with pytest.raises(InvalidInputError) as raised:
         simulate(settings.pop("theta0"), settings.pop("duration"), **settings)
+    assert raised.value.argument == name and str(raised.value).startswith(f"{name}: ")
+
+
+@pytest.mark.parametrize("arguments, name", [({"rate": 333.0}, "rate"), ({"timestep": 3e-4}, "timestep"),
+                                             ({"timestep": -1.0}, "timestep"), ({"duration": 0.0}, "duration")])
+def test_simulate_mujoco_names_the_bad_argument_in_the_field(arguments, name):
+    """MuJoCo steps 1 ms by default: 333 Hz and 1 kHz at 0.3 ms are no whole number of steps."""
+    settings = {"duration": 0.01} | arguments
+    with pytest.raises(InvalidInputError) as raised:
+        simulate_mujoco([0.0, 0.3, 0.4], settings.pop("duration"), **settings)
     assert raised.value.argument == name and str(raised.value).startswith(f"{name}: ")
 
 

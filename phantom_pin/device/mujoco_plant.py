@@ -37,19 +37,7 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     if timestep is not None:
         model.opt.timestep = positive(timestep, "timestep")
     data = mujoco.MjData(model)
-    argument = "rate" if timestep is None else "timestep"
-    steps = 1.0 / (rate * model.opt.timestep)
-    if steps > MAX_STEPS:
-        raise InvalidInputError(f"{argument}: {steps:.3g} MuJoCo steps of {model.opt.timestep:g} s per sample at "
-                                f"{rate:g} Hz, more than {MAX_STEPS:.0e}")
-    if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
-        raise InvalidInputError(f"{argument}: {rate:g} Hz is not 1 / timestep ({1 / model.opt.timestep:g} Hz) divided "
-                                "by a whole number" + ("; pass timestep" if timestep is None else ""))
-    steps = int(round(steps))
-    if (samples - 1) * steps > MAX_STEPS:
-        raise InvalidInputError(f"{'duration' if steps == 1 else argument}: {duration:g} s at {rate:g} Hz needs "
-                                f"{(samples - 1) * steps:.3g} MuJoCo steps of {model.opt.timestep:g} s, more than "
-                                f"{MAX_STEPS:.0e} (minutes)")
+    steps = _steps(model.opt.timestep, rate, duration, samples, "rate" if timestep is None else "timestep")
     coupling = device.phantom.coupling
     names = coupling.tree.names[1:]
     qpos = [model.joint(name).qposadr[0] for name in names]
@@ -94,3 +82,22 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
         t=np.arange(samples) / rate, theta=out_theta, dtheta=out_dtheta, tau=applied, tau_commanded=commanded,
         current=None if device.config.actuation.motor is None else device.motor_currents(applied),
         tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=steps)
+
+
+def _steps(timestep: float, rate: float, duration: float, samples: int, argument: str) -> int:
+    """MuJoCo's steps of ``timestep`` s per sample period at ``rate`` Hz, a whole number;
+    InvalidInputError naming ``argument`` (rate or timestep; duration for a run too long at one
+    step per sample) beyond MAX_STEPS per sample or per run."""
+    steps = 1.0 / (rate * timestep)
+    if steps > MAX_STEPS:
+        raise InvalidInputError(f"{steps:.3g} MuJoCo steps of {timestep:g} s per sample at {rate:g} Hz, more than "
+                                f"{MAX_STEPS:.0e}", argument=argument)
+    if abs(steps - round(steps)) > 1e-9 * steps or round(steps) < 1:
+        raise InvalidInputError(f"{rate:g} Hz is not 1 / timestep ({1 / timestep:g} Hz) divided by a whole number"
+                                + ("; pass timestep" if argument == "rate" else ""), argument=argument)
+    whole = int(round(steps))
+    if (samples - 1) * whole > MAX_STEPS:
+        raise InvalidInputError(f"{duration:g} s at {rate:g} Hz needs {(samples - 1) * whole:.3g} MuJoCo steps of "
+                                f"{timestep:g} s, more than {MAX_STEPS:.0e} (minutes)",
+                                argument="duration" if whole == 1 else argument)
+    return whole

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import array
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
