@@ -83,7 +83,7 @@ class Plant:
     """The device between two samples, for simulate(): ``saturate`` a command, then ``hold`` it
     over a sample period.
 
-    M(theta) ddtheta + C dtheta + N(theta) = tau - tau_friction - tau_stops, with M including the
+    M(theta) ddtheta + C dtheta + N(theta) = tau - tau_friction + tau_stops, with M including the
     rotors' reflected inertia (Pinocchio's crba and nonLinearEffects on the Phantom's mimic
     model: Phantom.forward_dynamics without its per-call checks), ``friction``
     (config.Friction: viscous and Coulomb in motion; a joint at rest sticks while the torque
@@ -110,7 +110,9 @@ class Plant:
         self.bounds = list(zip(lower.tolist(), upper.tolist(), strict=True))     # rad, per stop coordinate
         self._flat_bounds = tuple(x for pair in self.bounds for x in pair)    # one unpacking per _margins
         self._stop_force = cast(StopForce, stops.force)                  # a float of floats
-        self._viscous, self._coulomb = actuation.friction.viscous, actuation.friction.coulomb
+        self._coulomb = actuation.friction.coulomb
+        #: (viscous N m s/rad, Coulomb N m), None without friction: one attribute lookup per evaluation
+        self._law = (actuation.friction.viscous, self._coulomb) if friction else None
         model = device.phantom.model
         # Pinocchio's model, data and inputs (filled in place), one tuple: one attribute lookup per evaluation
         self._pinocchio = (model, model.createData(), np.zeros(3), np.zeros(3))
@@ -159,16 +161,16 @@ class Plant:
         torque that takes) and the stops' ``contact`` (each engaged stop's spring and damper acting
         from its bound whichever side q is, so that a step is smooth up to the event that ends it);
         with ``holding``, (ddtheta, the friction torque holding each stuck joint, N m).
-        M^-1 (tau - friction - stops - C dtheta - N). The arguments' order suits functools.partial
+        M^-1 (tau - friction + stops - C dtheta - N). The arguments' order suits functools.partial
         (RK4's acceleration)."""
         # unrolled on Python floats: this runs four times per RK4 step, and Python's cost per
         # operation is what remains beside Pinocchio's (benchmarks/bench_plants.py)
         q0, q1, q2 = q
         v0, v1, v2 = v
         t0, t1, t2 = tau
-        friction = self.friction
-        if friction:
-            viscous, coulomb = self._viscous, self._coulomb
+        law = self._law
+        if law is not None:
+            viscous, coulomb = law
             m0, m1, m2 = mode
             t0 -= viscous * v0 + coulomb * m0
             t1 -= viscous * v1 + coulomb * m1
@@ -192,7 +194,7 @@ class Plant:
         b0, b1, b2 = pin.nonLinearEffects(model, data, position, rate).tolist()
         rhs = (t0 - b0, t1 - b1, t2 - b2)
         mass = pin.crba(model, data, position, pin.Convention.WORLD).tolist()    # DEVELOPERS.md
-        if not friction or all(mode):
+        if law is None or all(mode):
             solution = solve_spd(mass, rhs)
             if solution is None:  # M(theta) includes the rotors: positive definite at every finite theta
                 raise Diverged

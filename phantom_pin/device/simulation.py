@@ -32,8 +32,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     rounded to encoder counts (Device.encoder_counts) and dtheta as the backward difference
     of those quantized angles over one period (at t = 0, against theta0 - dtheta0 / rate).
 
-    Plant (device.plant.Plant): M(theta) ddtheta + C dtheta + N(theta) = tau_motor - tau_friction + tau_stops,
-    with M including the rotors' reflected inertia (Pinocchio's crba and nonLinearEffects
+    Plant (device.plant.Plant): M(theta) ddtheta + C dtheta + N(theta) = tau_motor -
+    tau_friction + tau_stops, with M including the rotors' reflected inertia (Pinocchio's crba and nonLinearEffects
     on the Phantom's mimic model, the computation of Phantom.forward_dynamics),
     ``friction`` config.Friction (viscous and Coulomb in motion; a joint at rest sticks while
     the torque that holds it is below the Coulomb torque: an exact mode of the integration, no
@@ -76,11 +76,13 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         out_theta.extend(q)
         out_dtheta.extend(v)
         t = k / rate  # as result.t: 9 / 1000 is 0.009, 9 * 0.001 is 0.009000000000000001
-        if controller is not None:
+        if controller is None:
+            commanded.extend(tau)                   # zero, nothing to clip
+        else:
             seen = (np.array(q), np.array(v)) if sense is None else sense(q)
             tau = command(controller(t, *seen), t).tolist()
-        commanded.extend(tau)
-        tau = plant.saturate(tau)
+            commanded.extend(tau)
+            tau = plant.saturate(tau)
         applied.extend(tau)
         if k == samples - 1:
             break
