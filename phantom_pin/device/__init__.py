@@ -1,9 +1,11 @@
-"""The physical PHANToM around its rigid body: stops, friction, motors, encoders (Device) and
-a haptic-loop simulator (simulate). Numbers: the Config's ``actuation`` and ``limits.stops``
-(config/NAME/actuation.yaml and joint_limits.yaml), with their sources."""
+"""The physical PHANToM around its rigid body: stops, friction, motors, encoders (Device), the
+plant between two samples (Plant: dynamics, friction with stiction, stops, saturation) and a
+haptic-loop simulator over it (simulate). Numbers: the Config's ``actuation`` and
+``limits.stops`` (config/NAME/actuation.yaml and joint_limits.yaml), with their sources."""
 
 from phantom_pin.device.device import Device
+from phantom_pin.device.plant import Plant
 from phantom_pin.device.run import SimulationResult
 from phantom_pin.device.simulation import simulate
 
-__all__ = ["Device", "SimulationResult", "simulate"]
+__all__ = ["Device", "Plant", "SimulationResult", "simulate"]
