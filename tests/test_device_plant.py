@@ -136,6 +136,16 @@ def test_simulate_mujoco_names_the_bad_argument_in_the_field(arguments, name):
     assert raised.value.argument == name and str(raised.value).startswith(f"{name}: ")
 
 
+@pytest.mark.parametrize("arguments, name", [
+    ({"dtheta0": [1e6, 0.0, 0.0]}, "dtheta0"),                                     # rad/s
+    ({"controller": lambda t, q, v: np.array([1e300, 0.0, 0.0]), "saturation": False}, "controller"),
+])
+def test_a_diverging_run_names_its_cause_in_the_field(arguments, name):
+    with pytest.raises(InvalidInputError) as raised:
+        simulate([0.0, 0.3, 0.4], 0.05, **arguments)
+    assert raised.value.argument == name and "the state diverged" in raised.value.detail
+
+
 def test_quantization_without_an_encoder_names_the_option():
     with pytest.raises(MissingDataError) as raised:
         simulate([0.2, 0.6, 0.8], 0.01, device=Device("touch"), quantization=True)

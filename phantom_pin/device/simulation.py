@@ -89,7 +89,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         try:
             q, v = plant.hold(q, v, tau, period, count)
         except Diverged:
-            raise InvalidInputError(_divergence(t, _rows(out_dtheta)[0], _rows(applied), saturation)) from None
+            raise _divergence(t, _rows(out_dtheta)[0], _rows(applied), saturation) from None
     if progress is not None:
         progress(1.0)
     theta_out, applied_out = _rows(out_theta), _rows(applied)
@@ -169,14 +169,16 @@ def _rows(buffer: array.array) -> np.ndarray:
     return np.frombuffer(buffer, dtype=float).reshape(-1, 3).copy()
 
 
-def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool | str) -> str:
-    """One line naming the likely cause of a state that diverged during the period from ``t``:
-    the largest initial rate or applied torque (what the plant was given)."""
+def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool | str) -> InvalidInputError:
+    """The error of a state that diverged during the period from ``t``, naming the likely cause:
+    the largest initial rate or applied torque (what the plant was given), in the argument field
+    where it is one argument."""
     rate, torque = float(np.abs(dtheta0).max()), float(np.abs(applied).max())
+    when = f"the state diverged between t = {t:.6g} s and the next sample"
     if rate >= 1e3:
-        cause = f"dtheta0: {rate:.3g} rad/s is far beyond any joint speed of the arm"
-    elif not saturation and torque >= 1e3:
-        cause = f"controller: it applied up to {torque:.3g} N m with saturation off"
-    else:
-        cause = f"controller or dtheta0: up to {torque:.3g} N m and {rate:.3g} rad/s at the start"
-    return f"{cause}; the state diverged between t = {t:.6g} s and the next sample"
+        return InvalidInputError(f"{rate:.3g} rad/s is far beyond any joint speed of the arm; {when}",
+                                 argument="dtheta0")
+    if not saturation and torque >= 1e3:
+        return InvalidInputError(f"it applied up to {torque:.3g} N m with saturation off; {when}",
+                                 argument="controller")
+    return InvalidInputError(f"controller or dtheta0: up to {torque:.3g} N m and {rate:.3g} rad/s at the start; {when}")
