@@ -146,6 +146,18 @@ def test_a_diverging_run_names_its_cause_in_the_field(arguments, name):
     assert raised.value.argument == name and "the state diverged" in raised.value.detail
 
 
+@pytest.mark.parametrize("call, name", [
+    (lambda device: Device(3), "phantom"),
+    (lambda device: device.available_torque([0.0, 0.3, 0.4], "yes"), "continuous"),
+    (lambda device: device.tip_force_capacity([0.0, 0.3, 0.4], [0.0, 0.0, 0.0]), "direction"),
+    (lambda device: device.encoder_counts([1e300, 0.0, 0.0]), "theta"),
+])
+def test_the_device_names_the_bad_argument_in_the_field(device, call, name):
+    with pytest.raises(InvalidInputError) as raised:
+        call(device)
+    assert raised.value.argument == name and str(raised.value) == f"{name}: {raised.value.detail}"
+
+
 def test_quantization_without_an_encoder_names_the_option():
     with pytest.raises(MissingDataError) as raised:
         simulate([0.2, 0.6, 0.8], 0.01, device=Device("touch"), quantization=True)

@@ -49,8 +49,8 @@ class Device:
     def __init__(self, phantom: Phantom | Description | str | Path | None = None) -> None:
         if not isinstance(phantom, Phantom):
             if phantom is not None and not isinstance(phantom, (Description, str, Path)):
-                raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, a Description, a model "
-                                        f"name, a configuration folder or None, got {phantom!r}")
+                raise InvalidInputError(f"expected a phantom_pin.Phantom, a Description, a model name, a "
+                                        f"configuration folder or None, got {phantom!r}", argument="phantom")
             phantom = Phantom(phantom)
         self.phantom = phantom
         self.config: Config = phantom.config
@@ -183,7 +183,7 @@ class Device:
         (config.Actuation.limit): a model without public motor data has one limit, its
         joint_torque_limit, for both."""
         if not isinstance(continuous, (bool, np.bool_)):
-            raise InvalidInputError(f"continuous: expected True or False, got {continuous!r}")
+            raise InvalidInputError(f"expected True or False, got {continuous!r}", argument="continuous")
         return np.array(self.config.actuation.limit("continuous" if continuous else "peak"))
 
     def _drive(self, needed_by: str) -> tuple[np.ndarray, Motor]:
@@ -247,7 +247,7 @@ class Device:
                                     "the same shape")
         scale = np.abs(u).max(axis=-1, keepdims=True)
         if np.any(scale == 0):
-            raise InvalidInputError("direction: must not be the zero vector")
+            raise InvalidInputError("must not be the zero vector", argument="direction")
         u = u / scale                                         # no overflow in the norm
         u = u / np.linalg.norm(u, axis=-1, keepdims=True)
         lower, upper = self.available_torque(q, continuous)
@@ -284,7 +284,7 @@ class Device:
         with np.errstate(over="ignore"):          # refused below
             counts = np.rint(q * self.counts_per_radian)
         if np.abs(counts).max() >= 2.0**62:
-            raise InvalidInputError("theta: too large, its encoder counts overflow a 64-bit integer")
+            raise InvalidInputError("too large, its encoder counts overflow a 64-bit integer", argument="theta")
         return counts.astype(np.int64)
 
     def encoder_theta(self, counts: object) -> np.ndarray:
