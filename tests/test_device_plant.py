@@ -92,6 +92,28 @@ def test_beyond_the_coulomb_torque_a_joint_at_rest_breaks_away_along_its_load(de
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
 
 
+def test_hold_is_classical_rk4_of_the_closed_form_without_friction_and_stops(device):
+    """One period of 1 ms in two RK4 steps under a held torque, against the classical RK4 of the
+    report's closed form written here."""
+    def rate(x, tau):
+        q, v = x[:3], x[3:]
+        return np.concatenate([v, np.linalg.solve(closed_form.mass_matrix(q, REPORT), rhs(q, v, tau))])
+
+    x, tau, h = np.array([0.1, 0.5, 0.6, 0.4, -0.2, 0.3]), np.array([0.02, 0.05, -0.03]), 5e-4
+    for _ in range(2):
+        k1 = rate(x, tau)
+        k2 = rate(x + h / 2 * k1, tau)
+        k3 = rate(x + h / 2 * k2, tau)
+        k4 = rate(x + h * k3, tau)
+        x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    got = plant(device, friction=False, hard_stops=False).hold([0.1, 0.5, 0.6], [0.4, -0.2, 0.3], tau.tolist(),
+                                                               1e-3, 2)
+    np.testing.assert_allclose(np.concatenate(got), x, rtol=0, atol=1e-15)   # rad, rad/s; measured 0
+    one = plant(device, friction=False, hard_stops=False).hold([0.1, 0.5, 0.6], [0.4, -0.2, 0.3], tau.tolist(),
+                                                               1e-3, 1)
+    assert np.abs(np.concatenate(one) - x).max() > 1e-13                          # two steps are not one (3.5e-13)
+
+
 def test_the_clip_is_the_data_sheet_torque_of_each_policy(device):
     command = [3.0, -3.0, 0.01]                    # N m, beyond both limits on joints 1 and 2
     continuous, peak = TAU_NOMINAL * RATIOS, TAU_STALL * RATIOS
