@@ -14,12 +14,12 @@ import numpy as np
 
 from phantom_pin import drivers
 from phantom_pin.cli.common import output, phantom, warn
+from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import io
-from phantom_pin.identification.simulation import KD, KP, tracking
 from phantom_pin.progress import Progress
 
 #: simulate()'s arguments that are options of the command (its errors name them).

@@ -2,7 +2,7 @@
 the rigid body with its rotors, friction, stops and saturation, RK4 with a zero-order hold)
 tracking a trajectory with feed-forward plus PD, as ``phantom-pin simulate --trajectory`` does.
 
-``tracking(t, theta, dtheta, tau)`` is that controller; ``track(device, ...)`` runs it and
+``phantom_pin.device.controllers.tracking`` is that controller; ``track(device, ...)`` runs it and
 returns the Log a real device would write: the encoder's angles (quantized, with an encoder)
 and the *commanded* torques, each held until the next sample ("held" timing), while the plant
 receives them plus white noise (an amplifier's error the log does not see).
@@ -10,31 +10,13 @@ receives them plus white noise (an amplifier's error the log does not see).
 
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
 
+from phantom_pin.device.controllers import tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import simulate
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log
-
-#: The PD gains of the tracking controller (N m/rad, N m s/rad).
-KP, KD = 5.0, 0.05
-
-
-def tracking(t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray,
-             kp: float = KP, kd: float = KD) -> Callable[[float, np.ndarray, np.ndarray], np.ndarray]:
-    """The controller (simulate's) that follows a trajectory sampled at the fixed rate of ``t``
-    (s; theta rad, dtheta rad/s, tau the feed-forward torque N m, each (N, 3)): at time s it
-    returns tau[k] + kp (theta[k] - theta_measured) + kd (dtheta[k] - dtheta_measured), k the
-    sample at t[0] + s (the last one after the end): simulate's time starts at 0."""
-    rate = (len(t) - 1) / (t[-1] - t[0])
-
-    def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        k = min(int(round(time * rate)), len(t) - 1)
-        return tau[k] + kp * (theta[k] - q) + kd * (dtheta[k] - v)
-    return controller
 
 
 def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray,
