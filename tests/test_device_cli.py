@@ -155,3 +155,20 @@ def test_simulate_tracks_a_consistent_trajectory_and_warns_when_openhaptics_is_r
     code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log), "--force",
                        "--convention", "openhaptics")
     assert code == 0 and err == ""
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--duration", "1e308"], "--duration: 1e+308 s at 1000 Hz gives more than 1000000 samples"),
+    (["--duration", "1e200", "--rate", "1e200"], "--duration: 1e+200 s at 1e+200 Hz gives more than 1000000 samples"),
+    (["--duration", "0.01", "--set", "actuation.friction.viscous=1e9"],
+     "error: the model (--model, --config, --params, --set): 0.01 s at 1000 Hz needs"),
+    (["--duration", "0.5", "--set", "segment_a.mass=1e3"],
+     "error: the model (--model, --config, --params, --set): with at most 0 N m applied and 0 rad/s at the start, "
+     "the device itself diverged"),
+])
+def test_simulate_blames_what_is_at_fault_in_one_line(tmp_path, capsys, argv, message):
+    """Before: OverflowError tracebacks for 1e308 s; a stiff friction blamed on --rate; a
+    1000 kg segment blamed on "controller or dtheta0" (both zero)."""
+    code, out, err = run(capsys, "simulate", "--theta0", "0.1", "0.3", "0.4", *argv, "-o", str(tmp_path / "r.csv"))
+    assert code == 2 and out == "" and err.count("\n") == 1 and message in err, err
+    assert not (tmp_path / "r.csv").exists()

@@ -23,7 +23,8 @@ from phantom_pin.identification import io
 from phantom_pin.progress import Progress
 
 #: simulate()'s arguments that are options of the command (its errors name them).
-OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization")}
+OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization")} | {
+    "device": "the model (--model, --config, --params, --set)"}
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}

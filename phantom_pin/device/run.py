@@ -90,7 +90,11 @@ def arguments(theta0: object, dtheta0: object, duration: object, rate: object, c
     if beyond > 2 * math.pi:
         raise InvalidInputError(f"{theta.tolist()} rad lies {beyond:.3g} rad beyond the stops, more than a turn: "
                                 "no posture of the arm", argument="theta0")
-    samples = math.floor(duration * rate * (1 + 1e-12)) + 1
+    periods = duration * rate * (1 + 1e-12)
+    if periods > MAX_SAMPLES:  # before the count: 1e308 s makes it inf, which no integer holds
+        raise InvalidInputError(f"{duration:g} s at {rate:g} Hz gives more than {MAX_SAMPLES} samples",
+                                argument="duration")
+    samples = math.floor(periods) + 1
     if samples < 2:
         raise InvalidInputError(f"{duration} s is shorter than one sample period (1 / rate = {1 / rate} s)",
                                 argument="duration")

@@ -89,7 +89,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         try:
             q, v = plant.hold(q, v, tau, period, count)
         except Diverged:
-            raise _divergence(t, _rows(out_dtheta)[0], _rows(applied), saturation) from None
+            raise _divergence(t, _rows(out_dtheta)[0], _rows(applied), saturation, device,
+                              _rows(out_theta)[0]) from None
     if progress is not None:
         progress(1.0)
     theta_out, applied_out = _rows(out_theta), _rows(applied)
@@ -143,8 +144,11 @@ def _steps(device: Device, theta0: np.ndarray, duration: float, rate: float, sam
             f"{substeps:.3g} substeps of {period / substeps:.2g} s"
             + ("" if fixed else f", the step the stiffest term allows on a stop: its "
                f"{device.config.limits.stops.stiffness:g} N m/rad and the friction; a run counted as if on one")
-            + f"), more than {MAX_STEPS:.0e} (about 4 minutes)",
-            argument="substeps" if fixed else "rate" if substeps > MAX_STEPS else "duration")
+            + f"), more than {MAX_STEPS:.0e} (about 4 minutes)"
+            + ("" if fixed or substeps <= MAX_STEPS else
+               f": the device's stops (B {device.config.limits.stops.damping:g} N m s/rad) and viscous friction "
+               f"({device.config.actuation.friction.viscous:g} N m s/rad) are too stiff to simulate at any rate"),
+            argument="substeps" if fixed else "device" if substeps > MAX_STEPS else "duration")
     return (substeps if fixed else free), substeps
 
 
@@ -169,10 +173,12 @@ def _rows(buffer: array.array) -> np.ndarray:
     return np.frombuffer(buffer, dtype=float).reshape(-1, 3).copy()
 
 
-def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool | str) -> InvalidInputError:
-    """The error of a state that diverged during the period from ``t``, naming the likely cause:
-    the largest initial rate or applied torque (what the plant was given), in the argument field
-    where it is one argument."""
+def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: bool | str, device: Device,
+                theta0: np.ndarray) -> InvalidInputError:
+    """The error of a state that diverged during the period from ``t``, naming the likely cause
+    in the argument field: the largest initial rate (dtheta0) or applied torque (controller),
+    what the plant was given; where both were modest, the device itself (its gravity torque at
+    ``theta0``, N m, against its stops)."""
     rate, torque = float(np.abs(dtheta0).max()), float(np.abs(applied).max())
     when = f"the state diverged between t = {t:.6g} s and the next sample"
     if rate >= 1e3:
@@ -181,4 +187,11 @@ def _divergence(t: float, dtheta0: np.ndarray, applied: np.ndarray, saturation: 
     if not saturation and torque >= 1e3:
         return InvalidInputError(f"it applied up to {torque:.3g} N m with saturation off; {when}",
                                  argument="controller")
+    if rate < 1.0 and torque < 1.0:  # neither the start nor the commands: the device's own numbers
+        gravity = float(np.abs(device.phantom.gravity(theta0)).max())
+        stops = device.config.limits.stops
+        return InvalidInputError(f"with at most {torque:.3g} N m applied and {rate:.3g} rad/s at the start, the "
+                                 f"device itself diverged: its gravity torque reaches {gravity:.3g} N m at theta0 "
+                                 f"against stops of {stops.stiffness:g} N m/rad (are its masses and lengths "
+                                 f"right?); {when}", argument="device")
     return InvalidInputError(f"controller or dtheta0: up to {torque:.3g} N m and {rate:.3g} rad/s at the start; {when}")
