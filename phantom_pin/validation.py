@@ -3,6 +3,7 @@ finiteness of inputs and results, angle wrapping, output paths."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -76,7 +77,7 @@ def wrap_angle(angle: np.ndarray) -> np.ndarray:
     return np.where(outside, np.pi - (np.pi - angle) % (2 * np.pi), angle)
 
 
-def output_path(path: object, force: bool, name: str, force_hint: str = "force=True") -> Path:
+def output_path(path: str | os.PathLike[str], force: bool, name: str, force_hint: str = "force=True") -> Path:
     """``path`` as the Path of a file to write: raise InvalidInputError naming ``name``
     if it is a folder, if its folder does not exist, or if it exists and not ``force``
     (``force_hint`` says how to ask for overwriting)."""

@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import CONFIG, RAISED, REPORT, dark, frame_pose, patch, render
+from helpers import CONFIG, RAISED, REPORT, dark, frame_pose, patch, render
 from phantom_pin import closed_form as cf
 from phantom_pin import describe
 from phantom_pin.cli import main

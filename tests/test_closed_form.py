@@ -5,7 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from conftest import REPORT
+from helpers import REPORT
 from phantom_pin import InvalidInputError, UnreachableTargetError
 from phantom_pin import closed_form as cf
 from phantom_pin.report import appendix

@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import URDF_PATH
+from helpers import URDF_PATH
 from phantom_pin.dynamics.coupling import Coupling, read_mimic_tags
 
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from conftest import REPORT
+from helpers import REPORT
 from phantom_pin.report import closed_form as cf
 from phantom_pin.report import derivation  # needs sympy, a test dependency: fail, never skip, without it
 

@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 import yourdfpy
 
-from conftest import CONFIG, REPORT, relative_error
+from helpers import CONFIG, REPORT, relative_error
 from phantom_pin.config import MODELS, files, models
 from phantom_pin.description.build import describe, links_yaml, shipped
 from phantom_pin.report import appendix, closed_form

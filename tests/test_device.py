@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from conftest import REPORT
+from helpers import REPORT
 from phantom_pin import Device, InvalidInputError, ParameterFileError, Phantom, closed_form, config
 from phantom_pin.config import MODELS
 

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import REPORT
+from helpers import REPORT
 from phantom_pin import closed_form, simulate
 from phantom_pin.cli import main
 

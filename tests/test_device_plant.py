@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import REPORT
+from helpers import REPORT
 from phantom_pin import Device, InvalidInputError, MissingDataError, closed_form, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.device.plant import Plant

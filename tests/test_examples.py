@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from conftest import CONFIG, REPORT, dark, frame_pose, light_grey, patch, render
+from helpers import CONFIG, REPORT, dark, frame_pose, light_grey, patch, render
 from phantom_pin import Device, Phantom, load
 from phantom_pin import closed_form as cf
 

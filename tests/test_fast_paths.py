@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import REPORT, URDF_PATH, relative_error
+from helpers import REPORT, URDF_PATH, relative_error
 from phantom_pin import InvalidInputError
 from phantom_pin import closed_form as cf
 from phantom_pin.dynamics.coupling import Coupling

@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from conftest import CONFIG, REPORT
+from helpers import CONFIG, REPORT
 from phantom_pin import Phantom, describe
 from phantom_pin.identification import base, constants
 from phantom_pin.identification import parameterization as pz

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import yaml
 
-from conftest import CONFIG, CONFIG_DIR, REPORT
+from helpers import CONFIG, CONFIG_DIR, REPORT
 from phantom_pin import closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.identification import io

@@ -12,7 +12,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import CONFIG, REPORT
+from helpers import CONFIG, REPORT
 from phantom_pin import Device, closed_form, describe, load
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides

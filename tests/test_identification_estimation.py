@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from conftest import CONFIG, REPORT
+from helpers import CONFIG, REPORT
 from phantom_pin import Device, Phantom, closed_form
 from phantom_pin.cli import main
 from phantom_pin.identification import constants, estimation, io

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from conftest import CONFIG
+from helpers import CONFIG
 from phantom_pin import Device, describe
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides

@@ -4,7 +4,7 @@ parameters to an inconsistent estimate generate a URDF that passes it."""
 import numpy as np
 import pytest
 
-from conftest import CONFIG, URDF_PATH
+from helpers import CONFIG, URDF_PATH
 from phantom_pin import ParameterFileError, Phantom, describe
 from phantom_pin.config.schema import BODIES as BODIES_FULL
 from phantom_pin.description.physical import check_urdf

@@ -5,7 +5,7 @@ describe() generates through xacro and Pinocchio reads."""
 import numpy as np
 import pytest
 
-from conftest import CONFIG
+from helpers import CONFIG
 from phantom_pin import Phantom, closed_form, describe
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.dynamics.coupling import Coupling

@@ -19,7 +19,7 @@ import pydrake.all as drake
 import pytest
 import yaml
 
-from conftest import CONFIG_DIR, relative_error
+from helpers import CONFIG_DIR, relative_error
 from phantom_pin import config
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.report import closed_form

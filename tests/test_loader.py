@@ -9,7 +9,7 @@ import pytest
 import yaml
 import yourdfpy
 
-from conftest import CONFIG_DIR, REPORT, SRDF_PATH, URDF_PATH, relative_error
+from helpers import CONFIG_DIR, REPORT, SRDF_PATH, URDF_PATH, relative_error
 from phantom_pin.dynamics.loader import PhantomLoader, load
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.report import closed_form

@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from conftest import CONFIG_DIR, REPORT, relative_error
+from helpers import CONFIG_DIR, REPORT, relative_error
 from phantom_pin import InvalidInputError, Phantom, UnreachableTargetError
 from phantom_pin import closed_form as cf
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from conftest import CONFIG_DIR, SRDF_PATH, URDF_PATH
+from helpers import CONFIG_DIR, SRDF_PATH, URDF_PATH
 from phantom_pin import ParameterFileError, Phantom
 from phantom_pin.cli import main
 from phantom_pin.config.files import FILES, apply_overrides, read_documents

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import REPORT
+from helpers import REPORT
 from phantom_pin import InvalidInputError, closed_form, simulate
 from phantom_pin.device.simulation import default_device
 

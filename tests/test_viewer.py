@@ -1,5 +1,5 @@
-"""The exported HTML rendered by headless chromium (conftest.render), checked against a
-pinhole projection of Pinocchio's kinematics (conftest.project)."""
+"""The exported HTML rendered by headless chromium (helpers.render), checked against a
+pinhole projection of Pinocchio's kinematics (helpers.project)."""
 
 import base64
 import json
@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 import umsgpack
 
-from conftest import RAISED, RESTING, dark, frame_pose, patch, red, render
+from helpers import RAISED, RESTING, dark, frame_pose, patch, red, render
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.viewer import FORCE_SCALE, Viewer
 

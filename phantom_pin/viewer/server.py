@@ -40,6 +40,7 @@ class MeshcatServer:
             preexec_fn=_die_with_parent if sys.platform == "linux" else None)
         atexit.register(self.stop)
         urls = {}
+        assert self.process.stdout is not None  # stdout=PIPE
         for _ in range(2):
             line = self.process.stdout.readline().decode().strip()
             key, _, value = line.partition("=")
@@ -64,7 +65,8 @@ class MeshcatServer:
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait()
-        self.process.stdout.close()
+        if self.process.stdout is not None:
+            self.process.stdout.close()
 
 
 def _serve() -> None:

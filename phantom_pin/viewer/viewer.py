@@ -58,7 +58,9 @@ def _in_order(html: str) -> str:
               [p for p, a in zip(payloads, is_animation) if a]
     script = (f"for (const command of {json.dumps(ordered)}) {{\n"
               "  viewer.handle_command_bytearray(Uint8Array.from(atob(command), c => c.charCodeAt(0)));\n}")
-    start = _COMMAND.search(html).start()
+    first = _COMMAND.search(html)
+    assert first is not None  # payloads were found by the same pattern
+    start = first.start()
     return html[:start] + script + _COMMAND.sub("", html[start:])
 
 
