@@ -31,6 +31,13 @@ BODIES = ("turret_link", "upper_arm_link", "crank_link", "lower_bar_link", "fore
 #: Largest |joint limit| (rad): a revolute joint's range beyond one turn each way repeats
 #: postures and describes no stop of this arm (mahilab's widest stop is 3.74 rad).
 JOINT_LIMIT_BOUND = 2 * math.pi
+#: Largest magnitude of any number of a configuration (SI units): the largest shipped is 1750
+#: (kg/m^3); past it squares and products of inertia overflow (l1 = 1e308: OverflowError) and
+#: MuJoCo's first step goes NaN. A scale, not a physical limit: a desk-top arm is far inside it.
+MAX_MAGNITUDE = 1e6
+#: The MJCF's timestep (s): a haptic loop's 1e-6 to 1e-2 s (MuJoCo went NaN on its first step
+#: of 1 s with the shipped stops and friction solref).
+TIMESTEP_RANGE = (1e-6, 1e-2)
 #: The stop coordinates as linear maps of theta (rows): theta1, theta2, theta3, theta2 - theta3.
 STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, -1.0]])
 STOP_COORDINATES.flags.writeable = False
@@ -319,6 +326,8 @@ class _Reader:
         name = ".".join(keys)
         if not is_number(value) or not math.isfinite(value):
             raise self.error(arg, f"{name} must be a finite number, got {value!r}")
+        if abs(value) > MAX_MAGNITUDE:
+            raise self.error(arg, f"{name} must be at most {MAX_MAGNITUDE:g} in magnitude (SI units), got {value!r}")
         if positive and value <= 0:
             raise self.error(arg, f"{name} must be positive, got {value!r}")
         if non_negative and value < 0:
@@ -328,8 +337,9 @@ class _Reader:
     def vector(self, arg: str, *keys: str, length: int) -> tuple:
         value = self.node(arg, *keys)
         if not (isinstance(value, list) and len(value) == length
-                and all(is_number(v) and math.isfinite(v) for v in value)):
-            raise self.error(arg, f"{'.'.join(keys)} must be a list of {length} finite numbers, got {value!r}")
+                and all(is_number(v) and math.isfinite(v) and abs(v) <= MAX_MAGNITUDE for v in value)):
+            raise self.error(arg, f"{'.'.join(keys)} must be a list of {length} finite numbers of magnitude at most "
+                                  f"{MAX_MAGNITUDE:g}, got {value!r}")
         return tuple(value)
 
     def text(self, arg: str, *keys: str) -> str:
@@ -360,6 +370,31 @@ DRIVE = ("transmission_ratio", "motor", "encoder")
 JOINT_LIMITS = ("joint_torque_limit", "joint_velocity_limit")
 
 
+#: Largest relative disagreement between a motor's torque and its torque constant times the
+#: current at the same point of its data sheet (maxon RE 25: 1.5 % at the nominal point, where
+#: the no-load current is not torque; 0.2 % at stall).
+MOTOR_TOLERANCE = 0.1
+
+
+def motor_problem(motor: Motor) -> str:
+    """What makes a motor's data sheet numbers inconsistent with each other ("" if nothing):
+    the continuous torque and current must be below the stall torque and current, and each
+    torque (N m) the torque constant (N m/A) times its current (A) within MOTOR_TOLERANCE."""
+    if motor.max_continuous_torque >= motor.stall_torque:
+        return (f"max_continuous_torque {motor.max_continuous_torque:g} N m must be below stall_torque "
+                f"{motor.stall_torque:g} N m")
+    if motor.max_continuous_current >= motor.stall_current:
+        return (f"max_continuous_current {motor.max_continuous_current:g} A must be below stall_current "
+                f"{motor.stall_current:g} A")
+    for torque, current in (("max_continuous_torque", "max_continuous_current"), ("stall_torque", "stall_current")):
+        expected = motor.torque_constant * getattr(motor, current)
+        if abs(getattr(motor, torque) / expected - 1) > MOTOR_TOLERANCE:
+            return (f"{torque} {getattr(motor, torque):g} N m is not torque_constant x {current} "
+                    f"({motor.torque_constant:g} N m/A x {getattr(motor, current):g} A = {expected:.4g} N m) within "
+                    f"{MOTOR_TOLERANCE:.0%}")
+    return ""
+
+
 def _actuation(r: _Reader) -> Actuation:
     arg = "actuation_file"
 
@@ -385,6 +420,9 @@ def _actuation(r: _Reader) -> Actuation:
         raise r.error(arg, f"{extra[0]} is for a model without motor data; with a motor, the joint limits "
                            "follow from max_continuous_torque, max_speed and the ratios")
     motor = Motor(*(act("motor", f.name, positive=True) for f in dataclasses.fields(Motor)))
+    problem = motor_problem(motor)
+    if problem:
+        raise r.error(arg, f"motor: {problem}")
     encoder = None if not public[2] else \
         Encoder(*(act("encoder", f.name, positive=True) for f in dataclasses.fields(Encoder)))
     ratios = tuple(act("transmission_ratio", j, positive=True) for j in JOINTS)
@@ -437,7 +475,10 @@ def _mujoco(r: _Reader) -> MujocoSettings:
                   r.vector(arg, "scene", "table_size", length=3),
                   r.number(arg, "scene", "table_offset_x"),
                   r.number(arg, "scene", "floor_below_table", positive=True))
-    return MujocoSettings(r.number(arg, "timestep", positive=True), integrator,
+    timestep = r.number(arg, "timestep", positive=True)
+    if not TIMESTEP_RANGE[0] <= timestep <= TIMESTEP_RANGE[1]:
+        raise r.error(arg, f"timestep must be {TIMESTEP_RANGE[0]:g} to {TIMESTEP_RANGE[1]:g} s, got {timestep!r}")
+    return MujocoSettings(timestep, integrator,
                           r.number(arg, "equality_solref_timesteps", positive=True),
                           r.number(arg, "equality_solref_damping_ratio", positive=True),
                           r.vector(arg, "equality_solimp", length=3),
