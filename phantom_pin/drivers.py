@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.validation import as_states
+from phantom_pin.validation import as_states, finite_result
 
 #: The names of the drivers' joint_states for theta1..theta3 (without prefix).
 JOINT_STATE_NAMES = ("waist", "shoulder", "elbow")
@@ -71,7 +71,15 @@ def openhaptics_torque_from_tau(tau: object) -> np.ndarray:
     """OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau
     (N m on the report's theta, e.g. Phantom.gravity): 1000 (-tau1, tau2, tau3)."""
     t, _ = as_states(tau, "tau")
-    return t * _SIGN * MILLI
+    with np.errstate(over="ignore"):  # reported by finite_result, naming tau
+        return finite_result(t * _SIGN * MILLI, "tau")
+
+
+def _prefix(prefix: object) -> str:
+    """``prefix`` (a ROS name prefix such as "left_") checked to be a str."""
+    if not isinstance(prefix, str):
+        raise InvalidInputError(f"expected a str such as '' or 'left_', got {prefix!r}", argument="prefix")
+    return prefix
 
 
 def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:
@@ -81,21 +89,24 @@ def theta_from_joint_state(names: object, position: object, prefix: str = "") ->
     (N, len(names)) for a batch): theta = (waist, shoulder, shoulder + elbow). Velocities
     (rad/s) convert the same way."""
     if isinstance(names, str) or not all(isinstance(n, str) for n in np.asarray(names, dtype=object).ravel()):
-        raise InvalidInputError(f"names: expected a sequence of joint names, got {names!r}")
+        raise InvalidInputError(f"expected a sequence of joint names, got {names!r}", argument="names")
     names = list(names)
-    wanted = [prefix + name for name in JOINT_STATE_NAMES]
+    wanted = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
     missing = [name for name in wanted if names.count(name) != 1]
     if missing:
-        raise InvalidInputError(f"names: must hold each of {', '.join(wanted)} exactly once; "
-                                f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not, in {names}")
+        raise InvalidInputError(f"must hold each of {', '.join(wanted)} exactly once; "
+                                f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not, in {names}",
+                                argument="names")
     values, _ = as_states(position, "position", width=len(names))
     waist, shoulder, elbow = (values[..., names.index(name)] for name in wanted)
-    return np.stack([waist, shoulder, shoulder + elbow], axis=-1)
+    with np.errstate(over="ignore"):  # reported by finite_result, naming position
+        return finite_result(np.stack([waist, shoulder, shoulder + elbow], axis=-1), "position")
 
 
 def joint_state_from_theta(theta: object, prefix: str = "") -> tuple[list[str], np.ndarray]:
     """(names, position) of the drivers' joint_states for the report's theta (rad):
     ([prefix + waist, shoulder, elbow], (theta1, theta2, theta3 - theta2)), (3,) or (N, 3)."""
     t, _ = as_states(theta, "theta")
-    return ([prefix + name for name in JOINT_STATE_NAMES],
-            np.stack([t[..., 0], t[..., 1], t[..., 2] - t[..., 1]], axis=-1))
+    names = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
+    with np.errstate(over="ignore"):  # reported by finite_result, naming theta
+        return names, finite_result(np.stack([t[..., 0], t[..., 1], t[..., 2] - t[..., 1]], axis=-1), "theta")

@@ -114,3 +114,18 @@ def test_bad_joint_states_raise_naming_the_argument(names, position, argument):
 def test_bad_vectors_raise_naming_the_argument(function):
     with pytest.raises(InvalidInputError, match=r"^(angles|theta|torque|tau): "):
         function([1.0, 2.0])
+
+
+@pytest.mark.parametrize("call, argument", [
+    (lambda: drivers.openhaptics_torque_from_tau([1e306, 0.0, 0.0]), "tau"),
+    (lambda: drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 1e308, 1e308]), "position"),
+    (lambda: drivers.joint_state_from_theta([0.0, -1e308, 1e308]), "theta"),
+    (lambda: drivers.joint_state_from_theta([0.0, 0.0, 0.0], prefix=5), "prefix"),
+    (lambda: drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], prefix=None), "prefix"),
+])
+def test_overflow_and_a_non_string_prefix_are_named_errors(call, argument):
+    """Before: -inf or inf came back from a finite input (1000 x 1e306 N m; 1e308 + 1e308 rad),
+    and a prefix of 5 raised TypeError."""
+    with pytest.raises(InvalidInputError) as error:
+        call()
+    assert error.value.argument == argument
