@@ -90,15 +90,15 @@ def theta_from_joint_state(names: object, position: object, prefix: str = "") ->
     (rad/s) convert the same way."""
     if isinstance(names, str) or not all(isinstance(n, str) for n in np.asarray(names, dtype=object).ravel()):
         raise InvalidInputError(f"expected a sequence of joint names, got {names!r}", argument="names")
-    names = list(names)
+    given: list[str] = list(names)  # type: ignore[call-overload]  # checked above: an iterable of str
     wanted = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
-    missing = [name for name in wanted if names.count(name) != 1]
+    missing = [name for name in wanted if given.count(name) != 1]
     if missing:
         raise InvalidInputError(f"must hold each of {', '.join(wanted)} exactly once; "
-                                f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not, in {names}",
+                                f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not, in {given}",
                                 argument="names")
-    values, _ = as_states(position, "position", width=len(names))
-    waist, shoulder, elbow = (values[..., names.index(name)] for name in wanted)
+    values, _ = as_states(position, "position", width=len(given))
+    waist, shoulder, elbow = (values[..., given.index(name)] for name in wanted)
     with np.errstate(over="ignore"):  # reported by finite_result, naming position
         return finite_result(np.stack([waist, shoulder, shoulder + elbow], axis=-1), "position")
 
