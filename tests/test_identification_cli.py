@@ -233,6 +233,14 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     assert keys["actuation.friction.coulomb"] == pytest.approx(law.coulomb, rel=1e-2)
     code, _, err = run(capsys, "simulate", "--trajectory", traj, "--duration", "3")
     assert code == 2 and "--duration: --trajectory sets it" in err
+    # the overlay carries its model and lengths: another model refuses it (before, the CAD
+    # model's overlay applied to premium_1_5 silently took the 1.5's lengths)
+    assert keys["model"] == "premium_1_5" and (keys["l1"], keys["l2"], keys["l3"]) == (
+        CONFIG.kinematics.l1, CONFIG.kinematics.l2, CONFIG.kinematics.l3)
+    urdf = tmp_path / "touch.urdf"
+    code, out, err = run(capsys, "--model", "touch", "urdf", "--params", overlay, "-o", urdf)
+    assert code == 2 and out == "" and err.count("\n") == 1 and not urdf.exists()
+    assert "model: these overrides were made for the model 'premium_1_5'" in err and "--model premium_1_5" in err
 
 
 @pytest.mark.parametrize("arguments, message", [

@@ -161,7 +161,7 @@ def identify_command(args: argparse.Namespace) -> int:
     if fit.problems and not args.force:
         more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
         raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--force writes it anyway)")
-    keys, notes = io.overlay(fit, given)
+    keys, notes = io.overlay(fit, given, phantom.config)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)
     except PhantomPinError as error:
@@ -188,6 +188,6 @@ def identify_command(args: argparse.Namespace) -> int:
         print(note)
     for problem in fit.problems:
         print(f"warning (written with --force): {problem}")
-    io.write_overlay(args.output, fit, args.log.name, given)
+    io.write_overlay(args.output, fit, args.log.name, given, phantom.config)
     print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
     return 0

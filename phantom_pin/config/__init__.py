@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from phantom_pin.config.files import FILES, apply_overrides, read_documents, read_overrides
+from phantom_pin.config.files import FILES, MODEL_KEY, apply_overrides, read_documents, read_overrides
 from phantom_pin.config.models import DEFAULT, MODELS, Model, models, resolve
 from phantom_pin.config.schema import (
     REPORT_SEGMENTS,
@@ -26,7 +26,7 @@ from phantom_pin.config.schema import (
 from phantom_pin.exceptions import ParameterFileError
 from phantom_pin.inertial import Inertial
 
-__all__ = ["read", "Config", "Inertial", "models", "Model", "MODELS", "DEFAULT", "FILES", "read_overrides",
+__all__ = ["read", "MODEL_KEY", "Config", "Inertial", "models", "Model", "MODELS", "DEFAULT", "FILES", "read_overrides",
            "Actuation", "CoupledStops", "Encoder", "Friction", "Kinematics", "Limits", "Motor",
            "MujocoSettings", "Scene", "Stops"]
 
@@ -34,11 +34,17 @@ __all__ = ["read", "Config", "Inertial", "models", "Model", "MODELS", "DEFAULT",
 def read(source: str | Path = DEFAULT, overrides: dict[str, object] | None = None) -> Config:
     """The Config of a model name (phantom_pin.models()) or a configuration folder, its
     files read once each, with ``overrides`` (dotted keys, files.apply_overrides) applied.
-    Raises ParameterFileError naming the file and the key, InvalidInputError naming
-    ``model`` for an unknown name or folder."""
+    An override ``model`` (files.MODEL_KEY, as identify's overlay writes it) must name this
+    model. Raises ParameterFileError naming the file and the key (or ``model`` for overrides
+    made for another model), InvalidInputError naming ``model`` for an unknown name or folder."""
     name, folder, _ = resolve(source)
-    documents = read_documents(folder)
     overrides = dict(overrides or {})
+    made_for = overrides.pop(MODEL_KEY, None)
+    if made_for is not None and made_for != name:
+        raise ParameterFileError(f"{MODEL_KEY}: these overrides were made for the model {made_for!r} (an "
+                                 f"identification's overlay, valid on its lengths and links only), not for "
+                                 f"{name!r}; choose --model {made_for}")
+    documents = read_documents(folder)
     in_links = {key: value for key, value in overrides.items() if section(key) == "links"}
     if in_links and "links" not in documents["physical_parameters_file"]:
         # a model in the report's form given links in full (identify's overlay): its five

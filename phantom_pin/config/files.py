@@ -119,6 +119,11 @@ def _child(node: object, part: str) -> object:
     return None
 
 
+#: The key of an overrides file that names the model it was made for (identify's overlays):
+#: read() refuses to apply it to another model.
+MODEL_KEY = "model"
+
+
 def read_overrides(path: Path | str) -> dict[str, float]:
     """Read a YAML file of parameter overrides into dotted keys.
 

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
+from phantom_pin.config import MODEL_KEY, MODELS, REPORT_SEGMENTS, Config, section
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.validation import as_states
 
@@ -217,13 +218,16 @@ def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2)
     return mean if ok.all() else None
 
 
-def overlay(fit, given: dict | None = None) -> tuple[dict[str, float], list[str]]:
+def overlay(fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
     """The --params keys of an identification (estimation.Fit) on a model with the overrides
     ``given`` (those of the bodies it identified dropped: the segments and links), and the
     comment lines that explain its friction: one value per law, the joints' inverse-variance
     mean of the physical (never negative) values, written only if they agree
-    (friction_overlay)."""
-    from phantom_pin.config import REPORT_SEGMENTS, section
+    (friction_overlay).
+
+    With the ``config`` identified on, the keys carry what the fit is only valid with: its
+    lengths l1, l2, l3 (m) and, for a named model, ``model`` (its name), which
+    phantom_pin.config.read checks against the model the keys are applied to."""
     from phantom_pin.identification.estimation import Fit
 
     if not isinstance(fit, Fit):
@@ -231,7 +235,12 @@ def overlay(fit, given: dict | None = None) -> tuple[dict[str, float], list[str]
     if given is not None and not isinstance(given, dict):
         raise InvalidInputError(f"given: expected a dict of --params keys or None, got {given!r}")
     bodies = REPORT_SEGMENTS + ("links",)
-    keys = {key: value for key, value in (given or {}).items() if section(key) not in bodies}
+    keys: dict[str, object] = {}
+    if config is not None:
+        if config.name in MODELS:
+            keys[MODEL_KEY] = config.name
+        keys.update(dataclasses.asdict(config.kinematics))
+    keys.update({key: value for key, value in (given or {}).items() if section(key) not in bodies})
     keys.update(fit.overrides)
     notes = []
     values, sigma = fit.friction
@@ -248,10 +257,11 @@ def overlay(fit, given: dict | None = None) -> tuple[dict[str, float], list[str]
     return keys, notes
 
 
-def write_overlay(path: Path | str, fit, source: str, given: dict | None = None) -> None:
+def write_overlay(path: Path | str, fit, source: str, given: dict | None = None,
+                  config: Config | None = None) -> None:
     """Write an identification (estimation.Fit) as a --params YAML file (dotted keys, SI units),
-    with the model's other overrides ``given`` (see ``overlay``)."""
-    keys, notes = overlay(fit, given)
+    with the model's other overrides ``given`` and what ``config`` fixes (see ``overlay``)."""
+    keys, notes = overlay(fit, given, config)
     lines = [f"# Identified by phantom-pin identify from {source} ({fit.structure} structure): a --params",
              "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
              "# (docs/identification.md). SI units.",
