@@ -156,6 +156,9 @@ BAD_LOGS = {
                           "the torques do not follow the motion"),
     "degrees": (lambda r: _bad(r, theta=np.degrees(r.log.theta)), "are they in degrees"),
     "mN m": (lambda r: _bad(r, tau=1000 * r.log.tau), "are they in another unit"),
+    # before: NumPy's overflow warnings and "SVD did not converge", naming nothing
+    "angles scaled by 1e300": (lambda r: _bad(r, theta=1e300 * r.log.theta), "rad beyond the stops, more than a turn"),
+    "torques scaled by 1e300": (lambda r: _bad(r, tau=1e300 * r.log.tau), "N m, more than 1000 N m: not joint torques"),
     "a 10 Hz log": (lambda r: _bad(r, step=100), "cutoff: 20 Hz needs a log at 400 Hz or faster (this one: 10 Hz"),
     "transmission ratio 11.2": (lambda r: _bad(r, tau=r.log.tau * [1, 11.2 / 11.6, 11.2 / 11.6]),
                                 "other transmission ratios (ratio 11."),

@@ -216,6 +216,14 @@ def _scaled(phi: np.ndarray, y: np.ndarray, weight: np.ndarray,
     return scale, _rms((phi @ solution[:p]) / np.where(scale != 0, scale, 1.0) - y, moving)
 
 
+#: Angles further than this beyond the stops (rad) are no posture of the arm: refused before
+#: the fit, as simulate refuses such a start.
+NO_POSTURE = 2 * np.pi
+#: Torques above this (N m) are no joint torque of a desk-top haptic arm (the Premium 1.5's
+#: peak is 1.7 N m): refused before the fit (1e300 overflowed its arithmetic).
+MAX_TORQUE = 1e3
+
+
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
              timing: str = "held") -> Fit:
@@ -250,6 +258,17 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise InvalidInputError(f"expected one of {', '.join(TIMINGS)}, got {timing!r}", argument="timing")
     if structure not in STRUCTURES:
         raise InvalidInputError(f"expected one of {', '.join(STRUCTURES)}, got {structure!r}", argument="structure")
+    beyond = np.abs(phantom.config.limits.stops.penetration(log.theta)).max(axis=0)
+    if (beyond > NO_POSTURE).any():  # before any arithmetic on them (1e300 rad: no SVD converges)
+        j = int(np.argmax(beyond))
+        raise LogError(f"theta{j + 1}: the log's angles reach {beyond[j]:.3g} rad beyond the stops, more than a "
+                       "turn: no posture of the arm; are they in degrees? (the log holds the report's theta in rad, "
+                       "or use --convention openhaptics)")
+    huge = np.abs(log.tau).max(axis=0)
+    if (huge > MAX_TORQUE).any():
+        j = int(np.argmax(huge))
+        raise LogError(f"tau{j + 1}: the log's torques reach {huge[j]:.3g} N m, more than {MAX_TORQUE:g} N m: not "
+                       "joint torques in N m (mN m? use --convention openhaptics for OpenHaptics' joint torques)")
     constant = [f"tau{j + 1}" for j in range(3) if np.ptp(log.tau[:, j]) == 0]
     if constant:
         raise LogError(f"{', '.join(constant)}: constant torque{'s' if len(constant) > 1 else ''} over the whole "
