@@ -179,13 +179,17 @@ def test_a_bad_log_is_refused_in_one_line_and_nothing_is_written(run, case, tmp_
 
 
 def test_forced_friction_is_never_negative(run, tmp_path):
-    """--force writes the sign-flipped log's result, with its problems as comments, and the
+    """--accept writes the sign-flipped log's result, with its problems as comments, and the
     friction it writes is not the negative estimate: 0 or more."""
     io.write_log(tmp_path / "log.csv", run.log.t, run.log.theta, -run.log.tau)
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--force")
-    assert code == 0 and "warning (written with --force): tau: the logged torques are -0.99" in out, err
+    assert code == 2 and "--accept writes it anyway" in err and not (tmp_path / "id.yaml").exists()
+    code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--accept")
+    assert code == 0 and "warning (written with --accept): tau: the logged torques are -0.99" in out, err
+    assert "negative friction (viscous1" in out
     text = (tmp_path / "id.yaml").read_text()
-    assert "# problem, written with --force:" in text
+    assert "# problem, written with --accept:" in text
+    code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--accept")
+    assert code == 2 and "exists; add --force to overwrite it" in err   # --accept is no licence to overwrite
     keys = read_overrides(tmp_path / "id.yaml")
     assert all(keys.get(f"actuation.friction.{kind}", 0.0) >= 0 for kind in ("viscous", "coulomb"))
-    assert "negative friction (viscous1" in out

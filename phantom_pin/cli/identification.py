@@ -75,8 +75,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--structure", choices=("general", "report"), default="general",
                           help="general: the rigid body in full, every identifiable base parameter (default); "
                                "report: the report's eight constants (a model in the report's form)")
-    identify.add_argument("--force", "-f", action="store_true",
-                          help="overwrite an existing file, and write a result the checks refuse")
+    identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
+    identify.add_argument("--accept", action="store_true",
+                          help="write the result even where the checks refuse it, each check's reason as a warning "
+                               "and a comment in the file")
     identify.add_argument("--convention", choices=CONVENTIONS, default="report",
                           help="the log's theta and tau columns: the report's theta (rad) and N m (default), "
                                "or OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad) and joint torques (mN m)")
@@ -158,9 +160,9 @@ def identify_command(args: argparse.Namespace) -> int:
                                   timing=args.torque_timing)
     finally:
         bar.close()
-    if fit.problems and not args.force:
+    if fit.problems and not args.accept:
         more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
-        raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--force writes it anyway)")
+        raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--accept writes it anyway)")
     keys, notes = io.overlay(fit, given, phantom.config)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)
@@ -187,7 +189,7 @@ def identify_command(args: argparse.Namespace) -> int:
     for note in notes:
         print(note)
     for problem in fit.problems:
-        print(f"warning (written with --force): {problem}")
+        print(f"warning (written with --accept): {problem}")
     io.write_overlay(args.output, fit, args.log.name, given, phantom.config)
     print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
     return 0

@@ -272,7 +272,7 @@ def write_overlay(path: Path | str, fit, source: str, given: dict | None = None,
         lines.append(f"#   beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written "
                      f"{fit.written[k]:.6g}: {name}")
     lines += [f"# {note}" for note in notes]
-    lines += [f"# problem, written with --force: {problem}" for problem in fit.problems]
+    lines += [f"# problem, written with --accept: {problem}" for problem in fit.problems]
     lines += ["# Directions the torques do not determine are kept near the model's values (the prior)."]
     lines += [f"{key}: {value!r}" for key, value in keys.items()]
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
