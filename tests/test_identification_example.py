@@ -1,8 +1,13 @@
 """examples/identify_simulated.py runs headless, writes its figure, and on the CAD device the
 general identification predicts the held-out torques within 0.5 %, far better than the report
-structure's fit and the report's parameters, and says the general model is needed."""
+structure's fit and the report's parameters, and says the general model is needed; the figures
+the README and docs/identification.md quote are the ones it prints."""
+
+from pathlib import Path
 
 from test_examples import figure, number, run
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def test_identify_simulated_example(tmp_path):
@@ -14,3 +19,8 @@ def test_identify_simulated_example(tmp_path):
     report = number(r"report's parameters (\S+) %", result.stdout)
     assert general < 0.5 and structure > 3 * general and report > 10 * general
     assert "this device has products of inertia or off-axis centres of mass" in result.stdout
+    quoted = (f"general {general:.2f} %, report structure {structure:.2f} %", f"report's parameters {report:.1f} %")
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    docs = " ".join((ROOT / "docs" / "identification.md").read_text().split())
+    for text in (readme, docs):  # before: the docs said 1.59 % where the example printed 1.43 %
+        assert quoted[0] in text and quoted[1] in text, quoted
