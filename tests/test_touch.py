@@ -4,6 +4,8 @@ refuses, and the identification of a simulated Touch through OpenHaptics' joint 
 
 import dataclasses
 import json
+import re
+import shlex
 import shutil
 from contextlib import redirect_stdout
 from io import StringIO
@@ -266,7 +268,17 @@ def test_a_touch_trajectory_in_openhaptics_terms_is_tracked_and_identified(tmp_p
                      "--restarts", "1", "--convention", "openhaptics"]) == 0
         assert main(["--model", "touch", "simulate", "--trajectory", str(traj), "--convention", "openhaptics",
                      "--format", "csv", "-o", str(log_)]) == 0
+    printed = StringIO()
+    with redirect_stdout(printed):
         assert main(["--model", "touch", "identify", str(log_), "-o", str(overlay)]) == 0
+    # the command identify suggests, run as printed, writes the identified URDF (before, the hint
+    # had no --model, and the overlay then applied to premium_1_5's lengths)
+    hint = re.search(r"\(phantom-pin (.*urdf --params .*)\)$", printed.getvalue(), re.MULTILINE).group(1)
+    assert hint.startswith("--model touch urdf")
+    with redirect_stdout(StringIO()):
+        assert main(shlex.split(hint.replace("my_phantom.urdf", str(tmp_path / "my_phantom.urdf")))) == 0
+    written = (tmp_path / "my_phantom.urdf").read_text()
+    assert written == describe("touch", overrides=read_overrides(overlay), robot_file="my_phantom.urdf").urdf
     estimate = describe("touch").config.report
     identified = Phantom(describe("touch", overrides=read_overrides(overlay)))
     theta = sample_postures(config.read("touch").limits, 200, np.random.default_rng(3), draws=800)

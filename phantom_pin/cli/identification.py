@@ -11,6 +11,7 @@ import numpy as np
 
 from phantom_pin import drivers
 from phantom_pin.cli.common import description, overrides
+from phantom_pin.config import DEFAULT
 from phantom_pin.description.build import describe
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -191,5 +192,7 @@ def identify_command(args: argparse.Namespace) -> int:
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
     io.write_overlay(args.output, fit, args.log.name, given, phantom.config)
-    print(f"wrote {args.output} (phantom-pin urdf --params {args.output} -o my_phantom.urdf)")
+    chosen = f"--config {args.config} " if args.config is not None else (
+        "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
+    print(f"wrote {args.output} (phantom-pin {chosen}urdf --params {args.output} -o my_phantom.urdf)")
     return 0
