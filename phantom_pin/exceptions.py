@@ -45,3 +45,7 @@ class ParameterFileError(PhantomPinError, ValueError):
 class MissingDataError(InvalidInputError):
     """The model lacks the data a call needs: its motors, transmission or encoders are not
     public (the Touch), so its currents or encoder counts cannot be computed."""
+
+
+class LogError(PhantomPinError, ValueError):
+    """A log file is missing, malformed, or not usable for identification."""

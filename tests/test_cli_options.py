@@ -101,3 +101,9 @@ def test_simulate_format_without_a_file_and_with_a_matching_extension(tmp_path, 
 def test_quiet_after_the_command_too(capsys):
     code, out, err = run(capsys, "check", "-n", "10", "-q")
     assert code == 0 and "all checks pass" in out and err == ""
+
+
+def test_show_refuses_an_empty_html_name_instead_of_serving(capsys):
+    """Before: `show --html ''` started the live viewer and blocked."""
+    code, out, err = run(capsys, "show", "--html", "")
+    assert code == 2 and out == "" and err == "phantom-pin: error: --html: empty; give a file name\n"

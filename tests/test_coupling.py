@@ -8,7 +8,8 @@ import pinocchio as pin
 import pytest
 
 from helpers import URDF_PATH
-from phantom_pin.dynamics.coupling import Coupling, read_mimic_tags
+from phantom_pin.description.mimic import read_mimic_tags
+from phantom_pin.dynamics.coupling import Coupling
 
 
 def _robots_dir() -> Path:

@@ -10,9 +10,9 @@ from helpers import CONFIG, REPORT
 from phantom_pin import Phantom, describe
 from phantom_pin.identification import base, constants
 from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.base import Structured, base_parameters
+from phantom_pin.identification.base import base_parameters
 from phantom_pin.identification.regressor import Regressor
-from phantom_pin.identification.structures import Report
+from phantom_pin.identification.structures import Report, Structured
 from phantom_pin.report import closed_form
 from test_identification_regressor import states as _states
 

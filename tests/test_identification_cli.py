@@ -10,6 +10,7 @@ from phantom_pin import closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.identification import io
 from phantom_pin.identification.excitation import continuous_effort
+from phantom_pin.identification.overlay import friction_overlay
 
 DESCRIPTION = describe()
 EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
@@ -157,11 +158,11 @@ def test_one_friction_value_is_written_only_when_the_joints_agree():
     """friction_overlay: the inverse-variance mean when every joint lies within max(3 sigma,
     20 % of the mean) of it, else None. Joint 3 here lies 0.27 from the mean of 1.033: 27 of its
     sigmas, and 26 % of the mean, so no common value."""
-    mean = io.friction_overlay(np.array([1.0, 1.01, 0.99]), np.array([0.01, 0.01, 0.01]))
+    mean = friction_overlay(np.array([1.0, 1.01, 0.99]), np.array([0.01, 0.01, 0.01]))
     assert mean == pytest.approx(1.0, abs=1e-12)
-    assert io.friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.01])) is None
+    assert friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.01])) is None
     # within 3 sigma though 26 % apart: one value
-    assert io.friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.1])) is not None
+    assert friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.1])) is not None
 
 
 @pytest.mark.parametrize("option, message", [

@@ -16,6 +16,7 @@ from phantom_pin.description.build import describe
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import estimation, excitation, io
+from phantom_pin.identification.overlay import overlay, write_overlay
 from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
@@ -164,7 +165,7 @@ def identify_command(args: argparse.Namespace) -> int:
     if fit.problems and not args.accept:
         more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
         raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--accept writes it anyway)")
-    keys, notes = io.overlay(fit, given, phantom.config)
+    keys, notes = overlay(fit, given, phantom.config)
     try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
         describe(phantom.config.folder, overrides=keys)
     except PhantomPinError as error:
@@ -191,7 +192,7 @@ def identify_command(args: argparse.Namespace) -> int:
         print(note)
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
-    io.write_overlay(args.output, fit, args.log.name, given, phantom.config)
+    write_overlay(args.output, fit, args.log.name, given, phantom.config)
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
     print(f"wrote {args.output} (phantom-pin {chosen}urdf --params {args.output} -o my_phantom.urdf)")

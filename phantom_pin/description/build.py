@@ -91,9 +91,9 @@ class Description:
     ``prefix`` of every name; ``urdf`` and ``srdf``: the texts xacro generates (every link
     passed the one physical check); ``mjcf`` and ``scene``: the MuJoCo texts, the scene
     including the robot as ``robot_file``. Phantom, load(), Device, simulate, the
-    identification, the viewer and the CLI all take a Description. ``cache`` holds what
-    consumers compute once per description (the identification's maps); nothing else in
-    it changes.
+    identification, the viewer and the CLI all take a Description. It is immutable; what a
+    consumer computes once per description lives with that consumer, keyed by it
+    (phantom_pin.identification.cache).
     """
 
     config: Config
@@ -104,7 +104,6 @@ class Description:
     mjcf: str
     scene: str
     robot_file: str
-    cache: dict = dataclasses.field(default_factory=dict, compare=False, repr=False)
 
 
 def _model(config: Config) -> Model:

@@ -29,7 +29,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from phantom_pin.config import Config, Scene
-from phantom_pin.dynamics.coupling import read_mimic_tags
+from phantom_pin.description.mimic import read_mimic_tags
 
 # (the header names the module as it was when the shipped files were first generated:
 # they stay byte for byte the same)

@@ -10,42 +10,14 @@ algorithms that Pinocchio 4.1 refuses, or gets wrong, on mimic models (DEVELOPER
 
 from __future__ import annotations
 
-import dataclasses
-import xml.etree.ElementTree as ET
-
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin.description.mimic import Mimic, read_mimic_tags
 from phantom_pin.exceptions import ParameterFileError
 
 #: Largest tree model (velocity dimension) whose projections use the Kronecker product.
 _KRON_MAX_NV = 16
-
-
-@dataclasses.dataclass(frozen=True)
-class Mimic:
-    """One <mimic> tag: angle(joint) = multiplier * angle(primary) + offset (rad or m)."""
-
-    joint: str
-    primary: str
-    multiplier: float
-    offset: float
-
-
-def read_mimic_tags(urdf_xml: str) -> dict[str, Mimic]:
-    """The <mimic> tags of a URDF document, keyed by the mimicking joint's name."""
-    try:
-        root = ET.fromstring(urdf_xml)
-    except ET.ParseError as error:
-        raise ParameterFileError(f"URDF is not well-formed XML: {error}") from error
-    mimics = {}
-    for joint in root.findall("joint"):
-        tag = joint.find("mimic")
-        if tag is not None:
-            name = joint.get("name")
-            mimics[name] = Mimic(name, tag.get("joint"), float(tag.get("multiplier", 1.0)),
-                                 float(tag.get("offset", 0.0)))
-    return mimics
 
 
 class Coupling:

@@ -5,9 +5,10 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 
-from phantom_pin.config import DEFAULT, MODELS
+from phantom_pin.config import DEFAULT, MODELS, Config
 from phantom_pin.description.build import Description, description_of
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
@@ -45,6 +46,12 @@ def load_rotor_parameters(model: pin.Model, srdf_xml: str) -> None:
         path = Path(folder) / "rotors.srdf"
         path.write_text(srdf_xml, encoding="utf-8")
         pin.loadRotorParameters(model, str(path), False)
+
+
+def gravity_of(config: Config) -> pin.Motion:
+    """Pinocchio's gravity of a configuration: (0, 0, -g) m/s^2 in base_link (a URDF cannot
+    carry it; Pinocchio's default, 9.81, is the report's)."""
+    return pin.Motion(np.array([0.0, 0.0, -config.gravity]), np.zeros(3))
 
 
 def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader) -> pin.RobotWrapper:
@@ -92,8 +99,6 @@ def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader)
         label, what = urdf_name.split(": ", 1)
         raise ParameterFileError(f"{label}: Pinocchio cannot load {what} ({_first_line(error)})") from error
     if isinstance(source, (Description, str, Path)):  # a URDF file of one's own keeps Pinocchio's g
-        from phantom_pin.dynamics.model import gravity_of
-
         model.gravity = gravity_of(description.config)
     robot = pin.RobotWrapper(model, *geometry)
     try:

@@ -14,7 +14,7 @@ import pinocchio as pin
 from phantom_pin.config import Config
 from phantom_pin.description.build import Description, description_of
 from phantom_pin.dynamics.coupling import Coupling
-from phantom_pin.dynamics.loader import load_rotor_parameters
+from phantom_pin.dynamics.loader import gravity_of, load_rotor_parameters
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
 from phantom_pin.validation import as_states, finite_result, same_batch, within_box, wrap_angle
 
@@ -58,12 +58,6 @@ def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray, before: tupl
     data, frame...) in ``before`` and ``after`` without a Python frame per row."""
     fixed = map(itertools.repeat, before), map(itertools.repeat, after)
     return np.array(list(map(function, *fixed[0], *arrays, *fixed[1])))
-
-
-def gravity_of(config: Config) -> pin.Motion:
-    """Pinocchio's gravity of a configuration: (0, 0, -g) m/s^2 in base_link (a URDF cannot
-    carry it; Pinocchio's default, 9.81, is the report's)."""
-    return pin.Motion(np.array([0.0, 0.0, -config.gravity]), np.zeros(3))
 
 
 def solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:

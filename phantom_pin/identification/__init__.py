@@ -7,10 +7,12 @@ The public names: ``estimate`` (a log and a Phantom -> Fit, in the ``general`` s
 ``track`` (a simulated device logging a trajectory), ``Regressor`` and ``base_parameters``;
 ``LogError`` for a bad log."""
 
+from phantom_pin.exceptions import LogError
 from phantom_pin.identification.base import base_parameters
 from phantom_pin.identification.estimation import Fit, estimate
 from phantom_pin.identification.excitation import Excitation, optimise
-from phantom_pin.identification.io import Log, LogError, overlay, read_log, read_trajectory, write_log, write_overlay
+from phantom_pin.identification.io import Log, read_log, read_trajectory, write_log
+from phantom_pin.identification.overlay import overlay, write_overlay
 from phantom_pin.identification.regressor import Regressor
 from phantom_pin.identification.simulation import track
 

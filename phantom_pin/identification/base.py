@@ -5,10 +5,10 @@ pivoting, W P = Q [R1 R2], gives the numerical rank r (|R_kk| > tol |R_11|) and 
 parameters beta = pi_1 + R1^-1 R2 pi_2 (pi_1 the r pivot columns' parameters), with
 W pi = W_1 beta for every pi. ``BaseParameters.matrix`` is the map K: beta = K pi.
 
-Two models are used (run ``python -m phantom_pin.identification.base`` to print both):
+Two models are used (run ``python -m phantom_pin.identification.structures`` to print both):
 the general rigid-body model (structures.General: every standard parameter of the five bodies,
 the rotor inertia and the friction, through ``Regressor``'s tree bodies), and the report's
-structure (``Structured``: the report parameters of ``parameterization``, where centres of mass
+structure (structures.Structured: the report parameters of ``parameterization``, where centres of mass
 lie on the segments' axes and the segment axes are principal, plus friction). The second's
 rigid-body base is the report's eight constants K1, K2, K3, L, M22, M33 and the gravity
 coefficients of eqs 81-94 (``report_constants``).
@@ -22,8 +22,6 @@ import numpy as np
 import scipy.linalg
 
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.dynamics.model import Phantom
-from phantom_pin.identification import constants, parameterization
 from phantom_pin.identification.regressor import Regressor
 
 #: Relative size of |R_kk| below which a column counts as dependent.
@@ -83,61 +81,9 @@ def base_parameters(stacked: np.ndarray, names: tuple[str, ...] | list[str],
     return BaseParameters(tuple(names), tuple(int(i) for i in order[:rank]), matrix)
 
 
-class Structured:
-    """The regressor in the report parameters x and friction f: tau = Phi (x, f) + tau_0.
-
-    Phi = [Y_rigid A, Y_friction] with pi = A x + b (parameterization.affine_map); tau_0 =
-    Y_rigid b is the part fixed by the known parameters (zero here: the pins' compensation
-    cancels and the base's fixed parameters do not enter). The configuration is the
-    regressor's Phantom's (``description``).
-    """
-
-    def __init__(self, regressor: Regressor) -> None:
-        self.regressor = regressor
-        self.description = regressor.phantom.description
-        self.affine, self.offset = parameterization.affine_map(self.description, regressor.bodies)
-        self.names = tuple(parameterization.SYMBOLS) + tuple(
-            f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
-
-    def __call__(self, theta: object, dtheta: object, ddtheta: object) -> tuple[np.ndarray, np.ndarray]:
-        """(Phi (..., 3, 26), tau_0 (..., 3)) at the given states (rad, rad/s, rad/s^2)."""
-        y = self.regressor(theta, dtheta, ddtheta)
-        rigid = y[..., :self.affine.shape[0]]
-        return (np.concatenate([rigid @ self.affine, y[..., self.regressor.friction]], axis=-1),
-                rigid @ self.offset)
-
-
 def sample(regressor: Regressor, n: int = 300, seed: int = 0) -> tuple[np.ndarray, ...]:
     """``n`` seeded states inside the limits of the regressor's configuration (the box, the
     stops and the coupled stops; rad, rad/s, rad/s^2)."""
     theta = sample_postures(regressor.phantom.config.limits, n, np.random.default_rng(seed), draws=4 * n)
     rng = np.random.default_rng(seed + 1)
     return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
-
-
-def main() -> None:
-    from phantom_pin.identification.structures import General
-
-    regressor = Regressor(Phantom())
-    states = sample(regressor)
-    full = base_parameters(regressor.stacked(*states), regressor.names,
-                           np.maximum(np.abs(regressor.parameters(5e-4, 0.01)), 1e-6))
-    general = General(regressor.phantom)
-    print(f"The mimic tree's regressor: {regressor.size} parameters ({len(regressor.bodies)} tree bodies x 10, "
-          f"3 rotors, 6 friction), {full.rank} base parameters; two of them are the hinge pins' own first "
-          "moments (crank_pin_link.mx, forearm_pin_link.mx), fixed by the model, so that the device has")
-    print(f"General rigid-body model (identify's default): {len(general.names)} parameters (5 bodies x 10, "
-          f"the rotor inertia, 6 friction), {general.base.rank} base parameters:")
-    print("\n".join(general.base.describe()))
-    structured = Structured(regressor)
-    phi = structured(*states)[0].reshape(-1, len(structured.names))
-    x0 = parameterization.report_vector(structured.description.config)
-    report = base_parameters(phi, structured.names, np.concatenate([np.abs(x0), [5e-4] * 3 + [0.01] * 3]))
-    print(f"\nThe report's structure: {len(structured.names)} parameters (report parameters and "
-          f"friction), {report.rank} base parameters: the friction and the report's constants")
-    for name, row in zip(constants.NAMES, constants.constants_matrix(structured.description)):
-        print(f"{name:4} = {words(row, parameterization.SYMBOLS)}")
-
-
-if __name__ == "__main__":
-    main()

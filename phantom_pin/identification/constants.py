@@ -17,6 +17,7 @@ import numpy as np
 
 from phantom_pin.description.build import Description
 from phantom_pin.identification import parameterization
+from phantom_pin.identification.cache import cached
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
 
@@ -44,9 +45,9 @@ def report_constants(x: np.ndarray, description: Description) -> np.ndarray:
 
 def constants_matrix(description: Description) -> np.ndarray:
     """C (8, 20) with report_constants(x) = C x: the constants are linear in x (lengths fixed).
-    Unit steps (1 kg, 1 kg m, 1 kg m^2) keep the differences exact to rounding. Cached on
-    the Description."""
-    if "constants_matrix" not in description.cache:
+    Unit steps (1 kg, 1 kg m, 1 kg m^2) keep the differences exact to rounding. Cached per
+    Description (identification.cache)."""
+    def compute() -> np.ndarray:
         x0 = parameterization.report_vector(description.config)
         c0 = report_constants(x0, description)
         columns = []
@@ -54,18 +55,19 @@ def constants_matrix(description: Description) -> np.ndarray:
             x = x0.copy()
             x[k] += 1.0
             columns.append(report_constants(x, description) - c0)
-        description.cache["constants_matrix"] = np.stack(columns, axis=1)
-    return description.cache["constants_matrix"].copy()
+        return np.stack(columns, axis=1)
+
+    return cached(description, "constants_matrix", compute).copy()
 
 
 def _unit_parameters(description: Description) -> tuple[ReportParameters, ...]:
     """One ReportParameters per constant whose constants are e_k (x = C^+ e_k), cached."""
-    if "unit_parameters" not in description.cache:
+    def compute() -> tuple[ReportParameters, ...]:
         pseudo = np.linalg.pinv(constants_matrix(description))
         known = parameterization.report_of(description.config)
-        description.cache["unit_parameters"] = tuple(_linear_parameters(pseudo[:, k], known)
-                                                     for k in range(len(NAMES)))
-    return description.cache["unit_parameters"]
+        return tuple(_linear_parameters(pseudo[:, k], known) for k in range(len(NAMES)))
+
+    return cached(description, "unit_parameters", compute)
 
 
 def _linear_parameters(x: np.ndarray, known: ReportParameters) -> ReportParameters:

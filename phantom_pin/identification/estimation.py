@@ -32,8 +32,8 @@ import scipy.signal
 
 from phantom_pin.config import Friction
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification.io import Log, LogError
+from phantom_pin.exceptions import InvalidInputError, LogError
+from phantom_pin.identification.io import Log
 from phantom_pin.identification.structures import STRUCTURES, Structure, friction_block
 
 #: Fewest periods of the cutoff the log must span (the filter's transients and edges).
@@ -89,7 +89,7 @@ class Fit:
     parameters, ``torque_rms`` the torque's RMS (N m); ``condition`` of the base regressor
     (columns scaled to unit norm); ``samples`` used; ``x``: the physical parameters
     (Structure.names: the structure's, then viscous1..3 N m s/rad, coulomb1..3 N m),
-    ``written`` = their beta, ``overrides`` their --params keys (without friction: io.overlay);
+    ``written`` = their beta, ``overrides`` their --params keys (without friction: overlay.overlay);
     ``comparison``: (name, residual RMS per joint, N m) of the other structure, or None;
     ``torque_scale`` (3,): the factors each joint's logged torque fits best with (joint 1's
     is 1), ``scaled_rms``: the residual with them; ``problems``: why the result should not be

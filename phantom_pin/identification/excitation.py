@@ -17,6 +17,7 @@ import scipy.optimize
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.identification.structures import General, Report, friction_block
 
 #: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
 #: would stall SLSQP's finite differences); the result is checked with the law itself.
@@ -113,8 +114,6 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
     numbers, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
     called with the share of the SLSQP iterations done. ``model``: the Phantom (or its
     Description, then loaded once more into Pinocchio) whose configuration is excited."""
-    from phantom_pin.identification.structures import General, Report, friction_block
-
     _check_arguments(period=period, harmonics=harmonics, samples=samples, margin=margin, torque_share=torque_share,
                      restarts=restarts, iterations=iterations, seed=seed, amplitude_weight=amplitude_weight)
     if progress is not None and not callable(progress):

@@ -17,8 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.config import MODEL_KEY, MODELS, REPORT_SEGMENTS, Config, section
-from phantom_pin.exceptions import InvalidInputError, PhantomPinError
+from phantom_pin.exceptions import LogError
 from phantom_pin.validation import as_states
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
@@ -26,10 +25,6 @@ TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "
                       "ddtheta1", "ddtheta2", "ddtheta3", "tau1", "tau2", "tau3")
 #: Shortest accepted log (s) and largest relative spread of the sampling interval.
 MIN_DURATION, RATE_TOLERANCE = 2.0, 0.01
-
-
-class LogError(PhantomPinError, ValueError):
-    """A log file is missing, malformed, or not usable for identification."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -206,73 +201,3 @@ def _column_name(text: str) -> str:
     ("Theta1", '"tau2"', "t [s]" as simulate writes it)."""
     name = text.strip().strip('"').strip("'").strip()
     return name.split("[")[0].strip().lower()
-
-
-def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2) -> float | None:
-    """One value for all three joints (inverse-variance mean) if each joint's estimate lies
-    within max(3 sigma, ``spread`` x mean) of it, else None: actuation.yaml holds one friction
-    law for every joint."""
-    weights = 1.0 / np.asarray(sigma) ** 2
-    mean = float((weights * values).sum() / weights.sum())
-    ok = np.abs(values - mean) <= np.maximum(3 * np.asarray(sigma), spread * abs(mean))
-    return mean if ok.all() else None
-
-
-def overlay(fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
-    """The --params keys of an identification (estimation.Fit) on a model with the overrides
-    ``given`` (those of the bodies it identified dropped: the segments and links), and the
-    comment lines that explain its friction: one value per law, the joints' inverse-variance
-    mean of the physical (never negative) values, written only if they agree
-    (friction_overlay).
-
-    With the ``config`` identified on, the keys carry what the fit is only valid with: its
-    lengths l1, l2, l3 (m) and, for a named model, ``model`` (its name), which
-    phantom_pin.config.read checks against the model the keys are applied to."""
-    from phantom_pin.identification.estimation import Fit
-
-    if not isinstance(fit, Fit):
-        raise InvalidInputError(f"fit: expected a phantom_pin.identification.Fit (estimate), got {fit!r}")
-    if given is not None and not isinstance(given, dict):
-        raise InvalidInputError(f"given: expected a dict of --params keys or None, got {given!r}")
-    bodies = REPORT_SEGMENTS + ("links",)
-    keys: dict[str, object] = {}
-    if config is not None:
-        if config.name in MODELS:
-            keys[MODEL_KEY] = config.name
-        keys.update(dataclasses.asdict(config.kinematics))
-    keys.update({key: value for key, value in (given or {}).items() if section(key) not in bodies})
-    keys.update(fit.overrides)
-    notes = []
-    values, sigma = fit.friction
-    for kind, part in (("viscous", slice(0, 3)), ("coulomb", slice(3, 6))):
-        common = friction_overlay(fit.x[-6:][part], sigma[part])   # the projection's: >= 0
-        listed = ", ".join(f"{v:.4g} +- {s:.2g}" for v, s in zip(values[part], sigma[part]))
-        if common is None:
-            notes.append(f"friction.{kind} per joint: {listed} (the joints differ: not written; "
-                         "actuation.yaml holds one value for all joints)")
-        else:
-            keys[f"actuation.friction.{kind}"] = common
-            notes.append(f"friction.{kind} per joint: {listed}; written {common:.4g}, the inverse-variance mean "
-                         "of the physical values (0 or more)")
-    return keys, notes
-
-
-def write_overlay(path: Path | str, fit, source: str, given: dict | None = None,
-                  config: Config | None = None) -> None:
-    """Write an identification (estimation.Fit) as a --params YAML file (dotted keys, SI units),
-    with the model's other overrides ``given`` and what ``config`` fixes (see ``overlay``)."""
-    keys, notes = overlay(fit, given, config)
-    lines = [f"# Identified by phantom-pin identify from {source} ({fit.structure} structure): a --params",
-             "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
-             "# (docs/identification.md). SI units.",
-             f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g}; "
-             "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms),
-             "# base parameters (estimate +- standard deviation; of the written parameters):"]
-    for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
-        lines.append(f"#   beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written "
-                     f"{fit.written[k]:.6g}: {name}")
-    lines += [f"# {note}" for note in notes]
-    lines += [f"# problem, written with --accept: {problem}" for problem in fit.problems]
-    lines += ["# Directions the torques do not determine are kept near the model's values (the prior)."]
-    lines += [f"{key}: {value!r}" for key, value in keys.items()]
-    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -26,6 +26,7 @@ import numpy as np
 from phantom_pin.config import Config
 from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.identification.cache import cached
 from phantom_pin.report.parameters import ReportParameters, links
 
 #: The report parameters, named by their --params key (first moments: mass * com).
@@ -97,9 +98,8 @@ def tree_parameters(x: np.ndarray, description: Description, bodies: list[str]) 
 def affine_map(description: Description, bodies: list[str]) -> tuple[np.ndarray, np.ndarray]:
     """(A, b) with pi_without_friction = A x + b; A is (73, 20), for the tree bodies
     ``bodies`` (link names in Pinocchio's order: Regressor.bodies). Built once per
-    Description (cached on it), from the Config alone."""
-    key = ("affine", tuple(bodies))
-    if key not in description.cache:
+    Description (identification.cache), from the Config alone."""
+    def compute() -> tuple[np.ndarray, np.ndarray]:
         x0 = report_vector(description.config)
         base = tree_parameters(x0, description, bodies)
         columns = []
@@ -111,6 +111,7 @@ def affine_map(description: Description, bodies: list[str]) -> tuple[np.ndarray,
             x[k] += step
             columns.append((tree_parameters(x, description, bodies) - base) / step)
         a = np.stack(columns, axis=1)
-        description.cache[key] = (a, base - a @ x0)
-    a, b = description.cache[key]
+        return a, base - a @ x0
+
+    a, b = cached(description, ("affine", tuple(bodies)), compute)
     return a.copy(), b.copy()

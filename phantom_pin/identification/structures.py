@@ -28,13 +28,39 @@ import numpy as np
 from phantom_pin.config.schema import BODIES, carve, uncarve
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.identification import constants, parameterization, physical
-from phantom_pin.identification.base import Structured, base_parameters, sample, words
+from phantom_pin.identification.base import base_parameters, sample, words
+from phantom_pin.identification.cache import cached
 from phantom_pin.identification.regressor import INERTIAL_NAMES, Regressor
 from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem
 
 FRICTION = constants.FRICTION_NAMES
 #: The unit of each standard parameter (INERTIAL_NAMES order).
 INERTIAL_UNITS = ("kg",) + ("kg m",) * 3 + ("kg m^2",) * 6
+
+
+
+class Structured:
+    """The regressor in the report parameters x and friction f: tau = Phi (x, f) + tau_0.
+
+    Phi = [Y_rigid A, Y_friction] with pi = A x + b (parameterization.affine_map); tau_0 =
+    Y_rigid b is the part fixed by the known parameters (zero here: the pins' compensation
+    cancels and the base's fixed parameters do not enter). The configuration is the
+    regressor's Phantom's (``description``).
+    """
+
+    def __init__(self, regressor: Regressor) -> None:
+        self.regressor = regressor
+        self.description = regressor.phantom.description
+        self.affine, self.offset = parameterization.affine_map(self.description, regressor.bodies)
+        self.names = tuple(parameterization.SYMBOLS) + tuple(
+            f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
+
+    def __call__(self, theta: object, dtheta: object, ddtheta: object) -> tuple[np.ndarray, np.ndarray]:
+        """(Phi (..., 3, 26), tau_0 (..., 3)) at the given states (rad, rad/s, rad/s^2)."""
+        y = self.regressor(theta, dtheta, ddtheta)
+        rigid = y[..., :self.affine.shape[0]]
+        return (np.concatenate([rigid @ self.affine, y[..., self.regressor.friction]], axis=-1),
+                rigid @ self.offset)
 
 
 class Structure:
@@ -111,11 +137,8 @@ class General(Structure):
                                      [config.actuation.rotor[0]] if self.motor else [], self.friction_prior])
         self.scale = np.concatenate([*(_body_scale(self.bodies[name]) for name in BODIES),
                                      [config.actuation.rotor[0]] if self.motor else [], self.friction_prior])
-        key = ("general base", prefix)
-        if key not in description.cache:      # the base of Y A: combinations of x only
-            description.cache[key] = base_parameters(regressor.stacked(*sample(regressor)) @ a, self.names,
-                                                     self.scale)
-        base = description.cache[key]
+        base = cached(description, ("general base", prefix),   # the base of Y A: combinations of x only
+                      lambda: base_parameters(regressor.stacked(*sample(regressor)) @ a, self.names, self.scale))
         order = np.argsort(base.independent)            # pivots in x's order: friction last
         self.base = dataclasses.replace(base, independent=tuple(base.independent[k] for k in order),
                                         matrix=base.matrix[order])
@@ -232,3 +255,29 @@ def _body_scale(body: Inertial) -> np.ndarray:
     m = pi[0]
     r = np.sqrt(max(pi[[4, 6, 9]].max(), 1e-12) / m)
     return np.array([m, *[m * r] * 3, *[m * r * r] * 6])
+
+
+def main() -> None:
+    regressor = Regressor(Phantom())
+    states = sample(regressor)
+    full = base_parameters(regressor.stacked(*states), regressor.names,
+                           np.maximum(np.abs(regressor.parameters(5e-4, 0.01)), 1e-6))
+    general = General(regressor.phantom)
+    print(f"The mimic tree's regressor: {regressor.size} parameters ({len(regressor.bodies)} tree bodies x 10, "
+          f"3 rotors, 6 friction), {full.rank} base parameters; two of them are the hinge pins' own first "
+          "moments (crank_pin_link.mx, forearm_pin_link.mx), fixed by the model, so that the device has")
+    print(f"General rigid-body model (identify's default): {len(general.names)} parameters (5 bodies x 10, "
+          f"the rotor inertia, 6 friction), {general.base.rank} base parameters:")
+    print("\n".join(general.base.describe()))
+    structured = Structured(regressor)
+    phi = structured(*states)[0].reshape(-1, len(structured.names))
+    x0 = parameterization.report_vector(structured.description.config)
+    report = base_parameters(phi, structured.names, np.concatenate([np.abs(x0), [5e-4] * 3 + [0.01] * 3]))
+    print(f"\nThe report's structure: {len(structured.names)} parameters (report parameters and "
+          f"friction), {report.rank} base parameters: the friction and the report's constants")
+    for name, row in zip(constants.NAMES, constants.constants_matrix(structured.description)):
+        print(f"{name:4} = {words(row, parameterization.SYMBOLS)}")
+
+
+if __name__ == "__main__":
+    main()

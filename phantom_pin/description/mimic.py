@@ -1,0 +1,35 @@
+"""A URDF's <mimic> tags: which joints follow which, by what multiplier and offset; read by
+the MJCF (its joint equalities) and by the dynamics' Coupling (the tree model's map)."""
+
+from __future__ import annotations
+
+import dataclasses
+import xml.etree.ElementTree as ET
+
+from phantom_pin.exceptions import ParameterFileError
+
+
+@dataclasses.dataclass(frozen=True)
+class Mimic:
+    """One <mimic> tag: angle(joint) = multiplier * angle(primary) + offset (rad or m)."""
+
+    joint: str
+    primary: str
+    multiplier: float
+    offset: float
+
+
+def read_mimic_tags(urdf_xml: str) -> dict[str, Mimic]:
+    """The <mimic> tags of a URDF document, keyed by the mimicking joint's name."""
+    try:
+        root = ET.fromstring(urdf_xml)
+    except ET.ParseError as error:
+        raise ParameterFileError(f"URDF is not well-formed XML: {error}") from error
+    mimics = {}
+    for joint in root.findall("joint"):
+        tag = joint.find("mimic")
+        if tag is not None:
+            name = joint.get("name")
+            mimics[name] = Mimic(name, tag.get("joint"), float(tag.get("multiplier", 1.0)),
+                                 float(tag.get("offset", 0.0)))
+    return mimics
