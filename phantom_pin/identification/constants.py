@@ -92,7 +92,7 @@ def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
     law = description.config.actuation.friction
     eye = np.eye(3)
     viscous = dtheta[..., :, None] * eye
-    coulomb = dataclasses.replace(law, viscous=0.0, coulomb=1.0).torque(dtheta)[..., :, None] * eye
+    coulomb = np.asarray(dataclasses.replace(law, viscous=0.0, coulomb=1.0).torque(dtheta))[..., :, None] * eye
     return np.concatenate([np.stack(columns, axis=-1), viscous, coulomb], axis=-1)
 
 

@@ -71,12 +71,12 @@ def condition_number(phi: np.ndarray) -> float:
 class Excitation:
     trajectory: Fourier
     condition: float        # of the general base regressor over one period (columns scaled to unit norm)
-    report_condition: float  # of the report structure's (None for a model in full)
+    report_condition: float | None  # of the report structure's (None for a model in full)
     peak_torque: np.ndarray  # N m per joint, the configuration's model with its friction
     min_slack: float        # rad, nearest approach to a stop
 
 
-def _check_arguments(**values: object) -> None:
+def _check_arguments(**values: float) -> None:
     """optimise()'s numbers: InvalidInputError naming the first that is out of its range."""
     integers = {"harmonics": 2, "samples": 10, "restarts": 1, "iterations": 1, "seed": 0}
     for name, value in values.items():

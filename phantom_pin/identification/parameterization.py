@@ -89,6 +89,8 @@ def tree_parameters(x: np.ndarray, description: Description, bodies: list[str]) 
     tree body (``bodies``, link names with the description's prefix), then J r_i^2 (kg m^2)."""
     config = description.config
     ratios = np.array(config.actuation.rotor[1])
+    if config.unprinted is None:
+        raise InvalidInputError("the report's parameters need a model in the report's form", argument="description")
     linked = links(report_parameters(x, config), config.unprinted, float(x[ROTOR]), config.actuation.rotor[1])
     prefix = description.prefix
     inertial = [linked[name[len(prefix):]].dynamic_parameters() for name in bodies]

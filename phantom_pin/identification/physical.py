@@ -19,6 +19,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from phantom_pin.config import Config
+from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import parameterization
 from phantom_pin.inertial import problem
 from phantom_pin.report.parameters import links
@@ -37,6 +38,8 @@ def consistent(x: np.ndarray, config: Config) -> bool:
     rotor = x[parameterization.ROTOR]
     if not ((rotor > 0 if config.actuation.motor else rotor == 0) and (x[list(parameterization.MASSES)] > 0).all()):
         return False
+    if config.unprinted is None:
+        raise InvalidInputError("the report's structure needs a model in the report's form", argument="config")
     linked = links(parameterization.report_parameters(x, config), config.unprinted, float(rotor),
                    config.actuation.rotor[1])
     return all(problem(link) is None for link in linked.values())
@@ -131,10 +134,16 @@ def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: 
     y = vt @ z0[free] * sizes                                      # the prior: consistent
     # the first weight balances the barrier and the cost (m / the prior's cost), but no less than
     # 1e-12 of the barrier's curvature: the Newton system stays solvable in floating point
-    weight = max(m / max(cost(y), 1e-300), 1e-12 * np.abs(barrier(y)[2]).max())
+    at_prior = barrier(y)
+    if at_prior is None:  # the prior is consistent (checked by the caller): inside the domain
+        raise InvalidInputError("the prior is not physically consistent", argument="prior")
+    weight = max(m / max(cost(y), 1e-300), 1e-12 * np.abs(at_prior[2]).max())
     while True:
         for _ in range(NEWTON_STEPS):
-            value, gradient, curvature = barrier(y)
+            evaluated = barrier(y)
+            if evaluated is None:  # the line search keeps y inside; rounding alone could leave
+                break
+            value, gradient, curvature = evaluated
             g = weight * (y - optimum) + gradient
             system = weight * np.eye(len(y)) + curvature
             try:

@@ -27,6 +27,7 @@ import numpy as np
 
 from phantom_pin.config.schema import BODIES, carve, uncarve
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import constants, parameterization, physical
 from phantom_pin.identification.base import base_parameters, sample, words
 from phantom_pin.identification.cache import cached
@@ -74,6 +75,9 @@ class Structure:
     offset: np.ndarray
     prior: np.ndarray                 # x of the Phantom's own model (friction: its law, each joint)
     scale: np.ndarray                 # the typical size of each entry of x
+    affine: np.ndarray                # the tree bodies' parameters pi = affine x + constant
+    constant: np.ndarray
+    rotor: int | None                 # x's index of the rotor inertia (None: no rotor parameter)
 
     def __init__(self, phantom: Phantom) -> None:
         self.phantom = phantom
@@ -100,6 +104,19 @@ class Structure:
 
     def friction_ok(self, x: np.ndarray) -> bool:
         return bool((np.asarray(x)[-6:] >= 0).all())
+
+    def regressor_of(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
+                     friction: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(Phi, tau_0) with tau = Phi x + tau_0 at the states (rad, rad/s, rad/s^2)."""
+        raise NotImplementedError
+
+    def consistent(self, x: np.ndarray) -> bool:
+        """Whether x is physically consistent (every body passes inertial.problem)."""
+        raise NotImplementedError
+
+    def overrides(self, x: np.ndarray) -> dict[str, float]:
+        """The --params keys of x (without friction)."""
+        raise NotImplementedError
 
 
 class General(Structure):
@@ -129,7 +146,7 @@ class General(Structure):
             else:
                 b[rows] = config.links[name].dynamic_parameters()
         if self.motor:
-            a[regressor.rotors, 50] = np.square(config.actuation.ratios)
+            a[regressor.rotors, 50] = np.square(np.asarray(config.actuation.ratios, dtype=float))
         a[regressor.friction, n - 6:] = np.eye(6)
         self.affine, self.constant = a, b
         self.rotor = 50 if self.motor else None
@@ -178,7 +195,10 @@ class General(Structure):
     def overrides(self, x: np.ndarray) -> dict[str, float]:
         """The links.* keys (mass kg, com m, inertia about the com kg m^2) and the rotor inertia."""
         out: dict[str, float] = {}
-        for name, body in self.bodies_of(x).items():
+        bodies = self.bodies_of(x)
+        if bodies is None:
+            raise InvalidInputError("a body's mass is not positive: no overlay", argument="x")
+        for name, body in bodies.items():
             out[f"links.{name}.mass"] = body.mass
             out.update({f"links.{name}.com.{k}": v for k, v in enumerate(body.com)})
             out.update({f"links.{name}.inertia.{k}": v for k, v in zip(INERTIA_KEYS, body.inertia)})
