@@ -280,7 +280,7 @@ def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, capsys, argv
 
 @pytest.mark.parametrize("file, old, new, message", [
     ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369, upper: 2.076941809873252}",
-     "joint2: {lower: -1e308, upper: 1e308}",
+     "joint2: {lower: -100.0, upper: 100.0}",
      "joint2.lower must be within one turn"),
     ("actuation.yaml", "motor:", "motor: [", "not valid YAML at line"),
     ("physical_parameters.yaml", "segment_a:", "segment_a: {", "not valid YAML at line"),

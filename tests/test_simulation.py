@@ -229,7 +229,7 @@ def test_the_plant_is_phantom_forward_dynamics_with_friction_and_stops():
 
 
 @pytest.mark.parametrize("duration, rate, stiffness, argument", [
-    (1e300, 1e-300, None, "rate"), (10000.0, 0.001, None, "duration"), (0.1, 1000.0, 1e12, "duration")])
+    (1e300, 1e-300, None, "rate"), (10000.0, 0.001, None, "duration"), (100.0, 1000.0, 1e6, "duration")])
 def test_work_beyond_a_few_minutes_is_refused_at_once(duration, rate, stiffness, argument):
     """The bound counts RK4 steps (periods x substeps), not samples: a huge period or a
     stiff stop is refused within a second, naming the argument and the stiffest term."""
