@@ -1,0 +1,404 @@
+"""A self-contained C99 header of one configuration's dynamics and kinematics, generated
+symbolically from its URDF (the same links, frames and <mimic> coupling Pinocchio loads).
+
+The generator runs the recursive Newton-Euler algorithm once over the URDF's tree with SymPy
+symbols for theta (rad), dtheta (rad/s) and ddtheta (rad/s^2) and the configuration's numbers
+as constants; each mimic joint's angle is multiplier * theta_primary + offset, so its torque
+returns to the primary joint times the multiplier (tau = G^T tau_tree). Gravity is the pass
+at zero rates, the mass matrix the passes at unit accelerations without gravity (plus the
+rotors' armature on the diagonal), the Coriolis vector the pass at zero accelerations without
+gravity. The tip's position in the report's frame s is the product of the joint transforms,
+its Jacobian the exact derivative. SymPy's common-subexpression elimination and C printer
+write each function as straight-line double arithmetic (literals with 17 significant digits).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any, Mapping
+
+from phantom_pin.config import DEFAULT, MODELS
+from phantom_pin.description.build import Description, describe, description_of
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError
+
+try:
+    import sympy as sp
+    from sympy.printing.c import C99CodePrinter
+except ImportError:  # pragma: no cover - the codegen extra
+    sp = None
+    C99CodePrinter = object
+
+#: The independent joints the header covers: the arm's three (the report's theta1..theta3).
+ARM_JOINTS = ("joint1", "joint2", "joint3")
+#: The URDF links of the report's frame s and of the tip (the gimbal's centre).
+FRAME_S, TIP = "report_s", "tip"
+
+
+def committed_header(name: str) -> Path:
+    """The committed header of a shipped model: include/ROBOT.h in the ROS package, beside
+    urdf/ROBOT.urdf (a ROS package's public headers live in include/)."""
+    model = MODELS[name]
+    return model.urdf.parent.parent / "include" / f"{model.urdf.stem}.h"
+
+
+def _require_sympy() -> None:
+    if sp is None:
+        raise ImportError("phantom_pin.codegen needs sympy: pip install 'phantom_pin[codegen]'")
+
+
+def is_identifier(name: object) -> bool:
+    """Whether ``name`` is a C identifier (letters, digits, underscores; not a leading digit)."""
+    return (isinstance(name, str) and name.isascii() and name.replace("_", "a").isalnum()
+            and not name[0].isdigit())
+
+
+# -- the URDF's tree ---------------------------------------------------------------------
+@dataclasses.dataclass(frozen=True)
+class _Joint:
+    name: str
+    parent: str
+    child: str
+    xyz: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+    axis: tuple[float, float, float] | None       # None: fixed
+    coordinate: int | None = None                 # index of theta driving it (None: fixed)
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+@dataclasses.dataclass(frozen=True)
+class _Link:
+    mass: float
+    com: tuple[float, float, float]
+    rpy: tuple[float, float, float]
+    inertia: tuple[float, float, float, float, float, float]  # ixx ixy ixz iyy iyz izz
+
+
+def _get(element: ET.Element, path: str, key: str, default: str | None = None) -> str:
+    """The attribute ``key`` of ``element``'s child at ``path`` ("" for the element itself);
+    ``default`` where absent; ParameterFileError if absent without a default."""
+    found = element if not path else element.find(path)
+    value = None if found is None else found.get(key)
+    if value is None:
+        if default is None:
+            raise ParameterFileError(f"URDF {element.tag} {element.get('name')!r}: no {path or element.tag} {key}")
+        return default
+    return value
+
+
+def _floats(text: str) -> tuple[float, float, float]:
+    x, y, z = (float(v) for v in text.split())
+    return x, y, z
+
+
+def _read_urdf(urdf: str, prefix: str) -> tuple[str, list[_Joint], dict[str, _Link]]:
+    """(root link, joints in topological order, links with an inertial) of a URDF text."""
+    root = ET.fromstring(urdf)
+    links: dict[str, _Link] = {}
+    for link in root.findall("link"):
+        inertial = link.find("inertial")
+        if inertial is not None:
+            ixx, ixy, ixz, iyy, iyz, izz = (float(_get(inertial, "inertia", k, "0"))
+                                            for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
+            links[_get(link, "", "name")] = _Link(
+                float(_get(inertial, "mass", "value")), _floats(_get(inertial, "origin", "xyz", "0 0 0")),
+                _floats(_get(inertial, "origin", "rpy", "0 0 0")), (ixx, ixy, ixz, iyy, iyz, izz))
+    arm = [prefix + name for name in ARM_JOINTS]
+    joints = []
+    for joint in root.findall("joint"):
+        name, kind = _get(joint, "", "name"), _get(joint, "", "type")
+        xyz, rpy = _floats(_get(joint, "origin", "xyz", "0 0 0")), _floats(_get(joint, "origin", "rpy", "0 0 0"))
+        parent, child = _get(joint, "parent", "link"), _get(joint, "child", "link")
+        if kind == "fixed":
+            joints.append(_Joint(name, parent, child, xyz, rpy, None))
+            continue
+        if kind not in ("revolute", "continuous"):
+            raise ParameterFileError(f"joint {name}: codegen covers revolute and fixed joints, not {kind}")
+        x, y, z = _floats(_get(joint, "axis", "xyz", "1 0 0"))
+        norm = math.sqrt(x * x + y * y + z * z)
+        primary = _get(joint, "mimic", "joint", name)
+        multiplier = float(_get(joint, "mimic", "multiplier", "1"))
+        offset = float(_get(joint, "mimic", "offset", "0"))
+        if primary not in arm:
+            raise ParameterFileError(f"joint {name}: codegen covers the arm's joints {', '.join(arm)} "
+                                     f"(and joints that mimic them), not {primary}")
+        joints.append(_Joint(name, parent, child, xyz, rpy, (x / norm, y / norm, z / norm), arm.index(primary),
+                             multiplier, offset))
+    children = {j.child for j in joints}
+    base = next(j.parent for j in joints if j.parent not in children)
+    order, frontier = [], [base]
+    while frontier:  # breadth first: every joint after its parent link's own joint
+        link = frontier.pop(0)
+        for joint in joints:
+            if joint.parent == link:
+                order.append(joint)
+                frontier.append(joint.child)
+    return base, order, links
+
+
+# -- symbolic algebra -----------------------------------------------------------------------
+def _num(value: float) -> Any:
+    """A configuration number as a SymPy constant: exact 0 and +-1, else 17 digits."""
+    if value in (0.0, 1.0, -1.0):
+        return sp.Integer(int(value))
+    return sp.Float(value, 17)
+
+
+def _rpy(rpy: tuple[float, float, float]) -> Any:
+    """URDF's fixed-axis roll-pitch-yaw rotation Rz(y) Ry(p) Rx(r), numeric."""
+    r, p, y = rpy
+    cr, sr, cp, sp_, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    rows = ((cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr),
+            (sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr),
+            (-sp_, cp * sr, cp * cr))
+    return sp.Matrix([[_num(v) for v in row] for row in rows])
+
+
+def _rotation(axis: tuple[float, float, float], angle: Any) -> Any:
+    """Rotation by ``angle`` about a unit ``axis`` (Rodrigues)."""
+    c, s = sp.cos(angle), sp.sin(angle)
+    a = sp.Matrix([_num(v) for v in axis])
+    cross = sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return c * sp.eye(3) + s * cross + (1 - c) * (a * a.T)
+
+
+def _cross(a: Any, b: Any) -> Any:
+    return sp.Matrix([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+class _Model:
+    """The URDF's tree with its constants as SymPy matrices, for the symbolic passes."""
+
+    def __init__(self, description: Description) -> None:
+        self.root, self.joints, links = _read_urdf(description.urdf, description.prefix)
+        self.gravity = _num(description.config.gravity)
+        self.armature = [_num(a) for a in description.config.actuation.armature]
+        self.links = {}
+        for name, link in links.items():
+            ixx, ixy, ixz, iyy, iyz, izz = link.inertia
+            rotation = _rpy(link.rpy)
+            inertia = sp.Matrix([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]).applyfunc(_num)
+            self.links[name] = (_num(link.mass), sp.Matrix([_num(v) for v in link.com]),
+                                rotation * inertia * rotation.T)
+        self.placements = {j.name: (_rpy(j.rpy), sp.Matrix([_num(v) for v in j.xyz])) for j in self.joints}
+
+    def rotation(self, joint: _Joint, theta: list[Any]) -> Any:
+        """The child frame's orientation in the parent's (parent -> child rotation)."""
+        fixed = self.placements[joint.name][0]
+        if joint.axis is None:
+            return fixed
+        assert joint.coordinate is not None
+        angle = _num(joint.multiplier) * theta[joint.coordinate] + _num(joint.offset)
+        return fixed * _rotation(joint.axis, angle)
+
+    def rnea(self, theta: list[Any], dtheta: list[Any], ddtheta: list[Any], gravity: bool) -> list[Any]:
+        """Joint torques (N m) on theta of the tree with every mimic joint following its
+        primary: Newton-Euler in each link's own frame; no armature."""
+        zero = sp.zeros(3, 1)
+        state = {self.root: (zero, zero, sp.Matrix([0, 0, self.gravity]) if gravity else zero)}
+        rotations = {}
+        for joint in self.joints:  # outwards: angular velocity, its rate, origin acceleration
+            w, dw, a = state[joint.parent]
+            r = self.rotation(joint, theta)
+            rotations[joint.name] = r
+            t = self.placements[joint.name][1]
+            rt = r.T
+            w_in = rt * w
+            a_child = rt * (a + _cross(dw, t) + _cross(w, _cross(w, t)))
+            if joint.axis is None:
+                state[joint.child] = (w_in, rt * dw, a_child)
+                continue
+            assert joint.coordinate is not None
+            axis = sp.Matrix([_num(v) for v in joint.axis])
+            k = _num(joint.multiplier)
+            rate, acc = k * dtheta[joint.coordinate], k * ddtheta[joint.coordinate]
+            state[joint.child] = (w_in + axis * rate, rt * dw + axis * acc + _cross(w_in, axis * rate), a_child)
+        wrench = {}
+        for link, (w, dw, a) in state.items():  # each link's own force and moment about its origin
+            if link not in self.links:
+                wrench[link] = (zero, zero)
+                continue
+            m, c, inertia = self.links[link]
+            force = m * (a + _cross(dw, c) + _cross(w, _cross(w, c)))
+            wrench[link] = (force, inertia * dw + _cross(w, inertia * w) + _cross(c, force))
+        tau = [sp.Integer(0)] * 3
+        for joint in reversed(self.joints):  # inwards: accumulate on the parent, project on the axis
+            f, n = wrench[joint.child]
+            if joint.axis is not None:
+                assert joint.coordinate is not None
+                axis = [_num(v) for v in joint.axis]
+                torque = axis[0] * n[0] + axis[1] * n[1] + axis[2] * n[2]
+                tau[joint.coordinate] += _num(joint.multiplier) * torque
+            r, t = rotations[joint.name], self.placements[joint.name][1]
+            rf = r * f
+            pf, pn = wrench[joint.parent]
+            wrench[joint.parent] = (pf + rf, pn + r * n + _cross(t, rf))
+        return tau
+
+    def pose(self, link: str, theta: list[Any]) -> tuple[Any, Any]:
+        """(rotation, origin) of ``link`` in the root link's frame."""
+        by_child = {j.child: j for j in self.joints}
+        rotation, origin = sp.eye(3), sp.zeros(3, 1)
+        while link != self.root:
+            joint = by_child[link]
+            # parent <- child: x_parent = R x_child + t
+            r, t = self.rotation(joint, theta), self.placements[joint.name][1]
+            rotation, origin = r * rotation, r * origin + t
+            link = joint.parent
+        return rotation, origin
+
+
+# -- C ---------------------------------------------------------------------------------------
+class _Printer(C99CodePrinter):  # type: ignore[misc]
+    """SymPy's C99 printer with squares as products and literals with 17 digits."""
+
+    def _print_Pow(self, expr: Any) -> str:
+        if expr.exp == 2:
+            base = self.parenthesize(expr.base, 100)
+            return f"{base}*{base}"
+        return super()._print_Pow(expr)
+
+
+def _body(outputs: list[tuple[str, Any]], inputs: list[tuple[str, list[Any]]]) -> str:
+    """C statements: the used inputs unpacked, the common subexpressions, the outputs."""
+    printer = _Printer({"precision": 17})
+    exprs = [e for _, e in outputs]
+    temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="none")
+    used = set().union(*(e.free_symbols for e in exprs))
+    lines = []
+    for array, symbols in inputs:
+        taken = [(i, s) for i, s in enumerate(symbols) if s in used]
+        if not taken:
+            lines.append(f"    (void){array};")
+        for i, s in taken:
+            lines.append(f"    const double {s} = {array}[{i}];")
+    for symbol, expr in temps:
+        lines.append(f"    const double {symbol} = {printer.doprint(expr)};")
+    for (target, _), expr in zip(outputs, reduced):
+        lines.append(f"    {target} = {printer.doprint(expr)};")
+    return "\n".join(lines)
+
+
+def _function(comment: str, signature: str, body: str) -> str:
+    text = "\n".join(" * " + line if line else " *" for line in comment.strip().splitlines())
+    return f"/*\n{text}\n */\nstatic inline void {signature}\n{{\n{body}\n}}\n"
+
+
+_ASSUMES = "Assumes finite input: no checks, no allocation, no global state."
+
+
+def header(source: str | Path | Description = DEFAULT, prefix: str = "phantom",
+           overrides: Mapping[str, object] | None = None) -> str:
+    """The C99 header of a model name (phantom_pin.models()) or a configuration folder with
+    ``overrides`` (as describe()'s), its functions named ``prefix``_...; its banner names
+    the model, the configuration's source and the overrides. describe()'s errors as they are;
+    InvalidInputError naming ``prefix`` unless it is a C identifier. A Description is taken
+    as it is (its banner then says so: the overrides it was built with are not known)."""
+    _require_sympy()
+    if not is_identifier(prefix):
+        raise InvalidInputError(f"must be a C identifier (letters, digits, _), got {prefix!r}",
+                                argument="prefix")
+    overlay = dict(overrides or {})
+    if isinstance(source, Description):
+        description, origin = source, f"a Description of {source.config.name}"
+        overlay_text = "as built into that Description"
+    else:
+        description = describe(source, overrides=overlay) if overlay else description_of(source, "source")
+        origin = (f"robots/phantom_description/config/{source}" if description.model is not None
+                  and str(source) == description.config.name else str(source))
+        overlay_text = "; ".join(f"{k} = {v!r}" for k, v in sorted(overlay.items())) or "none"
+    return _header(description, prefix, origin, overlay_text)
+
+
+def _header(description: Description, prefix: str, origin: str, overlay: str) -> str:
+    model = _Model(description)
+    theta = list(sp.symbols("q0:3", real=True))
+    dtheta = list(sp.symbols("dq0:3", real=True))
+    ddtheta = list(sp.symbols("ddq0:3", real=True))
+    f = list(sp.symbols("f0:3", real=True))
+    zero = [sp.Integer(0)] * 3
+    arm = model.armature
+    gravity = model.rnea(theta, zero, zero, True)
+    columns = [model.rnea(theta, zero, [sp.Integer(int(i == j)) for i in range(3)], False) for j in range(3)]
+    mass = [[columns[min(i, j)][max(i, j)] + (arm[i] if i == j else 0) for j in range(3)] for i in range(3)]
+    coriolis = model.rnea(theta, dtheta, zero, False)
+    full = model.rnea(theta, dtheta, ddtheta, True)
+    inverse = [full[i] + arm[i] * ddtheta[i] for i in range(3)]
+    r_s, p_s = model.pose(FRAME_S, theta)
+    _, p_tip = model.pose(TIP, theta)
+    position = r_s.T * (p_tip - p_s)
+    jacobian = [[sp.diff(position[i], theta[j]) for j in range(3)] for i in range(3)]
+    name = description.config.name
+    T, D, A = ("theta", theta), ("dtheta", dtheta), ("ddtheta", ddtheta)
+    guard = f"{prefix.upper()}_MODEL_H"
+    units = ("theta: the report's joint angles theta1..theta3 (rad); dtheta (rad/s); ddtheta (rad/s^2);\n"
+             "torques in N m on theta. " + _ASSUMES)
+    parts = [
+        f"/* {prefix}: the dynamics and kinematics of the PHANToM model {name}, generated by\n"
+        f" * phantom-pin codegen (phantom_pin.codegen) from its configuration. Do not edit: regenerate.\n"
+        f" *\n"
+        f" * Model: {name} (URDF robot {ET.fromstring(description.urdf).get('name')})\n"
+        f" * Configuration: {origin}\n"
+        f" * Overlay: {overlay}\n"
+        f" * Gravity: {description.config.gravity!r} m/s^2 along base_link's -z; armature (kg m^2): "
+        f"{', '.join(repr(a) for a in description.config.actuation.armature)}\n"
+        f" *\n"
+        f" * The arm's three joints (the report's theta1..theta3, the URDF's joint1..joint3, the\n"
+        f" * parallelogram's mimic joints following them); the tip is the gimbal's centre. A\n"
+        f" * stylus gimbal, where the device has one, is not part of this header.\n"
+        f" * C99 and C++, double precision, only <math.h>: static inline functions, no allocation,\n"
+        f" * no global state, every function re-entrant. Arrays are row-major. Every function\n"
+        f" * assumes finite input and does not check it.\n"
+        f" */\n"
+        f"#ifndef {guard}\n#define {guard}\n\n#include <math.h>\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n",
+        _function(f"Gravity torques tau = N(theta) (N m) at rest.\n{units}",
+                  f"{prefix}_gravity(const double theta[3], double tau[3])",
+                  _body([(f"tau[{i}]", gravity[i]) for i in range(3)], [T])),
+        _function(f"Inverse dynamics tau = M(theta) ddtheta + C(theta, dtheta) dtheta + N(theta) (N m),\n"
+                  f"the rotors' armature included; no friction.\n{units}",
+                  f"{prefix}_inverse_dynamics(const double theta[3], const double dtheta[3], "
+                  f"const double ddtheta[3], double tau[3])",
+                  _body([(f"tau[{i}]", inverse[i]) for i in range(3)], [T, D, A])),
+        _function(f"Joint-space mass matrix M(theta) (kg m^2), row-major M[3*i + j], symmetric,\n"
+                  f"the rotors' armature on its diagonal.\n{units}",
+                  f"{prefix}_mass_matrix(const double theta[3], double M[9])",
+                  _body([(f"M[{3 * i + j}]", mass[i][j]) for i in range(3) for j in range(3)], [T])),
+        _function(f"Coriolis and centrifugal torques c = C(theta, dtheta) dtheta (N m).\n{units}",
+                  f"{prefix}_coriolis(const double theta[3], const double dtheta[3], double c[3])",
+                  _body([(f"c[{i}]", coriolis[i]) for i in range(3)], [T, D])),
+        _function(f"Tip position p (m) in the report's frame s (x left, y up, z forward); the tip is\n"
+                  f"the gimbal's centre.\n{_ASSUMES}",
+                  f"{prefix}_tip_position(const double theta[3], double p[3])",
+                  _body([(f"p[{i}]", position[i]) for i in range(3)], [T])),
+        _function(f"Tip Jacobian J = dp/dtheta (m/rad), row-major J[3*i + j]: the tip's linear velocity\n"
+                  f"in frame s is J dtheta.\n{_ASSUMES}",
+                  f"{prefix}_tip_jacobian(const double theta[3], double J[9])",
+                  _body([(f"J[{3 * i + j}]", jacobian[i][j]) for i in range(3) for j in range(3)], [T])),
+        _function(f"Joint torques tau = J^T f (N m) that exert the force f (N, frame s) at the tip.\n{_ASSUMES}",
+                  f"{prefix}_jacobian_transpose_force(const double theta[3], const double f[3], double tau[3])",
+                  _body([(f"tau[{j}]", sum(jacobian[i][j] * f[i] for i in range(3))) for j in range(3)],
+                        [T, ("f", f)])),
+        _openhaptics(prefix),
+        f"#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {guard} */\n",
+    ]
+    return "\n".join(parts)
+
+
+def _openhaptics(prefix: str) -> str:
+    """OpenHaptics' conventions (phantom_pin.drivers): angles theta = (-a1, a2, a3);
+    HD_CURRENT_JOINT_TORQUE (mN m) = 1000 (-tau1, tau2, tau3)."""
+    return "\n".join([
+        _function("The report's theta (rad) of OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad): (-a1, a2, a3)\n"
+                  "(phantom_pin.drivers.theta_from_openhaptics).",
+                  f"{prefix}_theta_from_openhaptics(const double angles[3], double theta[3])",
+                  "    theta[0] = -angles[0];\n    theta[1] = angles[1];\n    theta[2] = angles[2];"),
+        _function("OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau\n"
+                  "(N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau).\n"
+                  "The sign is inferred from SensAble's CommandJointTorque sample: check it on your device.",
+                  f"{prefix}_openhaptics_torque_from_tau(const double tau[3], double torque[3])",
+                  "    torque[0] = -1000.0 * tau[0];\n    torque[1] = 1000.0 * tau[1];\n"
+                  "    torque[2] = 1000.0 * tau[2];"),
+    ])

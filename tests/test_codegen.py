@@ -1,0 +1,186 @@
+"""The generated C header (phantom_pin.codegen): compiled strictly as C99 and C++17, loaded
+through ctypes, and compared function by function with Pinocchio through Phantom's API on every
+shipped model and on an identified-style overlay; the committed headers are fresh; bad input
+is refused and nothing is written."""
+
+import ctypes
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from phantom_pin import Phantom, describe
+from phantom_pin.cli import main
+from phantom_pin.codegen import header, write_header
+from phantom_pin.codegen.generate import committed_header
+from phantom_pin.config import models
+from phantom_pin.config.sampling import random_states
+from phantom_pin.exceptions import InvalidInputError
+
+#: Relative tolerance per state: max |C - Pinocchio| / max |Pinocchio| of each output.
+TOLERANCE = 1e-12
+N_STATES = 1000
+#: An identified-style overlay on the CAD model: products of inertia and centres of mass off
+#: the links' axes, as `phantom-pin identify` writes them (links.NAME.{mass,com.k,inertia.xy}).
+OVERLAY = {"links.forearm_link.com.1": 0.0031, "links.forearm_link.inertia.xy": 1.5e-7,
+           "links.forearm_link.inertia.yz": -2e-7, "links.lower_bar_link.com.2": -0.0017,
+           "links.lower_bar_link.inertia.xy": 1e-7, "links.upper_arm_link.com.1": 0.0022,
+           "links.upper_arm_link.inertia.yz": 3e-6, "links.crank_link.mass": 0.2}
+CASES = [(name, None) for name in models()] + [("premium_1_5_cad", OVERLAY)]
+STRICT_C = ["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+STRICT_CXX = ["g++", "-std=c++17", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+
+#: A shared library over the header: each function looped over n states (row-major arrays).
+SHIM = """#include "model.h"
+#define LOOP(name, call) void batch_##name(int n, const double *a, const double *b, \\
+    const double *c, double *out) { int k; (void)b; (void)c; for (k = 0; k < n; ++k) { call; } }
+LOOP(gravity, phantom_gravity(a + 3 * k, out + 3 * k))
+LOOP(inverse_dynamics, phantom_inverse_dynamics(a + 3 * k, b + 3 * k, c + 3 * k, out + 3 * k))
+LOOP(mass_matrix, phantom_mass_matrix(a + 3 * k, out + 9 * k))
+LOOP(coriolis, phantom_coriolis(a + 3 * k, b + 3 * k, out + 3 * k))
+LOOP(tip_position, phantom_tip_position(a + 3 * k, out + 3 * k))
+LOOP(tip_jacobian, phantom_tip_jacobian(a + 3 * k, out + 9 * k))
+LOOP(jacobian_transpose_force, phantom_jacobian_transpose_force(a + 3 * k, b + 3 * k, out + 3 * k))
+LOOP(theta_from_openhaptics, phantom_theta_from_openhaptics(a + 3 * k, out + 3 * k))
+LOOP(openhaptics_torque_from_tau, phantom_openhaptics_torque_from_tau(a + 3 * k, out + 3 * k))
+"""
+
+
+def build(text, folder):
+    """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the shim as a
+    shared library (-O2); returns the ctypes library."""
+    (folder / "model.h").write_text(text)
+    (folder / "shim.c").write_text(SHIM)
+    (folder / "shim.cpp").write_text(SHIM)
+    subprocess.run([*STRICT_C, "-O2", "-fPIC", "-shared", "shim.c", "-o", "libmodel.so", "-lm"],
+                   cwd=folder, check=True, capture_output=True, text=True)
+    subprocess.run([*STRICT_CXX, "-O2", "-c", "shim.cpp", "-o", "shim_cpp.o"], cwd=folder, check=True,
+                   capture_output=True, text=True)
+    return ctypes.CDLL(str(folder / "libmodel.so"))
+
+
+def call(library, name, width, a, b=None, c=None):
+    """The batch_<name> of the library on (n, 3) arrays: (n, width)."""
+    a = np.ascontiguousarray(a, dtype=float)
+    out = np.empty((len(a), width))
+    pointer = ctypes.POINTER(ctypes.c_double)
+    args = [np.ascontiguousarray(x if x is not None else a, dtype=float) for x in (b, c)]
+    getattr(library, f"batch_{name}")(ctypes.c_int(len(a)), a.ctypes.data_as(pointer),
+                                      args[0].ctypes.data_as(pointer), args[1].ctypes.data_as(pointer),
+                                      out.ctypes.data_as(pointer))
+    return out
+
+
+def per_state_error(actual, expected):
+    """The largest over states of max |actual - expected| / max |expected| (each (n, k))."""
+    return float((np.abs(actual - expected).max(axis=1) / np.abs(expected).max(axis=1)).max())
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None or shutil.which("g++") is None,
+                    reason="never: .ci/run installs g++ (this marks the dependency)")
+@pytest.mark.parametrize("name, overlay", CASES, ids=[n if o is None else f"{n}+overlay" for n, o in CASES])
+def test_every_function_matches_pinocchio(name, overlay, tmp_path):
+    """Each function of the header, compiled with -Werror as C99 and C++17, equals Phantom's
+    (Pinocchio's) to 1e-12 relative per state over 1000 seeded states inside the stops."""
+    description = describe(name, overrides=overlay) if overlay else describe(name)
+    library = build(header(name, overrides=overlay), tmp_path)
+    phantom = Phantom(description)
+    theta, dtheta, ddtheta = random_states(description.config.limits, N_STATES, seed=30)
+    force = np.random.default_rng(31).normal(0, 2, (N_STATES, 3))
+    pose = phantom.forward_kinematics(theta)
+    jacobian = pose[:, :3, :3] @ phantom.body_jacobian(theta)[:, :3]  # the tip's velocity in s
+    expected = {
+        "gravity": phantom.gravity(theta),
+        "inverse_dynamics": phantom.inverse_dynamics(theta, dtheta, ddtheta),
+        "mass_matrix": phantom.mass_matrix(theta).reshape(-1, 9),
+        "coriolis": np.einsum("nij,nj->ni", phantom.coriolis_matrix(theta, dtheta), dtheta),
+        "tip_position": pose[:, :3, 3],
+        "tip_jacobian": jacobian.reshape(-1, 9),
+        "jacobian_transpose_force": np.einsum("nij,ni->nj", jacobian, force),
+    }
+    inputs = {"inverse_dynamics": (dtheta, ddtheta), "coriolis": (dtheta,), "jacobian_transpose_force": (force,)}
+    errors = {}
+    for function, reference in expected.items():
+        actual = call(library, function, reference.shape[1], theta, *inputs.get(function, ()))
+        errors[function] = per_state_error(actual, reference)
+    assert max(errors.values()) <= TOLERANCE, errors
+    mass = call(library, "mass_matrix", 9, theta).reshape(-1, 3, 3)
+    assert np.array_equal(mass, mass.transpose(0, 2, 1))  # symmetric by construction
+
+
+def test_openhaptics_helpers_follow_the_drivers(tmp_path):
+    """The header's OpenHaptics conversions equal phantom_pin.drivers' (exactly: sign flips
+    and a scaling by 1000)."""
+    from phantom_pin import drivers
+    library = build(header("touch"), tmp_path)
+    values = np.random.default_rng(5).normal(0, 1, (50, 3))
+    assert np.array_equal(call(library, "theta_from_openhaptics", 3, values), drivers.theta_from_openhaptics(values))
+    assert np.array_equal(call(library, "openhaptics_torque_from_tau", 3, values),
+                          drivers.openhaptics_torque_from_tau(values))
+
+
+@pytest.mark.parametrize("name", models())
+def test_committed_headers_are_fresh(name):
+    """Each shipped model's committed header is what its configuration generates now."""
+    assert committed_header(name).read_text() == header(name), \
+        f"{name}: run phantom-pin codegen --model {name} -o {committed_header(name)} --force"
+
+
+def test_the_banner_names_model_source_and_overlay():
+    text = header("premium_1_5_cad", prefix="lab_arm", overrides={"links.crank_link.mass": 0.2})
+    banner = text[:text.index("*/")]
+    assert "Model: premium_1_5_cad" in banner
+    assert "Configuration: robots/phantom_description/config/premium_1_5_cad" in banner
+    assert "Overlay: links.crank_link.mass = 0.2" in banner
+    assert "static inline void lab_arm_gravity(const double theta[3], double tau[3])" in text
+    assert "phantom_gravity" not in text and "PHANTOM_MODEL_H" not in text
+
+
+def test_bad_input_is_refused_with_describes_line(tmp_path):
+    """header() raises describe()'s own error; a prefix that is not a C identifier is named."""
+    with pytest.raises(Exception) as described:
+        describe("touch", overrides={"links.forearm_link.mass": -1.0})
+    with pytest.raises(type(described.value)) as generated:
+        header("touch", overrides={"links.forearm_link.mass": -1.0})
+    assert str(generated.value) == str(described.value)
+    for prefix in ("1abc", "a-b", "", "é", "a b"):
+        with pytest.raises(InvalidInputError) as error:
+            header("touch", prefix=prefix)
+        assert error.value.argument == "prefix"
+
+
+def test_the_writer_never_overwrites_without_force(tmp_path):
+    target = tmp_path / "model.h"
+    write_header("one", target)
+    with pytest.raises(InvalidInputError):
+        write_header("two", target)
+    assert target.read_text() == "one"
+    write_header("two", target, force=True)
+    assert target.read_text() == "two"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.h"]  # no temporary left
+
+
+def test_cli_writes_the_header_and_refuses_bad_input(tmp_path, capsys):
+    """phantom-pin codegen: the header of --model with --set and --prefix; on bad input one
+    line naming the option, exit 2, and no file."""
+    out = tmp_path / "arm.h"
+    assert main(["codegen", "--model", "touch", "--prefix", "arm", "-o", str(out)]) == 0
+    assert out.read_text() == header("touch", prefix="arm")
+    assert main(["codegen", "--model", "touch", "-o", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert out.read_text() == header("touch", prefix="arm")
+    bad = tmp_path / "bad.h"
+    assert main(["codegen", "--model", "touch", "--prefix", "9lives", "-o", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("phantom-pin: error: --prefix:") and err.count("\n") == 1
+    assert main(["codegen", "--model", "touch", "--set", "links.forearm_link.mass=-1", "-o", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert main(["info", "--model", "touch", "--set", "links.forearm_link.mass=-1"]) == 2
+    assert capsys.readouterr().err == err  # the same line as any command's describe()
+    assert not bad.exists()
+    assert main(["codegen", "--model", "touch", "--set", "links.forearm_link.com.1=0.003",
+                 "-o", str(out), "--force"]) == 0
+    assert "Overlay: links.forearm_link.com.1 = 0.003" in out.read_text()
+
