@@ -129,13 +129,14 @@ def _read_urdf(urdf: str, prefix: str) -> tuple[str, list[_Joint], dict[str, _Li
                              multiplier, offset))
     children = {j.child for j in joints}
     base = next(j.parent for j in joints if j.parent not in children)
-    order, frontier = [], [base]
+    order: list[_Joint] = []
+    frontier = [base]
     while frontier:  # breadth first: every joint after its parent link's own joint
-        link = frontier.pop(0)
-        for joint in joints:
-            if joint.parent == link:
-                order.append(joint)
-                frontier.append(joint.child)
+        here = frontier.pop(0)
+        for each in joints:
+            if each.parent == here:
+                order.append(each)
+                frontier.append(each.child)
     return base, order, links
 
 
@@ -252,7 +253,7 @@ class _Model:
 
 
 # -- C ---------------------------------------------------------------------------------------
-class _Printer(C99CodePrinter):  # type: ignore[misc]
+class _Printer(C99CodePrinter):
     """SymPy's C99 printer with squares as products and literals with 17 digits."""
 
     def _print_Pow(self, expr: Any) -> str:
