@@ -252,6 +252,24 @@ class _Model:
         return rotation, origin
 
 
+def _leaner(exprs: list[Any]) -> list[Any]:
+    """``exprs`` or, if it takes fewer operations after common-subexpression elimination,
+    their expansion with sin(theta_i)^2 = 1 - cos(theta_i)^2: the Newton-Euler passes rotate
+    vectors into each link and back, which leaves sums such as g cos^2 + g sin^2 (the
+    expansion halves gravity's and the mass matrix's operations, not the Coriolis vector's)."""
+    def is_power(e: Any) -> bool:
+        return bool(e.is_Pow and e.base.func == sp.sin and e.exp.is_Integer and e.exp >= 2)
+
+    def reduced(e: Any) -> Any:  # sin^n = sin^(n mod 2) (1 - cos^2)^(n div 2)
+        return sp.sin(e.base.args[0]) ** (e.exp % 2) * (1 - sp.cos(e.base.args[0]) ** 2) ** (e.exp // 2)
+    expanded = [sp.expand(sp.expand(e).replace(is_power, reduced)) for e in exprs]
+
+    def cost(candidate: list[Any]) -> int:
+        temps, reduced = sp.cse(candidate, order="none")
+        return int(sum(sp.count_ops(e) for _, e in temps) + sum(sp.count_ops(e) for e in reduced))
+    return expanded if cost(expanded) < cost(exprs) else exprs
+
+
 # -- C ---------------------------------------------------------------------------------------
 class _Printer(C99CodePrinter):
     """SymPy's C99 printer with squares as products and literals with 17 digits."""
@@ -322,12 +340,14 @@ def _header(description: Description, prefix: str, origin: str, overlay: str) ->
     f = list(sp.symbols("f0:3", real=True))
     zero = [sp.Integer(0)] * 3
     arm = model.armature
-    gravity = model.rnea(theta, zero, zero, True)
+    gravity = _leaner(model.rnea(theta, zero, zero, True))
     columns = [model.rnea(theta, zero, [sp.Integer(int(i == j)) for i in range(3)], False) for j in range(3)]
-    mass = [[columns[min(i, j)][max(i, j)] + (arm[i] if i == j else 0) for j in range(3)] for i in range(3)]
-    coriolis = model.rnea(theta, dtheta, zero, False)
+    upper = _leaner([columns[j][i] + (arm[i] if i == j else 0) for i in range(3) for j in range(i, 3)])
+    index = {(i, j): k for k, (i, j) in enumerate((i, j) for i in range(3) for j in range(i, 3))}
+    mass = [[upper[index[min(i, j), max(i, j)]] for j in range(3)] for i in range(3)]
+    coriolis = _leaner(model.rnea(theta, dtheta, zero, False))
     full = model.rnea(theta, dtheta, ddtheta, True)
-    inverse = [full[i] + arm[i] * ddtheta[i] for i in range(3)]
+    inverse = _leaner([full[i] + arm[i] * ddtheta[i] for i in range(3)])
     r_s, p_s = model.pose(FRAME_S, theta)
     _, p_tip = model.pose(TIP, theta)
     position = r_s.T * (p_tip - p_s)
