@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from phantom_pin.cli.common import output, overrides, source
+from phantom_pin.progress import Progress
 
 
 def codegen(args: argparse.Namespace) -> int:
@@ -12,7 +13,11 @@ def codegen(args: argparse.Namespace) -> int:
     --prefix; nothing is written on failure, nor over a file without --force."""
     from phantom_pin.codegen import header, write_header  # sympy is only needed here
     target = output(args)
-    text = header(source(args), prefix=args.prefix, overrides=overrides(args))
+    bar = Progress("codegen", 1.0, enabled=False if args.quiet else None)
+    try:
+        text = header(source(args), prefix=args.prefix, overrides=overrides(args), progress=bar.update)
+    finally:
+        bar.close()
     write_header(text, target, force=args.force, name="--output", force_hint="--force")
     print(f"wrote {target}")
     return 0

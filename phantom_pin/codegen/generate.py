@@ -18,7 +18,7 @@ import dataclasses
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from phantom_pin.config import DEFAULT, MODELS
 from phantom_pin.description.build import Description, describe, description_of
@@ -310,12 +310,15 @@ _ASSUMES = "Assumes finite input: no checks, no allocation, no global state."
 
 
 def header(source: str | Path | Description = DEFAULT, prefix: str = "phantom",
-           overrides: Mapping[str, object] | None = None) -> str:
+           overrides: Mapping[str, object] | None = None,
+           progress: Callable[[float], None] | None = None) -> str:
     """The C99 header of a model name (phantom_pin.models()) or a configuration folder with
     ``overrides`` (as describe()'s), its functions named ``prefix``_...; its banner names
     the model, the configuration's source and the overrides. describe()'s errors as they are;
     InvalidInputError naming ``prefix`` unless it is a C identifier. A Description is taken
-    as it is (its banner then says so: the overrides it was built with are not known)."""
+    as it is (its banner then says so: the overrides it was built with are not known).
+    ``progress``: called with the share done (0..1), for a progress bar; generation takes
+    seconds (SymPy)."""
     _require_sympy()
     if not is_identifier(prefix):
         raise InvalidInputError(f"must be a C identifier (letters, digits, _), got {prefix!r}",
@@ -329,10 +332,11 @@ def header(source: str | Path | Description = DEFAULT, prefix: str = "phantom",
         origin = (f"robots/phantom_description/config/{source}" if description.model is not None
                   and str(source) == description.config.name else str(source))
         overlay_text = "; ".join(f"{k} = {v!r}" for k, v in sorted(overlay.items())) or "none"
-    return _header(description, prefix, origin, overlay_text)
+    return _header(description, prefix, origin, overlay_text, progress or (lambda share: None))
 
 
-def _header(description: Description, prefix: str, origin: str, overlay: str) -> str:
+def _header(description: Description, prefix: str, origin: str, overlay: str,
+            progress: Callable[[float], None]) -> str:
     model = _Model(description)
     theta = list(sp.symbols("q0:3", real=True))
     dtheta = list(sp.symbols("dq0:3", real=True))
@@ -341,13 +345,17 @@ def _header(description: Description, prefix: str, origin: str, overlay: str) ->
     zero = [sp.Integer(0)] * 3
     arm = model.armature
     gravity = _leaner(model.rnea(theta, zero, zero, True))
+    progress(0.1)
     columns = [model.rnea(theta, zero, [sp.Integer(int(i == j)) for i in range(3)], False) for j in range(3)]
     upper = _leaner([columns[j][i] + (arm[i] if i == j else 0) for i in range(3) for j in range(i, 3)])
     index = {(i, j): k for k, (i, j) in enumerate((i, j) for i in range(3) for j in range(i, 3))}
     mass = [[upper[index[min(i, j), max(i, j)]] for j in range(3)] for i in range(3)]
+    progress(0.25)
     coriolis = _leaner(model.rnea(theta, dtheta, zero, False))
+    progress(0.45)
     full = model.rnea(theta, dtheta, ddtheta, True)
     inverse = _leaner([full[i] + arm[i] * ddtheta[i] for i in range(3)])
+    progress(0.75)
     r_s, p_s = model.pose(FRAME_S, theta)
     _, p_tip = model.pose(TIP, theta)
     position = r_s.T * (p_tip - p_s)
