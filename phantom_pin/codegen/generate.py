@@ -272,12 +272,13 @@ def _leaner(exprs: list[Any]) -> list[Any]:
 
 # -- C ---------------------------------------------------------------------------------------
 class _Printer(C99CodePrinter):
-    """SymPy's C99 printer with squares as products and literals with 17 digits."""
+    """SymPy's C99 printer with small integer powers as products (gcc inlines pow(x, 2)
+    alone) and literals with 17 digits."""
 
     def _print_Pow(self, expr: Any) -> str:
-        if expr.exp == 2:
+        if expr.exp.is_Integer and 2 <= expr.exp <= 8:  # libm's pow is a call, not inlined
             base = self.parenthesize(expr.base, 100)
-            return f"{base}*{base}"
+            return "(" + "*".join([base] * int(expr.exp)) + ")"
         return super()._print_Pow(expr)
 
 

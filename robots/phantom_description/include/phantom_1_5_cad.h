@@ -35,7 +35,7 @@ static inline void phantom_gravity(const double theta[3], double tau[3])
     const double x1 = sin(q2);
     tau[0] = 0;
     tau[1] = -0.01168015322205906*x0 + 0.00016495130494079999*sin(q1);
-    tau[2] = -2.1175823681357508e-20*pow(x0, 4)*x1 - 5.9292306307801024e-21*x0*x0*x1 - 0.08726199629418466*x1 + 0.00129283570783878*cos(q2);
+    tau[2] = -2.1175823681357508e-20*(x0*x0*x0*x0)*x1 - 5.9292306307801024e-21*(x0*x0)*x1 - 0.08726199629418466*x1 + 0.00129283570783878*cos(q2);
 }
 
 /*
@@ -54,39 +54,39 @@ static inline void phantom_inverse_dynamics(const double theta[3], const double 
     const double ddq0 = ddtheta[0];
     const double ddq1 = ddtheta[1];
     const double ddq2 = ddtheta[2];
-    const double x0 = dq0*dq0;
+    const double x0 = (dq0*dq0);
     const double x1 = 5.2939559203393771e-23*x0;
     const double x2 = cos(q2);
-    const double x3 = pow(x2, 4);
+    const double x3 = (x2*x2*x2*x2);
     const double x4 = ddq0*x3;
     const double x5 = cos(q1);
     const double x6 = sin(q2);
     const double x7 = x1*x6;
     const double x8 = sin(q1);
-    const double x9 = dq1*dq1;
+    const double x9 = (dq1*dq1);
     const double x10 = x8*x9;
-    const double x11 = x5*x5;
+    const double x11 = (x5*x5);
     const double x12 = dq0*dq1;
     const double x13 = ddq1*x8;
     const double x14 = dq0*dq2;
     const double x15 = x5*x9;
-    const double x16 = dq2*dq2;
+    const double x16 = (dq2*dq2);
     const double x17 = x16*x6;
     const double x18 = x0*x8;
-    const double x19 = pow(x5, 3);
+    const double x19 = (x5*x5*x5);
     const double x20 = 3.7585582671798982e-6*x6;
     const double x21 = x16*x2;
     const double x22 = ddq2*x2;
-    const double x23 = x2*x2;
+    const double x23 = (x2*x2);
     const double x24 = ddq0*x23;
     const double x25 = x14*x3;
-    const double x26 = pow(x5, 4);
+    const double x26 = (x5*x5*x5*x5);
     const double x27 = ddq0*x5;
     const double x28 = 0.00074954044292652991*x6;
     const double x29 = ddq0*x8;
     const double x30 = ddq0*x2;
     const double x31 = x14*x23;
-    const double x32 = pow(x2, 3);
+    const double x32 = (x2*x2*x2);
     const double x33 = x14*x6;
     const double x34 = x12*x5;
     const double x35 = x12*x8;
@@ -103,14 +103,14 @@ static inline void phantom_inverse_dynamics(const double theta[3], const double 
     const double x46 = 4.2351647362715017e-22*x18*x6;
     const double x47 = 1.164670302474663e-21*x37;
     const double x48 = x26*x6;
-    const double x49 = pow(x2, 5);
+    const double x49 = (x2*x2*x2*x2*x2);
     const double x50 = x0*x5;
-    const double x51 = pow(x5, 5);
+    const double x51 = (x5*x5*x5*x5*x5);
     const double x52 = 0.00037477022146326496*x2;
-    const double x53 = pow(x2, 7);
+    const double x53 = (x2*x2*x2*x2*x2*x2*x2);
     tau[0] = 0.0027042917212983698*ddq0*x11 + 0.0023513543986905206*ddq0 - 4.4090681069567996e-7*ddq1*x5 - ddq2*x20 - 2.6469779601696886e-23*x0*x19 + x1*x5 + x1 + 4.4090681069567996e-7*x10 - 4.0075486457599998e-6*x11*x12 - 3.6189151799194961e-25*x11*x18 + 2.0037743228799999e-6*x12 + 4.4865102947968001e-5*x13 + 0.00074954044292652991*x14*x2*x5 + 1.4096053610335828e-5*x14 + 4.4865102947968001e-5*x15 + 5.2175985596777802e-5*x17 - 5.169878828456423e-26*x18 + 2.6625867245999999e-7*x2*x27 + 0.0017399928982328727*x2*x33 - 2.6625867245999999e-7*x2*x35 - 3.7585582671798982e-6*x21 - 5.2175985596777802e-5*x22 + 4.2351647362715017e-22*x24*x26 - 0.00086999644911643636*x24 + 2.0679515313825692e-25*x25*x26 + 1.0339757656912846e-25*x25 - 1.0339757656912846e-25*x26*x31 - 8.4703294725430034e-22*x26*x4 + x27*x28 - x28*x35 - 2.0037743228799999e-6*x29*x5 - 1.4096053610335828e-5*x30*x6 - 2.8192107220671657e-5*x31 + 1.0587911840678754e-22*x32*x33 - 2.6625867245999999e-7*x33*x5 - 0.0054085834425967396*x34*x8 + 5.2939559203393771e-23*x4 + x7;
     tau[1] = 0.002859119033934581*ddq1 - 1.00188716144e-6*x0 - x17*x38 + x17*x44 + x18*x41 + x18*x45 + x21*x39 + x21*x43 + x22*x38 - x22*x44 + 2.2234614865425384e-21*x23*x42 - x23*x46 + x23*x47 - 4.4090681069567996e-7*x27 + 4.4865102947968001e-5*x29 - 5.6115932755597397e-21*x3*x42 + x3*x46 - x3*x47 + 2.6469779601696886e-23*x34 + 2.0037743228799999e-6*x36 + 5.8233515123733148e-22*x37 + x39*x40 + x40*x43 + 0.0027042917212983698*x42 - 0.01168015322205906*x5 + 0.00016495130494079999*x8;
-    tau[2] = -ddq0*x20 + 1.3312933622999999e-7*ddq1*x2*x5 + 0.00037477022146326496*ddq1*x5*x6 + 1.3312933622999999e-7*ddq1*x6*x8 - 5.2939559203393771e-23*ddq2*x26 + 0.0010242514860169095*ddq2 + 5.2939559203393771e-23*dq0*dq2*x6 + 2.0679515313825692e-25*x0*pow(x2, 6)*x26 + 1.5881867761018131e-22*x0*x2*x26*x6 + 9.26442286059391e-23*x0*x2*x51 - 0.00086999644911643636*x0*x2*x6 + 1.4096053610335828e-5*x0*x23 + 8.4703294725430034e-22*x0*x32*x5 - 1.5881867761018131e-22*x0*x48*x53 - 1.6940658945086007e-21*x0*x49*x51 + 5.2939559203393771e-23*x0*x49*x6 + 1.3312933622999999e-7*x0*x5*x6 - 7.0480268051679141e-6*x0 - x10*x41 - x10*x45 - x11*x53*x7 - 5.9292306307801024e-21*x11*x6 - x13*x52 - x15*x52 - 1.5881867761018131e-22*x2*x36*x6 + 0.00129283570783878*x2 - 5.2175985596777802e-5*x30 - x32*x7 - 2.1175823681357508e-20*x48 - 8.4703294725430034e-22*x49*x50 + 1.3312933622999999e-7*x5*x6*x9 - x50*x52 - 0.08726199629418466*x6;
+    tau[2] = -ddq0*x20 + 1.3312933622999999e-7*ddq1*x2*x5 + 0.00037477022146326496*ddq1*x5*x6 + 1.3312933622999999e-7*ddq1*x6*x8 - 5.2939559203393771e-23*ddq2*x26 + 0.0010242514860169095*ddq2 + 5.2939559203393771e-23*dq0*dq2*x6 + 2.0679515313825692e-25*x0*(x2*x2*x2*x2*x2*x2)*x26 + 1.5881867761018131e-22*x0*x2*x26*x6 + 9.26442286059391e-23*x0*x2*x51 - 0.00086999644911643636*x0*x2*x6 + 1.4096053610335828e-5*x0*x23 + 8.4703294725430034e-22*x0*x32*x5 - 1.5881867761018131e-22*x0*x48*x53 - 1.6940658945086007e-21*x0*x49*x51 + 5.2939559203393771e-23*x0*x49*x6 + 1.3312933622999999e-7*x0*x5*x6 - 7.0480268051679141e-6*x0 - x10*x41 - x10*x45 - x11*x53*x7 - 5.9292306307801024e-21*x11*x6 - x13*x52 - x15*x52 - 1.5881867761018131e-22*x2*x36*x6 + 0.00129283570783878*x2 - 5.2175985596777802e-5*x30 - x32*x7 - 2.1175823681357508e-20*x48 - 8.4703294725430034e-22*x49*x50 + 1.3312933622999999e-7*x5*x6*x9 - x50*x52 - 0.08726199629418466*x6;
 }
 
 /*
@@ -124,10 +124,10 @@ static inline void phantom_mass_matrix(const double theta[3], double M[9])
     const double q1 = theta[1];
     const double q2 = theta[2];
     const double x0 = cos(q2);
-    const double x1 = pow(x0, 4);
+    const double x1 = (x0*x0*x0*x0);
     const double x2 = cos(q1);
-    const double x3 = x0*x0;
-    const double x4 = pow(x2, 4);
+    const double x3 = (x0*x0);
+    const double x4 = (x2*x2*x2*x2);
     const double x5 = x0*x2;
     const double x6 = sin(q2);
     const double x7 = x2*x6;
@@ -135,7 +135,7 @@ static inline void phantom_mass_matrix(const double theta[3], double M[9])
     const double x9 = -4.4090681069567996e-7*x2 + 4.4865102947968001e-5*x8;
     const double x10 = -5.2175985596777802e-5*x0 - 3.7585582671798982e-6*x6;
     const double x11 = -0.00037477022146326496*x0*x8 + 1.3312933622999999e-7*x5 + 1.3312933622999999e-7*x6*x8 + 0.00037477022146326496*x7;
-    M[0] = -1.4096053610335828e-5*x0*x6 - 8.4703294725430034e-22*x1*x4 + 5.2939559203393771e-23*x1 + 0.0027042917212983698*x2*x2 - 2.0037743228799999e-6*x2*x8 + 4.2351647362715017e-22*x3*x4 - 0.00086999644911643636*x3 + 2.6625867245999999e-7*x5 + 0.00074954044292652991*x7 + 0.0023513543986905206;
+    M[0] = -1.4096053610335828e-5*x0*x6 - 8.4703294725430034e-22*x1*x4 + 5.2939559203393771e-23*x1 + 0.0027042917212983698*(x2*x2) - 2.0037743228799999e-6*x2*x8 + 4.2351647362715017e-22*x3*x4 - 0.00086999644911643636*x3 + 2.6625867245999999e-7*x5 + 0.00074954044292652991*x7 + 0.0023513543986905206;
     M[1] = x9;
     M[2] = x10;
     M[3] = x9;
@@ -158,30 +158,30 @@ static inline void phantom_coriolis(const double theta[3], const double dtheta[3
     const double dq0 = dtheta[0];
     const double dq1 = dtheta[1];
     const double dq2 = dtheta[2];
-    const double x0 = dq0*dq0;
+    const double x0 = (dq0*dq0);
     const double x1 = 5.2939559203393771e-23*x0;
     const double x2 = cos(q1);
     const double x3 = sin(q2);
     const double x4 = x1*x3;
-    const double x5 = dq1*dq1;
+    const double x5 = (dq1*dq1);
     const double x6 = sin(q1);
     const double x7 = x5*x6;
     const double x8 = dq0*dq1;
     const double x9 = dq0*dq2;
     const double x10 = x2*x5;
-    const double x11 = dq2*dq2;
+    const double x11 = (dq2*dq2);
     const double x12 = x11*x3;
     const double x13 = x0*x6;
-    const double x14 = pow(x2, 3);
+    const double x14 = (x2*x2*x2);
     const double x15 = cos(q2);
     const double x16 = x11*x15;
-    const double x17 = pow(x15, 4);
+    const double x17 = (x15*x15*x15*x15);
     const double x18 = x17*x9;
-    const double x19 = x2*x2;
-    const double x20 = x15*x15;
+    const double x19 = (x2*x2);
+    const double x20 = (x15*x15);
     const double x21 = x20*x9;
-    const double x22 = pow(x2, 4);
-    const double x23 = pow(x15, 3);
+    const double x22 = (x2*x2*x2*x2);
+    const double x23 = (x15*x15*x15);
     const double x24 = x3*x9;
     const double x25 = x2*x8;
     const double x26 = x6*x8;
@@ -192,15 +192,15 @@ static inline void phantom_coriolis(const double theta[3], const double dtheta[3
     const double x31 = 0.00037477022146326496*x3;
     const double x32 = 4.2351647362715017e-22*x13*x3;
     const double x33 = 1.164670302474663e-21*x28;
-    const double x34 = pow(x15, 5);
+    const double x34 = (x15*x15*x15*x15*x15);
     const double x35 = x0*x2;
-    const double x36 = pow(x2, 5);
+    const double x36 = (x2*x2*x2*x2*x2);
     const double x37 = 0.00037477022146326496*x15;
     const double x38 = x0*x3;
-    const double x39 = pow(x15, 7);
+    const double x39 = (x15*x15*x15*x15*x15*x15*x15);
     c[0] = -2.6469779601696886e-23*x0*x14 + x1*x2 + x1 + 4.4865102947968001e-5*x10 + 5.2175985596777802e-5*x12 - 3.6189151799194961e-25*x13*x19 - 5.169878828456423e-26*x13 + 0.00074954044292652991*x15*x2*x9 + 0.0017399928982328727*x15*x24 - 2.6625867245999999e-7*x15*x26 - 3.7585582671798982e-6*x16 + 2.0679515313825692e-25*x18*x22 + 1.0339757656912846e-25*x18 - 4.0075486457599998e-6*x19*x8 - 2.6625867245999999e-7*x2*x24 - 1.0339757656912846e-25*x21*x22 - 2.8192107220671657e-5*x21 + 1.0587911840678754e-22*x23*x24 - 0.0054085834425967396*x25*x6 - 0.00074954044292652991*x26*x3 + x4 + 4.4090681069567996e-7*x7 + 2.0037743228799999e-6*x8 + 1.4096053610335828e-5*x9;
     c[1] = -1.00188716144e-6*x0 - 1.3312933622999999e-7*x12*x2 + 0.00037477022146326496*x12*x6 + x13*x29 + x13*x31 + 0.00037477022146326496*x16*x2 + 1.3312933622999999e-7*x16*x6 - 5.6115932755597397e-21*x17*x30 + x17*x32 - x17*x33 + 2.2234614865425384e-21*x20*x30 - x20*x32 + x20*x33 + 2.6469779601696886e-23*x25 + 2.0037743228799999e-6*x27 + 5.8233515123733148e-22*x28 + 0.0027042917212983698*x30;
-    c[2] = 5.2939559203393771e-23*dq0*dq2*x3 + 2.0679515313825692e-25*x0*pow(x15, 6)*x22 + 1.5881867761018131e-22*x0*x15*x22*x3 + 9.26442286059391e-23*x0*x15*x36 + 8.4703294725430034e-22*x0*x2*x23 + 1.3312933622999999e-7*x0*x2*x3 + 1.4096053610335828e-5*x0*x20 + 5.2939559203393771e-23*x0*x3*x34 - 1.6940658945086007e-21*x0*x34*x36 - 7.0480268051679141e-6*x0 - x10*x37 - 1.5881867761018131e-22*x15*x27*x3 - 0.00086999644911643636*x15*x38 - x19*x39*x4 + 1.3312933622999999e-7*x2*x3*x5 - 1.5881867761018131e-22*x22*x38*x39 - x23*x4 - x29*x7 - x31*x7 - 8.4703294725430034e-22*x34*x35 - x35*x37;
+    c[2] = 5.2939559203393771e-23*dq0*dq2*x3 + 2.0679515313825692e-25*x0*(x15*x15*x15*x15*x15*x15)*x22 + 1.5881867761018131e-22*x0*x15*x22*x3 + 9.26442286059391e-23*x0*x15*x36 + 8.4703294725430034e-22*x0*x2*x23 + 1.3312933622999999e-7*x0*x2*x3 + 1.4096053610335828e-5*x0*x20 + 5.2939559203393771e-23*x0*x3*x34 - 1.6940658945086007e-21*x0*x34*x36 - 7.0480268051679141e-6*x0 - x10*x37 - 1.5881867761018131e-22*x15*x27*x3 - 0.00086999644911643636*x15*x38 - x19*x39*x4 + 1.3312933622999999e-7*x2*x3*x5 - 1.5881867761018131e-22*x22*x38*x39 - x23*x4 - x29*x7 - x31*x7 - 8.4703294725430034e-22*x34*x35 - x35*x37;
 }
 
 /*

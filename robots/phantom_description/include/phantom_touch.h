@@ -35,7 +35,7 @@ static inline void phantom_gravity(const double theta[3], double tau[3])
     const double x1 = sin(q2);
     tau[0] = 0;
     tau[1] = 0.025145025325349997*x0;
-    tau[2] = -5.5057141571529522e-21*pow(x0, 4)*x1 - 1.2705494208814505e-21*x0*x0*x1 + 0.0078927206781345988*x1;
+    tau[2] = -5.5057141571529522e-21*(x0*x0*x0*x0)*x1 - 1.2705494208814505e-21*(x0*x0)*x1 + 0.0078927206781345988*x1;
 }
 
 /*
@@ -55,29 +55,29 @@ static inline void phantom_inverse_dynamics(const double theta[3], const double 
     const double ddq1 = ddtheta[1];
     const double ddq2 = ddtheta[2];
     const double x0 = cos(q1);
-    const double x1 = x0*x0;
+    const double x1 = (x0*x0);
     const double x2 = ddq0*x1;
     const double x3 = cos(q2);
-    const double x4 = pow(x3, 4);
+    const double x4 = (x3*x3*x3*x3);
     const double x5 = ddq0*x4;
-    const double x6 = x3*x3;
+    const double x6 = (x3*x3);
     const double x7 = ddq0*x6;
     const double x8 = 2.1175823681357508e-22*x4;
-    const double x9 = pow(x0, 4);
+    const double x9 = (x0*x0*x0*x0);
     const double x10 = 2.1175823681357508e-22*x9;
     const double x11 = sin(q2);
     const double x12 = x0*x11;
-    const double x13 = pow(x3, 3);
+    const double x13 = (x3*x3*x3);
     const double x14 = dq0*dq2;
     const double x15 = x11*x14;
     const double x16 = sin(q1);
     const double x17 = dq0*dq1*x16;
-    const double x18 = dq0*dq0;
+    const double x18 = (dq0*dq0);
     const double x19 = x16*x18;
     const double x20 = x0*x19;
     const double x21 = 9.8053788524999988e-5*ddq2;
     const double x22 = 9.8053788524999988e-5*x11;
-    const double x23 = dq2*dq2;
+    const double x23 = (dq2*dq2);
     const double x24 = 9.8053788524999988e-5*x3;
     const double x25 = x0*x24;
     const double x26 = x16*x22;
@@ -86,13 +86,13 @@ static inline void phantom_inverse_dynamics(const double theta[3], const double 
     const double x29 = x1*x11;
     const double x30 = ddq2*x1;
     const double x31 = x11*x9;
-    const double x32 = pow(x3, 7);
+    const double x32 = (x3*x3*x3*x3*x3*x3*x3);
     const double x33 = x0*x18;
-    const double x34 = pow(x0, 5);
-    const double x35 = dq1*dq1;
-    const double x36 = pow(x3, 5);
+    const double x34 = (x0*x0*x0*x0*x0);
+    const double x35 = (dq1*dq1);
+    const double x36 = (x3*x3*x3*x3*x3);
     tau[0] = 0.00019610757704999998*ddq0*x12 + 0.0002198439162625*ddq0 + 0.00019610757704999998*x0*x14*x3 - 0.00057618065532999997*x0*x17 + x10*x5 + x10*x7 - 0.00019610757704999998*x11*x17 + 5.2939559203393771e-23*x13*x15 + 0.00012534291252499998*x15*x3 - 4.2351647362715017e-22*x2*x6 + x2*x8 + 0.00028809032766499999*x2 - 5.2939559203393771e-23*x5 - 6.2671456262499992e-5*x7;
-    tau[1] = 0.00030759608766499998*ddq1 - 8.4703294725430034e-22*pow(x0, 3)*x19*x4 + 0.025145025325349997*x0 + x12*x21 - x16*x21*x3 + x19*x22 + 0.00028809032766499999*x20 + x23*x25 + x23*x26 - 2.1175823681357508e-22*x27*x6 + x27*x8 - x28*x4 + x28*x6;
+    tau[1] = 0.00030759608766499998*ddq1 - 8.4703294725430034e-22*(x0*x0*x0)*x19*x4 + 0.025145025325349997*x0 + x12*x21 - x16*x21*x3 + x19*x22 + 0.00028809032766499999*x20 + x23*x25 + x23*x26 - 2.1175823681357508e-22*x27*x6 + x27*x8 - x28*x4 + x28*x6;
     tau[2] = 9.8053788524999988e-5*ddq1*x0*x11 - ddq1*x16*x24 - 7.4446255129772491e-24*ddq2*x9 + 8.1978156262499993e-5*ddq2 + 1.0587911840678754e-22*x0*x18*x36 + 1.9273308272485545e-22*x1*x11*x13*x18 + 1.9025154088719637e-23*x1*x11*x18*x3 + 3.019209235818551e-23*x11*x13*x18 + 8.6853964318067906e-23*x11*x18*x3*x9 - 6.2671456262499992e-5*x11*x18*x3 - 1.3234889800848443e-23*x11*x18*x32 + 3.1763735522036263e-22*x11*x18*x36*x9 + 0.0078927206781345988*x11 - 1.9273308272485545e-22*x13*x18*x31 - 1.0587911840678754e-22*x13*x33 - x18*x25 - 1.0587911840678754e-22*x18*x29*x36 + 5.2939559203393771e-23*x18*x3*x34 - 5.2939559203393771e-23*x18*x32*x34 - x25*x35 - x26*x35 - 1.2705494208814505e-21*x29 - 2.6469779601696886e-23*x30*x6 - 5.7902642878711937e-24*x30 - 5.5057141571529522e-21*x31 - 2.6469779601696886e-23*x32*x33;
 }
 
@@ -107,12 +107,12 @@ static inline void phantom_mass_matrix(const double theta[3], double M[9])
     const double q1 = theta[1];
     const double q2 = theta[2];
     const double x0 = cos(q1);
-    const double x1 = x0*x0;
+    const double x1 = (x0*x0);
     const double x2 = cos(q2);
-    const double x3 = pow(x2, 4);
-    const double x4 = x2*x2;
+    const double x3 = (x2*x2*x2*x2);
+    const double x4 = (x2*x2);
     const double x5 = 2.1175823681357508e-22*x3;
-    const double x6 = pow(x0, 4);
+    const double x6 = (x0*x0*x0*x0);
     const double x7 = sin(q2);
     const double x8 = x1*x4;
     const double x9 = 9.8053788524999988e-5*x0*x7 - 9.8053788524999988e-5*x2*sin(q1);
@@ -140,7 +140,7 @@ static inline void phantom_coriolis(const double theta[3], const double dtheta[3
     const double dq1 = dtheta[1];
     const double dq2 = dtheta[2];
     const double x0 = cos(q2);
-    const double x1 = pow(x0, 3);
+    const double x1 = (x0*x0*x0);
     const double x2 = sin(q2);
     const double x3 = dq0*dq2;
     const double x4 = x2*x3;
@@ -148,28 +148,28 @@ static inline void phantom_coriolis(const double theta[3], const double dtheta[3
     const double x6 = x0*x5;
     const double x7 = sin(q1);
     const double x8 = dq0*dq1*x7;
-    const double x9 = dq0*dq0;
+    const double x9 = (dq0*dq0);
     const double x10 = x7*x9;
     const double x11 = x10*x5;
     const double x12 = 9.8053788524999988e-5*x2;
-    const double x13 = dq2*dq2;
+    const double x13 = (dq2*dq2);
     const double x14 = 9.8053788524999988e-5*x6;
     const double x15 = x12*x7;
-    const double x16 = pow(x0, 4);
+    const double x16 = (x0*x0*x0*x0);
     const double x17 = x10*x16;
     const double x18 = 2.1175823681357508e-22*x2;
-    const double x19 = x0*x0;
+    const double x19 = (x0*x0);
     const double x20 = 8.4703294725430034e-22*x11;
-    const double x21 = pow(x0, 7);
+    const double x21 = (x0*x0*x0*x0*x0*x0*x0);
     const double x22 = x2*x9;
     const double x23 = x5*x9;
-    const double x24 = pow(x5, 5);
-    const double x25 = dq1*dq1;
-    const double x26 = pow(x0, 5);
-    const double x27 = x5*x5;
-    const double x28 = pow(x5, 4);
+    const double x24 = (x5*x5*x5*x5*x5);
+    const double x25 = (dq1*dq1);
+    const double x26 = (x0*x0*x0*x0*x0);
+    const double x27 = (x5*x5);
+    const double x28 = (x5*x5*x5*x5);
     c[0] = 0.00012534291252499998*x0*x4 + 5.2939559203393771e-23*x1*x4 - 0.00019610757704999998*x2*x8 + 0.00019610757704999998*x3*x6 - 0.00057618065532999997*x5*x8;
-    c[1] = x10*x12 - x10*x18*x19 + 0.00028809032766499999*x11 + x13*x14 + x13*x15 - x16*x20 + x17*x18 - 8.4703294725430034e-22*x17*pow(x5, 3) + x19*x20;
+    c[1] = x10*x12 - x10*x18*x19 + 0.00028809032766499999*x11 + x13*x14 + x13*x15 - x16*x20 + x17*x18 - 8.4703294725430034e-22*x17*(x5*x5*x5) + x19*x20;
     c[2] = 1.9025154088719637e-23*x0*x2*x27*x9 + 8.6853964318067906e-23*x0*x2*x28*x9 - 6.2671456262499992e-5*x0*x2*x9 + 5.2939559203393771e-23*x0*x24*x9 + 1.9273308272485545e-22*x1*x2*x27*x9 + 3.019209235818551e-23*x1*x2*x9 - 1.9273308272485545e-22*x1*x22*x28 - 1.0587911840678754e-22*x1*x23 - x14*x25 - x14*x9 - x15*x25 + 3.1763735522036263e-22*x2*x26*x28*x9 - 1.3234889800848443e-23*x21*x22 - 2.6469779601696886e-23*x21*x23 - 5.2939559203393771e-23*x21*x24*x9 - 1.0587911840678754e-22*x22*x26*x27 + 1.0587911840678754e-22*x26*x5*x9;
 }
 
