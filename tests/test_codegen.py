@@ -49,7 +49,9 @@ LOOP(openhaptics_torque_from_tau, phantom_openhaptics_torque_from_tau(a + 3 * k,
 
 def build(text, folder):
     """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the shim as a
-    shared library (-O2); returns the ctypes library."""
+    shared library (-O2); returns the ctypes library. Fails in one line without gcc and g++."""
+    if not (shutil.which("gcc") and shutil.which("g++")):
+        pytest.fail("gcc and g++ compile the header: apt-get install g++ (.ci/run installs it)", pytrace=False)
     (folder / "model.h").write_text(text)
     (folder / "shim.c").write_text(SHIM)
     (folder / "shim.cpp").write_text(SHIM)
@@ -77,8 +79,6 @@ def per_state_error(actual, expected):
     return float((np.abs(actual - expected).max(axis=1) / np.abs(expected).max(axis=1)).max())
 
 
-@pytest.mark.skipif(shutil.which("gcc") is None or shutil.which("g++") is None,
-                    reason="never: .ci/run installs g++ (this marks the dependency)")
 @pytest.mark.parametrize("name, overlay", CASES, ids=[n if o is None else f"{n}+overlay" for n, o in CASES])
 def test_every_function_matches_pinocchio(name, overlay, tmp_path):
     """Each function of the header, compiled with -Werror as C99 and C++17, equals Phantom's
