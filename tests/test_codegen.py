@@ -16,7 +16,7 @@ from phantom_pin.codegen import header, write_header
 from phantom_pin.codegen.generate import committed_header
 from phantom_pin.config import models
 from phantom_pin.config.sampling import random_states
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 
 #: Relative tolerance per state: max |C - Pinocchio| / max |Pinocchio| of each output.
 TOLERANCE = 1e-12
@@ -210,3 +210,22 @@ def test_servo_loop_example_closes_the_loop_like_simulate(name, tmp_path):
     assert np.abs(log[:, 1:4] - result.theta).max() <= 1e-12
     assert np.abs(log[:, 4:] - result.tau_commanded).max() <= 1e-12
     assert np.abs(log[-1, 1:4] - rest).max() < 2e-3
+
+
+def test_without_sympy_one_line_names_the_package(monkeypatch, tmp_path, capsys):
+    """Without SymPy (the codegen extra) header() and the command refuse in one line naming
+    the package, and write nothing."""
+    from phantom_pin.codegen import generate
+    monkeypatch.setattr(generate, "sp", None)
+    with pytest.raises(PhantomPinError, match="needs the package sympy"):
+        header("touch")
+    assert main(["codegen", "--model", "touch", "-o", str(tmp_path / "a.h")]) == 2
+    err = capsys.readouterr().err
+    assert "sympy" in err and err.count("\n") == 1
+    assert not (tmp_path / "a.h").exists()
+
+
+def test_a_missing_config_folder_is_blamed_on_config(tmp_path, capsys):
+    assert main(["codegen", "--config", str(tmp_path / "none"), "-o", str(tmp_path / "a.h")]) == 2
+    assert capsys.readouterr().err.startswith("phantom-pin: error: --config: ")
+    assert not (tmp_path / "a.h").exists()

@@ -15,7 +15,8 @@ def codegen(args: argparse.Namespace) -> int:
     target = output(args)
     bar = Progress("codegen", 1.0, enabled=False if args.quiet else None)
     try:
-        text = header(source(args), prefix=args.prefix, overrides=overrides(args), progress=bar.update)
+        text = header(source(args), prefix=args.prefix, overrides=overrides(args), progress=bar.update,
+                      argument="--config" if args.config is not None else "--model")
     finally:
         bar.close()
     write_header(text, target, force=args.force, name="--output", force_hint="--force")
@@ -30,4 +31,4 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--output", "-o", required=True, help="the header to write, e.g. phantom_touch.h")
     command.add_argument("--prefix", default="phantom", help="the C name of every function (default phantom)")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
-    command.set_defaults(run=codegen, options={"prefix": "--prefix", "source": "--config"})
+    command.set_defaults(run=codegen, options={"prefix": "--prefix"})

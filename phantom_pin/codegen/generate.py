@@ -22,7 +22,7 @@ from typing import Any, Callable, Mapping
 
 from phantom_pin.config import DEFAULT, MODELS
 from phantom_pin.description.build import Description, describe, description_of
-from phantom_pin.exceptions import InvalidInputError, ParameterFileError
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
 
 try:
     import sympy as sp
@@ -45,8 +45,9 @@ def committed_header(name: str) -> Path:
 
 
 def _require_sympy() -> None:
+    """PhantomPinError in one line without SymPy (the command line prints it, exit 2)."""
     if sp is None:
-        raise ImportError("phantom_pin.codegen needs sympy: pip install 'phantom_pin[codegen]'")
+        raise PhantomPinError("phantom_pin.codegen needs the package sympy: pip install 'phantom_pin[codegen]'")
 
 
 def is_identifier(name: object) -> bool:
@@ -312,14 +313,14 @@ _ASSUMES = "Assumes finite input: no checks, no allocation, no global state."
 
 def header(source: str | Path | Description = DEFAULT, prefix: str = "phantom",
            overrides: Mapping[str, object] | None = None,
-           progress: Callable[[float], None] | None = None) -> str:
+           progress: Callable[[float], None] | None = None, *, argument: str = "source") -> str:
     """The C99 header of a model name (phantom_pin.models()) or a configuration folder with
     ``overrides`` (as describe()'s), its functions named ``prefix``_...; its banner names
     the model, the configuration's source and the overrides. describe()'s errors as they are;
     InvalidInputError naming ``prefix`` unless it is a C identifier. A Description is taken
     as it is (its banner then says so: the overrides it was built with are not known).
     ``progress``: called with the share done (0..1), for a progress bar; generation takes
-    seconds (SymPy)."""
+    seconds (SymPy). ``argument``: the name that errors about ``source`` give it."""
     _require_sympy()
     if not is_identifier(prefix):
         raise InvalidInputError(f"must be a C identifier (letters, digits, _), got {prefix!r}",
@@ -329,7 +330,7 @@ def header(source: str | Path | Description = DEFAULT, prefix: str = "phantom",
         description, origin = source, f"a Description of {source.config.name}"
         overlay_text = "as built into that Description"
     else:
-        description = describe(source, overrides=overlay) if overlay else description_of(source, "source")
+        description = describe(source, overrides=overlay) if overlay else description_of(source, argument)
         origin = (f"robots/phantom_description/config/{source}" if description.model is not None
                   and str(source) == description.config.name else str(source))
         overlay_text = "; ".join(f"{k} = {v!r}" for k, v in sorted(overlay.items())) or "none"
