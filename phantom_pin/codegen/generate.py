@@ -20,7 +20,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from phantom_pin.config import DEFAULT, MODELS
+from phantom_pin.config import MODELS
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
 
@@ -311,7 +311,7 @@ def _function(comment: str, signature: str, body: str) -> str:
 _ASSUMES = "Assumes finite input: no checks, no allocation, no global state."
 
 
-def header(source: str | Path | Description = DEFAULT, prefix: str = "phantom",
+def header(source: str | Path | Description, prefix: str = "phantom",
            overrides: Mapping[str, object] | None = None,
            progress: Callable[[float], None] | None = None, *, argument: str = "source") -> str:
     """The C99 header of a model name (phantom_pin.models()) or a configuration folder with
