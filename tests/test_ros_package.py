@@ -26,8 +26,9 @@ def test_every_installed_folder_exists_and_holds_files():
     cmake = (DESCRIPTION_DIR / "CMakeLists.txt").read_text()
     package = ET.parse(DESCRIPTION_DIR / "package.xml").getroot()
     assert re.search(r"project\((\w+)", cmake).group(1) == package.findtext("name")
-    (folders,) = re.findall(r"install\(DIRECTORY\s+([^)]*?)\s+DESTINATION", cmake, re.S)
+    (folders,) = re.findall(r"install\(DIRECTORY\s+([^)]*?)\s+DESTINATION share", cmake, re.S)
     folders = folders.split()
+    assert re.search(r"install\(DIRECTORY include/\s+DESTINATION include/\$\{PROJECT_NAME\}\)", cmake)
     assert set(folders) >= {"urdf", "srdf", "mjcf", "config", "launch"}
     for folder in folders:
         assert any((DESCRIPTION_DIR / folder).iterdir()), folder
@@ -118,6 +119,11 @@ def test_colcon_builds_and_installs_the_package_and_xacro_reproduces_the_urdfs(t
                 installed = share / source.relative_to(DESCRIPTION_DIR)
                 assert installed.read_bytes() == source.read_bytes(), installed
     assert (share / "package.xml").is_file()
+    headers = sorted((DESCRIPTION_DIR / "include").glob("*.h"))
+    assert headers  # the C servo-loop headers, under include/phantom_description/
+    for header in headers:
+        installed = tmp_path / "install" / "phantom_description" / "include" / "phantom_description" / header.name
+        assert installed.read_bytes() == header.read_bytes(), installed
     xacro = Path(sys.executable).parent / "xacro"
     for model in MODELS.values():
         top = share / "urdf" / model.urdf_xacro.name
