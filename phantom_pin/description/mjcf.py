@@ -30,6 +30,7 @@ import numpy as np
 
 from phantom_pin.config import Config, Scene
 from phantom_pin.description.mimic import read_mimic_tags
+from phantom_pin.exceptions import ParameterFileError
 
 # (the header names the module as it was when the shipped files were first generated:
 # they stay byte for byte the same)
@@ -61,6 +62,31 @@ def _quat_from_rpy(rpy: list[float]) -> np.ndarray:
                      cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
 
 
+def _child(element: ET.Element, path: str) -> ET.Element:
+    """The sub-element at ``path`` that describe()'s URDF always has; ParameterFileError naming
+    what is missing otherwise (a URDF of one's own)."""
+    found = element.find(path)
+    if found is None:
+        raise ParameterFileError(f"URDF: <{element.tag} name={element.get('name')!r}> has no <{path}>")
+    return found
+
+
+def _attr(element: ET.Element, name: str) -> str:
+    """The attribute ``name`` of ``element``, which describe()'s URDF always gives."""
+    value = element.get(name)
+    if value is None:
+        raise ParameterFileError(f"URDF: <{element.tag} name={element.get('name')!r}> has no {name} attribute")
+    return value
+
+
+def _content(element: ET.Element, path: str) -> str:
+    """The text of the sub-element at ``path`` (as _child)."""
+    text = _child(element, path).text
+    if text is None:
+        raise ParameterFileError(f"URDF: <{path}> of <{element.tag} name={element.get('name')!r}> is empty")
+    return text
+
+
 def _place(element: ET.Element, origin: ET.Element | None) -> None:
     """Copy a URDF <origin> onto an MJCF element as pos and (unless identity) quat."""
     if origin is None:
@@ -75,17 +101,17 @@ def _place(element: ET.Element, origin: ET.Element | None) -> None:
 
 def _geom(parent: ET.Element, source: ET.Element, cls: str, material: str | None = None) -> None:
     """A URDF <visual> or <collision> as an MJCF geom of default class ``cls``."""
-    shape = source.find("geometry")[0]
+    shape = _child(source, "geometry")[0]
     geom = ET.SubElement(parent, "geom", {"class": cls})
     if shape.tag == "cylinder":
         geom.set("type", "cylinder")
-        geom.set("size", _vec([float(shape.get("radius")), float(shape.get("length")) / 2]))
+        geom.set("size", _vec([float(_attr(shape, "radius")), float(_attr(shape, "length")) / 2]))
     elif shape.tag == "box":
         geom.set("type", "box")
-        geom.set("size", _vec([float(v) / 2 for v in shape.get("size").split()]))
+        geom.set("size", _vec([float(v) / 2 for v in _attr(shape, "size").split()]))
     elif shape.tag == "sphere":
         geom.set("type", "sphere")
-        geom.set("size", _num(float(shape.get("radius"))))
+        geom.set("size", _num(float(_attr(shape, "radius"))))
     else:  # the xacro writes primitives only
         raise ValueError(f"unsupported URDF geometry <{shape.tag}>")
     _place(geom, source.find("origin"))
@@ -97,9 +123,9 @@ def _inertial(body: ET.Element, link: ET.Element) -> None:
     inertial = link.find("inertial")
     if inertial is None:
         return
-    i = {k: float(v) for k, v in inertial.find("inertia").attrib.items()}
+    i = {k: float(v) for k, v in _child(inertial, "inertia").attrib.items()}
     element = ET.SubElement(body, "inertial", {"pos": "0 0 0",  # MJCF requires pos
-                                               "mass": _num(float(inertial.find("mass").get("value")))})
+                                               "mass": _num(float(_attr(_child(inertial, "mass"), "value")))})
     _place(element, inertial.find("origin"))
     element.set("fullinertia", _vec([i["ixx"], i["iyy"], i["izz"], i["ixy"], i["ixz"], i["iyz"]]))
 
@@ -127,17 +153,17 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     urdf = ET.fromstring(urdf_xml)
     srdf = ET.fromstring(srdf_xml)
     mimics = read_mimic_tags(urdf_xml)
-    links = {link.get("name"): link for link in urdf.findall("link")}
+    links = {_attr(link, "name"): link for link in urdf.findall("link")}
     joints = urdf.findall("joint")
     children: dict[str, list[ET.Element]] = {}
     for joint in joints:
-        children.setdefault(joint.find("parent").get("link"), []).append(joint)
-    child_links = {joint.find("child").get("link") for joint in joints}
+        children.setdefault(_attr(_child(joint, "parent"), "link"), []).append(joint)
+    child_links = {_attr(_child(joint, "child"), "link") for joint in joints}
     (root_link,) = [name for name in links if name not in child_links]
-    transmissions = {t.find("joint").get("name"): t for t in urdf.findall("transmission")}
+    transmissions = {_attr(_child(t, "joint"), "name"): t for t in urdf.findall("transmission")}
 
     timestep = settings.timestep
-    mujoco = ET.Element("mujoco", {"model": urdf.get("name")})
+    mujoco = ET.Element("mujoco", {"model": _attr(urdf, "name")})
     ET.SubElement(mujoco, "compiler", {"angle": "radian", "autolimits": "true"})
     option = ET.SubElement(mujoco, "option", {"timestep": _num(timestep), "integrator": settings.integrator})
     if config.gravity != MUJOCO_GRAVITY:  # MuJoCo's default is the report's
@@ -154,8 +180,8 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
 
     asset = ET.SubElement(mujoco, "asset")
     for material in urdf.findall("material"):
-        ET.SubElement(asset, "material", {"name": material.get("name"),
-                                          "rgba": material.find("color").get("rgba")})
+        ET.SubElement(asset, "material", {"name": _attr(material, "name"),
+                                          "rgba": _attr(_child(material, "color"), "rgba")})
 
     worldbody = ET.SubElement(mujoco, "worldbody")
 
@@ -164,22 +190,22 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
         body = ET.SubElement(parent, "body", {"name": name})
         if joint is not None:
             _place(body, joint.find("origin"))
-            if joint.get("type") == "revolute":
+            if _attr(joint, "type") == "revolute":
                 ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
-                                                               joint.get("name") in mimics, friction_solref,
-                                                               stop_ranges.get(joint.get("name")), stop_soft))
-            elif joint.get("type") != "fixed":
+                                                               _attr(joint, "name") in mimics, friction_solref,
+                                                               stop_ranges.get(_attr(joint, "name")), stop_soft))
+            elif _attr(joint, "type") != "fixed":
                 raise ValueError(f"unsupported URDF joint type {joint.get('type')!r}")
         link = links[name]
         _inertial(body, link)
         for visual in link.findall("visual"):
             material = visual.find("material")
-            _geom(body, visual, "visual", material.get("name") if material is not None else None)
+            _geom(body, visual, "visual", _attr(material, "name") if material is not None else None)
         for collision in link.findall("collision"):
             _geom(body, collision, "collision")
         for child_joint in children.get(name, []):
-            child = child_joint.find("child").get("link")
-            if (child_joint.get("type") == "fixed" and links[child].find("inertial") is None
+            child = _attr(_child(child_joint, "child"), "link")
+            if (_attr(child_joint, "type") == "fixed" and links[child].find("inertial") is None
                     and child not in children):  # a frame: a site on this body
                 _place(ET.SubElement(body, "site", {"name": child, "class": "frame"}),
                        child_joint.find("origin"))
@@ -191,7 +217,7 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
 
     contact = ET.SubElement(mujoco, "contact")
     for pair in srdf.iter("disable_collisions"):
-        ET.SubElement(contact, "exclude", {"body1": pair.get("link1"), "body2": pair.get("link2")})
+        ET.SubElement(contact, "exclude", {"body1": _attr(pair, "link1"), "body2": _attr(pair, "link2")})
 
     # the parallelogram's coupled stops, which a URDF cannot express, as a fixed tendon
     # theta2 - theta3 limited to [-(theta3 - theta2)_max, (theta2 - theta3)_max]
@@ -213,12 +239,12 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     actuator = ET.SubElement(mujoco, "actuator")
     motor = config.actuation.motor
     for index, (name, transmission) in enumerate(transmissions.items()):
-        ratio = float(transmission.find("actuator/mechanicalReduction").text)
+        ratio = float(_content(transmission, "actuator/mechanicalReduction"))
         # the saturation policy's torque at the motor shaft: the data sheet's number itself (not a
         # quotient's rounding), or the joint's without motor data (gear 1)
         torque = config.actuation.saturation_torque[index] if motor is None else \
             motor.max_continuous_torque if config.actuation.saturation == "continuous" else motor.stall_torque
-        ET.SubElement(actuator, "motor", {"name": transmission.find("actuator").get("name"),
+        ET.SubElement(actuator, "motor", {"name": _attr(_child(transmission, "actuator"), "name"),
                                           "joint": name, "gear": _num(ratio),
                                           "ctrlrange": _vec([-torque, torque]),
                                           "forcerange": _vec([-torque, torque])})
@@ -230,7 +256,7 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     ET.SubElement(sensor, "framepos", {"name": f"{prefix}tip_pos", "objtype": "site",
                                        "objname": f"{prefix}tip"})
     return (_text(mujoco, robot_name),
-            _text(_scene(settings.scene, links[f"{prefix}turret_link"], robot_file, urdf.get("name")), robot_name))
+            _text(_scene(settings.scene, links[f"{prefix}turret_link"], robot_file, _attr(urdf, "name")), robot_name))
 
 
 def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element], rotor_inertia: float,
@@ -244,18 +270,18 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element], r
     A mimic joint gets no range: its primary's range bounds it through the equality, and
     a second limit on the same motion would over-constrain MuJoCo's solver.
     """
-    attributes = {"name": joint.get("name")}
+    attributes = {"name": _attr(joint, "name")}
     if not mimic:
-        limit = joint.find("limit")
-        lower, upper = stops if stops is not None else (float(limit.get("lower")), float(limit.get("upper")))
+        limit = _child(joint, "limit")
+        lower, upper = stops if stops is not None else (float(_attr(limit, "lower")), float(_attr(limit, "upper")))
         attributes["range"] = _vec([lower, upper])
         attributes.update(stop_soft)
-    axis = joint.find("axis").get("xyz")
+    axis = _attr(_child(joint, "axis"), "xyz")
     if axis != "0 -1 0":  # the default class's axis, that of joints 2, 3 and the pins
         attributes["axis"] = axis
-    transmission = transmissions.get(joint.get("name"))
+    transmission = transmissions.get(_attr(joint, "name"))
     if transmission is not None and rotor_inertia:  # no rotor without public motor data
-        ratio = float(transmission.find("actuator/mechanicalReduction").text)
+        ratio = float(_content(transmission, "actuator/mechanicalReduction"))
         attributes["armature"] = _num(rotor_inertia * ratio**2)
     dynamics = joint.find("dynamics")
     if dynamics is not None:  # MuJoCo's frictionloss is dry friction with stiction, a soft constraint
@@ -268,12 +294,12 @@ def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element], r
 
 def _scene(scene: Scene, turret: ET.Element, robot_file: str, name: str) -> ET.Element:
     top = -scene.shoulder_height  # the table top, m in base_link (origin: shoulder)
-    plate = min(float(v.find("origin").get("xyz").split()[2]) for v in turret.findall("visual"))
+    plate = min(float(_attr(_child(v, "origin"), "xyz").split()[2]) for v in turret.findall("visual"))
     size = [float(v) for v in scene.table_size]
     mujoco = ET.Element("mujoco", {"model": f"{name} scene"})
     ET.SubElement(mujoco, "include", {"file": robot_file})
     # the turret (joint1) sits on the stand, which is world geometry: no contact between them
-    ET.SubElement(ET.SubElement(mujoco, "contact"), "exclude", {"body1": "world", "body2": turret.get("name")})
+    ET.SubElement(ET.SubElement(mujoco, "contact"), "exclude", {"body1": "world", "body2": _attr(turret, "name")})
     ET.SubElement(mujoco, "statistic", {"center": "0.1 0 0", "extent": "0.6"})
     visual = ET.SubElement(mujoco, "visual")
     ET.SubElement(visual, "headlight", {"diffuse": "0.6 0.6 0.6", "ambient": "0.3 0.3 0.3",
