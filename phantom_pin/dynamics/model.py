@@ -6,7 +6,7 @@ import itertools
 import math
 import os
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence, TypeGuard
 
 import numpy as np
 import pinocchio as pin
@@ -40,15 +40,22 @@ def _finite(array: np.ndarray) -> bool:
     return math.isfinite(sum(array.ravel("K").tolist()))
 
 
-# The fast paths of one state, in every method: ``a, b, c = theta.tolist() if theta.size
-# == 3 else ()`` followed by ``_isfinite(a + b + c)`` is the cheapest check (0.16 us,
-# against 0.33 us for a shape comparison and sum()) that theta is a finite vector of shape
-# (3,): a batch fails to unpack () without being listed (ValueError), as tolist() of a
-# (1, 3) array does; that of a (3, 1) array unpacks into lists whose sum isfinite refuses
-# (TypeError), as it refuses complex numbers and strings; lists have no size
-# (AttributeError). A sum that overflows only sends a finite input to the checked path.
-# Functions of theta alone stay finite on a finite theta; where rates enter, whose products
-# can overflow, the result is checked instead or as well.
+def _one(value: object) -> TypeGuard[np.ndarray]:
+    """The fast paths' check, written once: True if ``value`` is a finite vector of shape (3,)
+    (an array; the dtype is left to eigenpy).
+
+    ``a, b, c = value.tolist() if value.size == 3 else ()`` then ``isfinite(a + b + c)`` is the
+    cheapest check (0.16 us, against 0.33 us for a shape comparison and sum()): a batch fails
+    to unpack () without being listed (ValueError), as tolist() of a (1, 3) array does; that of
+    a (3, 1) array unpacks into lists whose sum isfinite refuses (TypeError), as it refuses
+    complex numbers and strings; lists have no size (AttributeError). A sum that overflows only
+    sends a finite input to the checked path. Functions of theta alone stay finite on a finite
+    theta; where rates enter, whose products can overflow, the caller checks the result too."""
+    try:
+        a, b, c = value.tolist() if value.size == 3 else ()  # type: ignore[attr-defined,misc]
+        return _isfinite(a + b + c)
+    except (AttributeError, TypeError, ValueError):
+        return False
 
 
 def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray, before: tuple = (),
@@ -80,12 +87,11 @@ def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Calla
     frame s; a closure, so that its fast path is as short as forward_kinematics'."""
     def method(self: Phantom, theta: object) -> np.ndarray:
         model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
-        try:  # the fast path (the comment above _rows)
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            if _isfinite(a + b + c):
+        if _one(theta):  # the fast path
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 return pin.computeFrameJacobian(model, data, theta, tip, reference)
-        except (AttributeError, TypeError, ValueError):  # no tolist, not (3,), not for eigenpy
-            pass
+            except TypeError:
+                pass
         return self._each(pin.computeFrameJacobian, ("theta",), theta, before=(model, data),
                           after=(tip, reference))
     method.__name__, method.__qualname__, method.__doc__ = name, f"Phantom.{name}", doc
@@ -211,14 +217,12 @@ class Phantom:
     # -- kinematics ------------------------------------------------------------------
     def forward_kinematics(self, theta: object) -> np.ndarray:
         """Pose g_st of the tool frame t in frame s (eq. 10): shape (..., 4, 4), metres."""
-        try:  # the fast path (the comment above _rows; the dtype is left to eigenpy)
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            if _isfinite(a + b + c):
+        if _one(theta):  # the fast path
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
-                return pin.updateFramePlacement(self._kinematics, self._kinematics_data,
-                                                self._frame_tip).homogeneous
-        except (AttributeError, TypeError, ValueError):
-            pass
+                return pin.updateFramePlacement(self._kinematics, self._kinematics_data, self._frame_tip).homogeneous
+            except TypeError:
+                pass
         return self._each(self._pose, ("theta",), theta)
 
     def inverse_kinematics(self, position: object, branch: str = "report") -> np.ndarray:
@@ -301,12 +305,11 @@ class Phantom:
     # -- dynamics --------------------------------------------------------------------
     def mass_matrix(self, theta: object) -> np.ndarray:
         """Joint-space inertia M(theta) (eqs 81-85), with the rotors' armature: (..., 3, 3)."""
-        try:  # the fast path, as forward_kinematics'
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            if _isfinite(a + b + c):
+        if _one(theta):  # the fast path
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 return pin.crba(self.model, self.data, theta)
-        except (AttributeError, TypeError, ValueError):
-            pass
+            except TypeError:
+                pass
         # the binding of crba returns the full symmetric matrix (DEVELOPERS.md), not data.M
         return self._each(pin.crba, ("theta",), theta, before=(self.model, self.data))
 
@@ -321,15 +324,13 @@ class Phantom:
         Pinocchio's computeCoriolisMatrix is silently wrong on mimic models, so it runs
         on the tree model and is projected: C = G^T C_tree G.
         """
-        try:  # the fast path (the comment above _rows); rates can overflow C
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            d, e, f = dtheta.tolist()
-            if _isfinite(a + b + c + d + e + f):
+        if _one(theta) and _one(dtheta):  # the fast path; rates can overflow C
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 out = self._coriolis(theta, dtheta)
                 if _finite(out):
                     return out
-        except (AttributeError, TypeError, ValueError):
-            pass
+            except TypeError:
+                pass
         names = ("theta", "dtheta")
         return self._tree_batch(pin.computeCoriolisMatrix, names, *self._states(names, theta, dtheta),
                                 before=(self.coupling.tree, self._tree_data))
@@ -339,12 +340,11 @@ class Phantom:
 
         A batch: rnea at zero rates and accelerations, by rneaInParallel.
         """
-        try:  # the fast path, as forward_kinematics'
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            if _isfinite(a + b + c):
+        if _one(theta):  # the fast path
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 return pin.computeGeneralizedGravity(self.model, self.data, theta)
-        except (AttributeError, TypeError, ValueError):
-            pass
+            except TypeError:
+                pass
         (q,) = self._states(("theta",), theta)
         if q.ndim == 1:
             return finite_result(pin.computeGeneralizedGravity(self.model, self.data, q), "theta")
@@ -366,8 +366,9 @@ class Phantom:
         One state: pinocchio.rnea on the mimic model. A batch (N, 3):
         pinocchio.rneaInParallel over ``threads`` OpenMP threads.
         """
+        q: Any = theta  # any object: its shape is asked, not assumed (lists have none)
         try:  # the fast path: one state (3,); eigenpy refuses (TypeError) complex and object
-            if theta.shape == dtheta.shape == ddtheta.shape == _ONE:  # arrays, converts others
+            if q.shape == dtheta.shape == ddtheta.shape == _ONE:  # type: ignore[attr-defined]
                 tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
                 # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
                 # only then are the inputs inspected, to name the bad one.
@@ -399,21 +400,24 @@ class Phantom:
         its adjugate; np.linalg.cholesky raises LinAlgError if M is not positive definite.
         A batch: the bias torques by rneaInParallel, M per state, one batched solve.
         """
-        try:  # the fast path (the comment above _rows): NaN/inf in dtheta or tau reaches
-            # every acceleration (0 * NaN is NaN), so the result is checked; theta1 enters
-            # neither M nor the bias torques, so theta is checked first. A tau of shape
-            # (3, 1) unpacks into lists, whose difference with a float raises TypeError.
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            t0, t1, t2 = tau.tolist()
-            if dtheta.shape == _ONE and _isfinite(a + b + c):
-                model, data = self.model, self.data
-                bias = pin.nonLinearEffects(model, data, theta, dtheta).tolist()
-                acc = solve_spd(pin.crba(model, data, theta).tolist(),
-                                (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
-                if acc is not None and _isfinite(sum(acc)):  # rates can overflow
-                    return np.array(acc)
-        except (AttributeError, TypeError, ValueError):  # no shape, not for eigenpy, complex tau
-            pass
+        rates: Any = dtheta  # any object: its shape is asked, not assumed
+        torques: Any = tau
+        # the fast path: NaN/inf in dtheta or tau reaches every acceleration (0 * NaN is NaN),
+        # so the result is checked; theta1 enters neither M nor the bias torques, so theta is
+        # checked first. A tau of shape (3, 1) unpacks into lists, whose difference with a float
+        # raises TypeError.
+        if _one(theta):
+            try:
+                t0, t1, t2 = torques.tolist()
+                if rates.shape == _ONE:
+                    model, data = self.model, self.data
+                    bias = pin.nonLinearEffects(model, data, theta, dtheta).tolist()
+                    acc = solve_spd(pin.crba(model, data, theta).tolist(),
+                                    (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
+                    if acc is not None and _isfinite(sum(acc)):  # rates can overflow
+                        return np.array(acc)
+            except (AttributeError, TypeError, ValueError):  # no shape, not for eigenpy, complex tau
+                pass
         names = ("theta", "dtheta", "tau")
         q, v, torque = self._states(names, theta, dtheta, tau)
         if q.ndim == 1:
@@ -422,8 +426,8 @@ class Phantom:
             rhs = torque - self._batched(q, v, np.zeros_like(q))
         mass = _rows(pin.crba, q.reshape(-1, 3), before=(self.model, self.data)).reshape(q.shape + (3,))
         np.linalg.cholesky(mass)  # LinAlgError unless every M is positive definite
-        acc = np.linalg.solve(mass, rhs[..., None])[..., 0]
-        return finite_result(acc, ", ".join(names))
+        accelerations = np.linalg.solve(mass, rhs[..., None])[..., 0]
+        return finite_result(accelerations, ", ".join(names))
 
     def _tree_derivatives(self, theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> np.ndarray:
         """d tau_tree / d q and d tau_tree / d v of the tree model, (2, tree.nv, tree.nv)."""
@@ -438,17 +442,14 @@ class Phantom:
         and are projected: d tau/d theta = G^T (d tau_tree/d q) G, and likewise for dtheta.
         """
         coupling = self.coupling
-        try:  # the fast path (the comment above _rows); rates can overflow the derivatives
-            a, b, c = theta.tolist() if theta.size == 3 else ()
-            d, e, f = dtheta.tolist()
-            g, h, i = ddtheta.tolist()
-            if _isfinite(a + b + c + d + e + f + g + h + i):
+        if _one(theta) and _one(dtheta) and _one(ddtheta):  # the fast path; rates can overflow
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 both = coupling.project(self._tree_derivatives(
                     coupling.configuration(theta), coupling.tangent(dtheta), coupling.tangent(ddtheta)))
                 if _finite(both):
                     return both[0], both[1]
-        except (AttributeError, TypeError, ValueError):
-            pass
+            except TypeError:
+                pass
         names = ("theta", "dtheta", "ddtheta")
         both = self._tree_batch(self._tree_derivatives, names, *self._states(names, theta, dtheta, ddtheta))
         return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()
