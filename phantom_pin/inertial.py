@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterable
 
 import numpy as np
 
@@ -26,6 +27,22 @@ TRIANGLE_SLACK = 1e-12
 
 #: The six numbers of a tensor, in the order of ``Inertial.inertia`` (and of the YAML keys).
 INERTIA_KEYS = ("xx", "xy", "xz", "yy", "yz", "zz")
+#: Three numbers: a point or vector (m), or one number per joint.
+Vector3 = tuple[float, float, float]
+#: An inertia tensor's six entries, in INERTIA_KEYS' order (kg m^2).
+Tensor6 = tuple[float, float, float, float, float, float]
+
+
+def vector3(values: Iterable[float]) -> Vector3:
+    """Exactly three numbers as a Vector3 (ValueError otherwise); their types are kept."""
+    a, b, c = values
+    return a, b, c
+
+
+def tensor6(values: Iterable[float]) -> Tensor6:
+    """Exactly six numbers as a Tensor6 (ValueError otherwise); their types are kept."""
+    xx, xy, xz, yy, yz, zz = values
+    return xx, xy, xz, yy, yz, zz
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,8 +76,8 @@ class Inertial:
         c = np.array([hx, hy, hz]) / m
         at_com = (np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
                   - m * (c @ c * np.eye(3) - np.outer(c, c)))
-        return cls(m, tuple(float(v) for v in c),
-                   tuple(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
+        return cls(m, vector3(float(v) for v in c),
+                   tensor6(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
 
 
 def _point(m: float, c: np.ndarray) -> np.ndarray:
@@ -77,8 +94,8 @@ def without_point_mass(body: Inertial, mass: float, point: tuple[float, float, f
     rest = m - mass
     com = (m * c - mass * p) / rest
     at_com = origin - _point(rest, com)
-    return Inertial(rest, tuple(float(v) for v in com),
-                    tuple(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
+    return Inertial(rest, vector3(float(v) for v in com),
+                    tensor6(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
 
 
 def principal_moments(tensor: np.ndarray) -> np.ndarray:

@@ -10,6 +10,7 @@ import copy
 import math
 import re
 from pathlib import Path
+from typing import cast
 
 import yaml
 
@@ -102,12 +103,12 @@ def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) ->
             raise ParameterFileError(f"{key}: {name} has no key {parts[0]!r}")
         if not is_number(_child(node, parts[-1])):
             raise ParameterFileError(f"{key}: not a number in {name}, cannot override it")
-        if not is_number(value) or not math.isfinite(value):
+        if not is_number(value) or not math.isfinite(cast(float, value)):
             raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
         if isinstance(node, list):
-            node[int(parts[-1])] = float(value)
+            node[int(parts[-1])] = float(cast(float, value))
         else:
-            node[parts[-1]] = float(value)
+            cast(dict, node)[parts[-1]] = float(cast(float, value))
     return documents
 
 

@@ -12,13 +12,13 @@ import dataclasses
 import math
 import types
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, Sequence, cast
 
 import numpy as np
 
 from phantom_pin.config.files import FILES, is_number
 from phantom_pin.exceptions import ParameterFileError
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, without_point_mass
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, Vector3, problem, tensor6, vector3, without_point_mass
 from phantom_pin.report.parameters import ReportParameters, Unprinted
 from phantom_pin.report.parameters import links as report_links
 
@@ -148,6 +148,7 @@ class Actuation:
         I_bexx, I_dfxx and I_baseyy include them)."""
         if self.motor is None:
             return 0.0, (0.0, 0.0, 0.0)
+        assert self.ratios is not None  # with a motor, its ratios (both given or both not public)
         return self.motor.rotor_inertia, self.ratios
 
     @property
@@ -155,7 +156,7 @@ class Actuation:
         """Reflected rotor inertia of each joint, rotor_inertia * ratio^2 (kg m^2); zero
         without motor data (see ``rotor``)."""
         inertia, ratios = self.rotor
-        return tuple(inertia * r**2 for r in ratios)
+        return vector3(inertia * r**2 for r in ratios)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,7 +180,8 @@ class Stops:
     stiffness: float
     damping: float
 
-    def bounds(self, lower: tuple | None = None, upper: tuple | None = None) -> tuple[np.ndarray, np.ndarray]:
+    def bounds(self, lower: Sequence[float] | np.ndarray | None = None,
+               upper: Sequence[float] | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(lower, upper), each (4,) rad, of the stop coordinates (STOP_COORDINATES): the
         joints' stops (or the given per-joint ``lower``/``upper``) and the coupled stops."""
         lo, hi = self.lower if lower is None else lower, self.upper if upper is None else upper
@@ -322,9 +324,12 @@ class _Reader:
         return node
 
     def number(self, arg: str, *keys: str, positive: bool = False, non_negative: bool = False) -> float:
-        value = self.node(arg, *keys)
+        node = self.node(arg, *keys)
         name = ".".join(keys)
-        if not is_number(value) or not math.isfinite(value):
+        if not is_number(node):
+            raise self.error(arg, f"{name} must be a finite number, got {node!r}")
+        value = cast(float, node)  # an int or a float (is_number)
+        if not math.isfinite(value):
             raise self.error(arg, f"{name} must be a finite number, got {value!r}")
         if abs(value) > MAX_MAGNITUDE:
             raise self.error(arg, f"{name} must be at most {MAX_MAGNITUDE:g} in magnitude (SI units), got {value!r}")
@@ -412,8 +417,8 @@ def _actuation(r: _Reader) -> Actuation:
     if public[2] and not public[1]:
         raise r.error(arg, "encoder needs the transmission_ratio and the motor (it is read at the motor shaft)")
     if not public[1]:
-        effort = tuple(act("joint_torque_limit", j, positive=True) for j in JOINTS)
-        velocity = tuple(act("joint_velocity_limit", j, positive=True) for j in JOINTS)
+        effort = vector3(act("joint_torque_limit", j, positive=True) for j in JOINTS)
+        velocity = vector3(act("joint_velocity_limit", j, positive=True) for j in JOINTS)
         return Actuation(None, None, None, friction, effort, velocity, effort, saturation)
     extra = [key for key in JOINT_LIMITS if key in document]
     if extra:
@@ -425,11 +430,11 @@ def _actuation(r: _Reader) -> Actuation:
         raise r.error(arg, f"motor: {problem}")
     encoder = None if not public[2] else \
         Encoder(*(act("encoder", f.name, positive=True) for f in dataclasses.fields(Encoder)))
-    ratios = tuple(act("transmission_ratio", j, positive=True) for j in JOINTS)
+    ratios = vector3(act("transmission_ratio", j, positive=True) for j in JOINTS)
     return Actuation(ratios, motor, encoder, friction,
-                     tuple(motor.max_continuous_torque * k for k in ratios),
-                     tuple(motor.max_speed / k for k in ratios),
-                     tuple(motor.stall_torque * k for k in ratios), saturation)
+                     vector3(motor.max_continuous_torque * k for k in ratios),
+                     vector3(motor.max_speed / k for k in ratios),
+                     vector3(motor.stall_torque * k for k in ratios), saturation)
 
 
 def _limits(r: _Reader) -> Limits:
@@ -459,7 +464,8 @@ def _limits(r: _Reader) -> Limits:
         if not all(lo <= t <= hi for t, lo, hi in zip(theta, lower, upper)):
             raise r.error(arg, f"postures.{name} {list(theta)} rad is outside the box joint1..joint3")
         postures[name] = theta
-    return Limits(lower, upper, Stops(tuple(s[0] for s in stops), tuple(s[1] for s in stops), coupled,
+    return Limits(vector3(lower), vector3(upper),
+                  Stops(vector3(s[0] for s in stops), vector3(s[1] for s in stops), coupled,
                                       r.number(arg, "stops", "stiffness", positive=True),
                                       r.number(arg, "stops", "damping", non_negative=True)),
                   types.MappingProxyType(postures))
@@ -499,8 +505,8 @@ def _report(r: _Reader, kinematics: Kinematics,
     def phys(*keys: str, positive: bool = True) -> float:
         return r.number(arg, *keys, positive=positive)
 
-    def inertia(segment: str) -> list[float]:
-        return [phys(segment, "inertia", axis) for axis in ("xx", "yy", "zz")]
+    def inertia(segment: str) -> Vector3:
+        return vector3(phys(segment, "inertia", axis) for axis in ("xx", "yy", "zz"))
 
     report = ReportParameters(
         kinematics.l1, kinematics.l2, kinematics.l3, phys("segment_be", "com", positive=False),
@@ -509,15 +515,16 @@ def _report(r: _Reader, kinematics: Kinematics,
         phys("segment_be", "mass"), *inertia("segment_be"), phys("segment_df", "mass"), *inertia("segment_df"),
         phys("segment_g", "inertia_yy"))
     unprinted = Unprinted(phys("segment_g", "mass"), phys("segment_g", "inertia_xx"), phys("segment_g", "inertia_zz"),
-                          phys("hinge_pin", "mass"), tuple(phys("hinge_pin", "inertia", a) for a in ("xx", "yy", "zz")))
+                          phys("hinge_pin", "mass"),
+                          vector3(phys("hinge_pin", "inertia", a) for a in ("xx", "yy", "zz")))
     return report, unprinted, report_links(report, unprinted, *actuation.rotor)
 
 
 def _inertial(r: _Reader, *keys: str) -> Inertial:
     """A body in full at ``keys`` of physical_parameters.yaml: mass, com, inertia."""
     arg = "physical_parameters_file"
-    return Inertial(r.number(arg, *keys, "mass", positive=True), r.vector(arg, *keys, "com", length=3),
-                    tuple(r.number(arg, *keys, "inertia", k) for k in INERTIA_KEYS))
+    return Inertial(r.number(arg, *keys, "mass", positive=True), vector3(r.vector(arg, *keys, "com", length=3)),
+                    tensor6(r.number(arg, *keys, "inertia", k) for k in INERTIA_KEYS))
 
 
 def _housing(r: _Reader) -> Inertial:
@@ -623,7 +630,8 @@ def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool)
             raise r.error("physical_parameters_file", f"link {link}: {trouble} (from {keys})")
     return Config(name, folder, overridden, kinematics, r.number("physical_parameters_file", "gravity", positive=True),
                   types.MappingProxyType(links), _housing(r), report, unprinted, actuation, _limits(r), _mujoco(r),
-                  _freeze(documents["visual_parameters_file"]), types.MappingProxyType(_sources(r)))
+                  cast(Mapping[str, object], _freeze(documents["visual_parameters_file"])),
+                  types.MappingProxyType(_sources(r)))
 
 
 #: The keys of the report's form that feed each link, for error messages.

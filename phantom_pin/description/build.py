@@ -8,6 +8,7 @@ import functools
 import tempfile
 import xml.dom.minidom
 from pathlib import Path
+from typing import cast
 
 import xacro
 import yaml
@@ -164,5 +165,5 @@ def description_of(source: object = None, argument: str = "model") -> Descriptio
         return shipped()
     if isinstance(source, str) and source in configuration.MODELS:
         return shipped(source)
-    configuration.resolve(source, argument)
-    return describe(source)
+    configuration.resolve(source, argument)  # InvalidInputError unless a model name or a folder
+    return describe(cast("str | Path", source))

@@ -29,7 +29,9 @@ def read_mimic_tags(urdf_xml: str) -> dict[str, Mimic]:
     for joint in root.findall("joint"):
         tag = joint.find("mimic")
         if tag is not None:
-            name = joint.get("name")
-            mimics[name] = Mimic(name, tag.get("joint"), float(tag.get("multiplier", 1.0)),
-                                 float(tag.get("offset", 0.0)))
+            name, primary = joint.get("name"), tag.get("joint")
+            if name is None or primary is None:
+                raise ParameterFileError(f"URDF: a joint with a <mimic> needs a name and the mimic a joint "
+                                         f"(joint {name!r}, mimic of {primary!r})")
+            mimics[name] = Mimic(name, primary, float(tag.get("multiplier", 1.0)), float(tag.get("offset", 0.0)))
     return mimics

@@ -11,7 +11,7 @@ import math
 import xml.etree.ElementTree as ET
 
 from phantom_pin.exceptions import ParameterFileError
-from phantom_pin.inertial import Inertial, problem
+from phantom_pin.inertial import Inertial, problem, tensor6, vector3
 
 #: Attributes of each URDF primitive that are sizes (m).
 _SIZES = {"cylinder": ("radius", "length"), "sphere": ("radius",), "box": ("size",)}
@@ -34,9 +34,10 @@ def urdf_inertial(inertial: ET.Element) -> Inertial | None:
     m = _numbers(None if mass is None else mass.get("value"), 1)
     values = [_numbers(None if inertia is None else inertia.get(f"i{k}", "0"), 1)
               for k in ("xx", "xy", "xz", "yy", "yz", "zz")]
-    if xyz is None or rpy is None or any(rpy) or m is None or any(v is None for v in values):
+    entries = [v[0] for v in values if v is not None]
+    if xyz is None or rpy is None or any(rpy) or m is None or len(entries) != len(values):
         return None
-    return Inertial(m[0], tuple(xyz), tuple(v[0] for v in values))
+    return Inertial(m[0], vector3(xyz), tensor6(entries))
 
 
 def _check_geometry(source: str, link: str, element: ET.Element) -> None:

@@ -80,12 +80,12 @@ class Coupling:
         q = np.empty(self.tree.nq)
         for tree_q, reduced_q, nq in self._copy_slots:
             q[tree_q:tree_q + nq] = q_reduced[reduced_q:reduced_q + nq]
-        for tree_q, nq, primary_q, primary_nq, multiplier, offset in self._mimic_slots:
+        for tree_q, nq, primary_q, primary_nq, multiplier, shift in self._mimic_slots:
             if primary_nq == 1:
                 angle = q_reduced[primary_q]
             else:  # continuous joint stored as (cos, sin)
                 angle = np.arctan2(q_reduced[primary_q + 1], q_reduced[primary_q])
-            angle = multiplier * angle + offset
+            angle = multiplier * angle + shift
             q[tree_q:tree_q + nq] = angle if nq == 1 else (np.cos(angle), np.sin(angle))
         return q
 

@@ -15,6 +15,8 @@ from decimal import Decimal
 
 import numpy as np
 
+from phantom_pin.report.parameters import ReportParameters
+
 #: The appendix's "Numerical Values", as printed (h = 0 omitted), by ReportParameters field name.
 NUMERICAL_VALUES = {
     "l1": "0.215", "l2": "0.170", "l3": "0.0325", "l5": "-0.0368", "l6": "0.0527",
@@ -29,7 +31,7 @@ APPENDIX_IAYY = float(NUMERICAL_VALUES["Iayy"])
 EQ41_IAYY = 0.001843e-4
 
 
-def applies(params: object) -> bool:
+def applies(params: ReportParameters) -> bool:
     """True if ``params`` (a ReportParameters) hold the report's numbers: every appendix value,
     with Iayy either the appendix's or eq. 41's. Only then do the printed torques apply."""
     return all(getattr(params, name) == float(text) for name, text in NUMERICAL_VALUES.items()
@@ -38,7 +40,7 @@ def applies(params: object) -> bool:
 
 def _c(text: str) -> tuple[float, float]:
     value = Decimal(text)
-    return float(value), float(Decimal(1).scaleb(value.as_tuple().exponent)) / 2
+    return float(value), float(Decimal(1).scaleb(int(value.as_tuple().exponent))) / 2
 
 
 def torques(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

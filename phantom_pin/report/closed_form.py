@@ -10,7 +10,7 @@ contain typos; the corrections, and their evidence, are listed in docs/errata.md
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Mapping, Protocol
 
 import numpy as np
 
@@ -210,7 +210,7 @@ def _gravity_entries(trig: _Trig, p: ReportParameters) -> dict[int, np.ndarray]:
             2: p.g / 2 * (p.l2 * p.ma + 2 * p.l3 * p.mc - 2 * p.l6 * p.mdf) * trig.s3}  # eq 94
 
 
-def _matrix(entries: dict[tuple[int, int], np.ndarray | float], shape: tuple[int, ...]) -> np.ndarray:
+def _matrix(entries: Mapping[tuple[int, int], np.ndarray | float], shape: tuple[int, ...]) -> np.ndarray:
     out = np.zeros(shape + (3, 3))
     for (i, j), value in entries.items():
         out[..., i, j] = value
