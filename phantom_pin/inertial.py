@@ -70,7 +70,7 @@ class Inertial:
                          origin[1, 2], origin[2, 2]])
 
     @classmethod
-    def from_dynamic_parameters(cls, pi: np.ndarray) -> "Inertial":
+    def from_dynamic_parameters(cls, pi: np.ndarray) -> Inertial:
         """The inverse of dynamic_parameters (the mass must be positive)."""
         m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = (float(v) for v in pi)
         c = np.array([hx, hy, hz]) / m

@@ -75,6 +75,6 @@ def test_the_layers_point_down():
 
 def test_every_module_imports_in_a_fresh_interpreter_leaves_first():
     order = list(TopologicalSorter(GRAPH).static_order())
-    script = "import importlib\nfor name in %r:\n    importlib.import_module(name)\n" % order
+    script = f"import importlib\nfor name in {order!r}:\n    importlib.import_module(name)\n"
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr

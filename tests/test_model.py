@@ -40,7 +40,7 @@ def test_coriolis_projection_is_right_and_pinocchio_mimic_coriolis_is_reported(p
     error = relative_error(raw, expected)
     warnings.warn(f"pinocchio {pin.__version__}: computeCoriolisMatrix on the mimic model is "
                   + (f"still wrong (relative error {error:.1e}); Phantom projects the tree model's"
-                     if error > TOLERANCE else "now right: Phantom.coriolis_matrix could call it"))
+                     if error > TOLERANCE else "now right: Phantom.coriolis_matrix could call it"), stacklevel=1)
 
 
 def test_inverse_dynamics_equals_closed_form(phantom, states):

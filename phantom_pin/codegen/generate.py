@@ -17,8 +17,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import xml.etree.ElementTree as ET
+from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any
 
 from phantom_pin.config import MODELS
 from phantom_pin.description.build import Description, describe, description_of

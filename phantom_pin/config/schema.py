@@ -11,8 +11,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import types
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Mapping, Sequence, cast
+from typing import cast
 
 import numpy as np
 
@@ -593,7 +594,7 @@ def uncarve(links: Mapping[str, Inertial], kinematics: Kinematics) -> dict[str, 
 REPORT_SEGMENTS = ("segment_a", "segment_c", "segment_be", "segment_df", "segment_g", "density")
 
 
-def in_full(documents: dict[str, dict], config: "Config") -> dict[str, dict]:
+def in_full(documents: dict[str, dict], config: Config) -> dict[str, dict]:
     """``documents`` (of ``config``) with physical_parameters.yaml in the links' full form: a
     model in the report's form gets its five bodies (``uncarve`` of its links, the rotors
     staying in the armature) in place of the report's segments; its dynamics are unchanged.

@@ -140,7 +140,7 @@ def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
     return Description(config, configuration.MODELS.get(config.name), prefix, urdf, srdf, mjcf, scene, robot_file)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def shipped(name: str = configuration.DEFAULT) -> Description:
     """A named model with its committed URDF, SRDF and MJCF files (which
     tests/test_description.py shows equal to describe(name)), read once per process."""

@@ -130,7 +130,7 @@ def _inertial(body: ET.Element, link: ET.Element) -> None:
     element.set("fullinertia", _vec([i["ixx"], i["iyy"], i["izz"], i["ixy"], i["ixz"], i["iyz"]]))
 
 
-def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_file: str,
+def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_file: str,  # noqa: C901 (one MJCF, section by section)
                robot_name: str) -> tuple[str, str]:
     """The MJCF texts (robot, scene) of a URDF and SRDF generated from ``config`` with
     ``prefix`` (phantom_pin.description.describe does all three in one place).

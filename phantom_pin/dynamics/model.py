@@ -5,8 +5,9 @@ from __future__ import annotations
 import itertools
 import math
 import os
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Callable, Sequence, TypeGuard
+from typing import Any, TypeGuard
 
 import numpy as np
 import pinocchio as pin

@@ -24,7 +24,7 @@ physically consistent parameters, and the checks that decide whether they may be
 from __future__ import annotations
 
 import dataclasses
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 import scipy.ndimage
@@ -224,7 +224,7 @@ NO_POSTURE = 2 * np.pi
 MAX_TORQUE = 1e3
 
 
-def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
+def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",  # noqa: C901 (checks, then stages)
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
              timing: str = "held") -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are

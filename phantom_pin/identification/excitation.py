@@ -9,7 +9,7 @@ the trajectory starts and ends each period at rest (dtheta = ddtheta = 0 at t = 
 from __future__ import annotations
 
 import dataclasses
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 import scipy.optimize
@@ -34,7 +34,7 @@ class Fourier:
     period: float
 
     @classmethod
-    def from_free(cls, free: np.ndarray, harmonics: int, period: float) -> "Fourier":
+    def from_free(cls, free: np.ndarray, harmonics: int, period: float) -> Fourier:
         """From q0 and the first H-1 harmonics; the H-th makes dtheta(0) = ddtheta(0) = 0."""
         q0, rest = free[:3], free[3:].reshape(2, 3, harmonics - 1)
         k = np.arange(1, harmonics)
@@ -94,7 +94,7 @@ def _check_arguments(**values: float) -> None:
         raise InvalidInputError(f"torque_share: expected a share in (0, 1], got {values['torque_share']!r}")
 
 
-def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int = 5,
+def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int = 5,  # noqa: C901 (closures of one problem)
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
              progress: Callable[[float], None] | None = None,

@@ -14,7 +14,7 @@ others to a prior). The decision stays with the one physical check of a link
 
 from __future__ import annotations
 
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -57,7 +57,7 @@ def pseudo_inertia(pi: np.ndarray) -> np.ndarray:
     return out
 
 
-def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,
+def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,  # noqa: C901 (one barrier method)
             scale: np.ndarray, bodies: Sequence[tuple[np.ndarray, np.ndarray]], positive: Sequence[int],
             consistent: Callable[[np.ndarray], bool], fixed: Sequence[int] = (),
             prior_weight: float = 1e-3) -> np.ndarray:

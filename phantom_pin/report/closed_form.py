@@ -10,7 +10,8 @@ contain typos; the corrections, and their evidence, are listed in docs/errata.md
 
 from __future__ import annotations
 
-from typing import Mapping, Protocol
+from collections.abc import Mapping
+from typing import Protocol
 
 import numpy as np
 

@@ -10,7 +10,7 @@ result settles each erratum in docs/errata.md. Needs SymPy (the ``test`` extra).
 from __future__ import annotations
 
 import functools
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 import sympy as sp
