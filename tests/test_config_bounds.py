@@ -8,7 +8,8 @@ import pytest
 
 from phantom_pin import ParameterFileError, config, describe
 from phantom_pin.cli import main
-from phantom_pin.config.schema import MAX_MAGNITUDE, MOTOR_TOLERANCE
+from phantom_pin.config.builders import MOTOR_TOLERANCE
+from phantom_pin.config.reader import MAX_MAGNITUDE
 
 
 @pytest.mark.parametrize("overrides, message", [

@@ -6,7 +6,7 @@ import pytest
 
 from helpers import CONFIG, URDF_PATH
 from phantom_pin import ParameterFileError, Phantom, describe
-from phantom_pin.config.schema import BODIES as BODIES_FULL
+from phantom_pin.config.types import BODIES as BODIES_FULL
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification import physical

@@ -1,14 +1,15 @@
 """Configurations: the named models, their parameter files read once into one typed,
-immutable ``Config`` (schema), the links in full (inertial) and the overrides (files)."""
+immutable ``Config`` (types, read by reader, built by builders), the links and bodies (bodies,
+inertial) and the overrides (files)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from phantom_pin.config.builders import REPORT_SEGMENTS, build, in_full
 from phantom_pin.config.files import FILES, MODEL_KEY, apply_overrides, read_documents, read_overrides
 from phantom_pin.config.models import DEFAULT, MODELS, Model, models, resolve
-from phantom_pin.config.schema import (
-    REPORT_SEGMENTS,
+from phantom_pin.config.types import (
     Actuation,
     Config,
     CoupledStops,
@@ -20,8 +21,6 @@ from phantom_pin.config.schema import (
     MujocoSettings,
     Scene,
     Stops,
-    build,
-    in_full,
 )
 from phantom_pin.exceptions import ParameterFileError
 from phantom_pin.inertial import Inertial
@@ -48,7 +47,7 @@ def read(source: str | Path = DEFAULT, overrides: dict[str, object] | None = Non
     in_links = {key: value for key, value in overrides.items() if section(key) == "links"}
     if in_links and "links" not in documents["physical_parameters_file"]:
         # a model in the report's form given links in full (identify's overlay): its five
-        # bodies in full, as its files give them (schema.in_full), then every override on them
+        # bodies in full, as its files give them (builders.in_full), then every override on them
         mixed = sorted(key for key in overrides if section(key) in REPORT_SEGMENTS)
         if mixed:
             raise ParameterFileError(f"{mixed[0]}: the report's segments and links.* describe the same bodies "

@@ -1,7 +1,7 @@
 """The parameter files of a configuration folder: YAML read once each, overrides applied.
 
 This is the only module that opens a parameter file. Everything it returns is plain data
-(mappings of mappings); phantom_pin.config.schema turns it into the typed Config.
+(mappings of mappings); phantom_pin.config.builders turns it into the typed Config (config.types).
 """
 
 from __future__ import annotations

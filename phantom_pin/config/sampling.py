@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from phantom_pin.config.schema import Limits
+from phantom_pin.config.types import Limits
 from phantom_pin.exceptions import ParameterFileError
 
 #: Rounds of rejection sampling before sample_postures gives up: enough when the limits keep

@@ -15,7 +15,7 @@ import yaml
 
 from phantom_pin import config as configuration
 from phantom_pin.config import Config, Model
-from phantom_pin.config.schema import JOINTS
+from phantom_pin.config.types import JOINTS, thaw
 from phantom_pin.description.mjcf import mjcf_texts
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
@@ -72,7 +72,7 @@ def _xacro_inputs(config: Config, folder: Path) -> dict[str, str]:
             "joint_velocity_limit": dict(zip(JOINTS, a.velocity))},
         "joint_limits_file": {**{j: {"lower": lo, "upper": hi} for j, lo, hi in zip(JOINTS, lim.lower, lim.upper)},
                               "postures": {name: list(theta) for name, theta in lim.postures.items()}},
-        "visual_parameters_file": configuration.schema.thaw(config.visual),
+        "visual_parameters_file": thaw(config.visual),
     }
     paths = {}
     for arg, document in documents.items():

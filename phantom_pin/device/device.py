@@ -10,7 +10,7 @@ from typing import cast
 import numpy as np
 
 from phantom_pin.config import Config
-from phantom_pin.config.schema import STOP_COORDINATES, Motor
+from phantom_pin.config.types import STOP_COORDINATES, Motor
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError

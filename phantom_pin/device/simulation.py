@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from phantom_pin.config.schema import SATURATIONS
+from phantom_pin.config.types import SATURATIONS
 from phantom_pin.device.device import Device
 from phantom_pin.device.plant import MAX_STEP, Diverged, Plant, contact_substeps
 from phantom_pin.device.run import MAX_STEPS, Controller, SimulationResult, arguments, command, default_device

@@ -2,7 +2,7 @@
 overlay writes, then the six friction coefficients viscous1..3 in N m s/rad and coulomb1..3
 in N m) and the base parameters the joint torques determine, beta = matrix x + offset:
 
-- ``General``: the rigid body in full. x = the five bodies (config.schema.BODIES) in
+- ``General``: the rigid body in full. x = the five bodies (config.types.BODIES) in
   standard parameters about their link frame's origin, Pinocchio's order [m (kg), m c
   (kg m), I_origin xx, xy, yy, xz, yz, zz (kg m^2)], then the rotor inertia J (kg m^2, at
   the motor shaft; absent without public motor data), then friction. beta: the base
@@ -25,7 +25,8 @@ import dataclasses
 
 import numpy as np
 
-from phantom_pin.config.schema import BODIES, carve, uncarve
+from phantom_pin.config.bodies import carve, uncarve
+from phantom_pin.config.types import BODIES
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import constants, parameterization, physical
