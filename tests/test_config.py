@@ -115,7 +115,8 @@ def test_yaml_numbers_without_a_dot_are_numbers(folder):
     actuation.write_text(text.replace(rotor, "  rotor_inertia: 11e-7"))
     c = config.read(folder)
     assert c.actuation.motor.rotor_inertia == 1.1e-6
-    np.testing.assert_allclose(Phantom(folder).model.armature, [1.1e-6 * r**2 for r in c.actuation.ratios], rtol=1e-12)
+    np.testing.assert_allclose(Phantom.from_folder(folder).model.armature, [1.1e-6 * r**2 for r in c.actuation.ratios],
+                               rtol=1e-12)
     overrides = folder.parent / "params.yaml"
     overrides.write_text("l1: 21e-2\nsegment_a.mass: +2E-2\n")
     assert read_overrides(overrides) == {"l1": 0.21, "segment_a.mass": 0.02}
@@ -155,7 +156,7 @@ def test_coupled_stops_that_leave_no_posture_are_refused(folder, forward, backwa
         line = next(line for line in text.splitlines() if line.strip().startswith(key + ":"))
         text = text.replace(line, f"  {key}: {value}")
     limits.write_text(text)
-    for call in (config.read, Phantom, Device, describe):
+    for call in (config.read, Phantom.from_folder, lambda f: Device(Phantom.from_folder(f)), describe):
         with pytest.raises(ParameterFileError, match=f"joint_limits.yaml: .*{message}"):
             call(folder)
     with pytest.raises(ParameterFileError, match=f"after the overrides, .*{message}"):  # as overrides
@@ -197,7 +198,7 @@ def test_malformed_files_are_named(folder, file, old, new, message):
     text = path.read_text()
     assert old in text
     path.write_text(text.replace(old, new, 1))
-    for call in (config.read, describe, Phantom, Device):
+    for call in (config.read, describe, Phantom.from_folder, lambda f: Device(Phantom.from_folder(f))):
         with pytest.raises(ParameterFileError, match=message) as error:
             call(folder)
         assert file in str(error.value)

@@ -35,8 +35,8 @@ def test_device_wraps_the_phantom_and_builds_one_by_default(phantom):
     assert Device().phantom.config == phantom.config
     with pytest.raises(InvalidInputError, match="phantom"):
         Device(42)
-    # a text is a model name or a folder now: one that names neither is refused as such
-    with pytest.raises(InvalidInputError, match="neither a model"):
+    # a text is a model name: one that names none is refused, naming the models and from_folder
+    with pytest.raises(InvalidInputError, match="expected a model name .*premium_1_5.*Phantom.from_folder"):
         Device("not a phantom")
 
 
@@ -225,15 +225,17 @@ def test_malformed_device_numbers_are_named(tmp_path, file, old, new, message):
 
 
 def test_device_reads_its_config_folder(tmp_path, phantom):
-    """Device(DIR) and Device(Phantom(DIR)) take the device numbers of DIR, the folder the
-    rigid body comes from; a phantom and a folder together are refused (Device takes one
-    source: there is no config_dir keyword any more)."""
+    """Device(Phantom.from_folder(DIR)) takes the device numbers of DIR, the folder the rigid
+    body comes from; Device(DIR) is refused naming that way (one input type per way of making
+    it); a phantom and a folder together are refused (no config_dir keyword any more)."""
     folder = tmp_path / "config"
     shutil.copytree(CONFIG_DIR, folder)
     text = (folder / "actuation.yaml").read_text()
     (folder / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
-    for device in (Device(folder), Device(Phantom(folder))):
-        np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB, 0, 0], rtol=1e-14)
+    device = Device(Phantom.from_folder(folder))
+    np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB, 0, 0], rtol=1e-14)
+    with pytest.raises(InvalidInputError, match=r"Device\(Phantom.from_folder\(path\)\)"):
+        Device(folder)
     with pytest.raises(TypeError):
         Device(phantom, folder)
     with pytest.raises(TypeError, match="config_dir"):

@@ -59,7 +59,7 @@ def test_the_exact_log_gives_the_true_general_base_parameters():
 
     model = General(PHANTOM)
     t = np.arange(10001) / RATE
-    theta, dtheta, ddtheta = excitation.optimise(PHANTOM.description, iterations=15, restarts=1).trajectory(t)
+    theta, dtheta, ddtheta = excitation.optimise(PHANTOM, iterations=15, restarts=1).trajectory(t)
     tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + CONFIG.actuation.friction.torque(dtheta)
     fit = estimation.estimate(io.Log(t, theta, tau), PHANTOM, timing="sampled")
     truth = model.matrix @ model.prior

@@ -118,3 +118,27 @@ def test_malformed_urdf_or_srdf_raise_a_named_parameter_file_error(tmp_path, att
     with pytest.raises(ParameterFileError, match=message) as error:
         load(loader)
     assert "\n" not in str(error.value)
+
+
+def test_a_folder_goes_through_describe(tmp_path):
+    """load() takes a loader class, a model name or a Description; a folder given directly is
+    refused naming the way (load(describe(folder))), which gives the model of the same files:
+    its gravity at a posture is the default model's (the folder is its copy), to 1e-12."""
+    import shutil
+
+    import numpy as np
+    import pinocchio as pin
+
+    from phantom_pin import InvalidInputError, describe, load
+    from phantom_pin.config import MODELS
+
+    folder = tmp_path / "mine"
+    shutil.copytree(MODELS["premium_1_5"].config, folder)
+    for bad in (folder, str(folder)):
+        with pytest.raises(InvalidInputError, match=r"load\(describe\(folder\)\)") as error:
+            load(bad)
+        assert error.value.argument == "source"
+    mine, shipped = load(describe(folder)), load("premium_1_5")
+    q = np.array([0.1, 0.4, 0.9])
+    np.testing.assert_allclose(pin.computeGeneralizedGravity(mine.model, mine.data, q),
+                               pin.computeGeneralizedGravity(shipped.model, shipped.data, q), rtol=0, atol=1e-12)

@@ -148,7 +148,7 @@ def test_modified_parameter_file_is_used(tmp_path, states):
     shutil.copytree(CONFIG_DIR, config)
     kinematics = config / "kinematics.yaml"
     kinematics.write_text(kinematics.read_text().replace("l1: 0.215", "l1: 0.2096"))
-    modified = Phantom(config)
+    modified = Phantom.from_folder(config)
     assert modified.config.report.l1 == modified.config.kinematics.l1 == 0.2096
     theta = states[0][:50]
     assert relative_error(modified.inverse_dynamics(*(s[:50] for s in states)),
@@ -235,3 +235,32 @@ def test_inverse_kinematics_behind_the_shoulder_gives_plus_pi_like_the_closed_fo
     for theta in (phantom.inverse_kinematics(target), cf.inverse_kinematics(target, REPORT)):
         assert abs(theta[0] - np.pi) < 1e-12
         np.testing.assert_allclose(theta[1:], [0.2, 0.3], atol=1e-9)
+
+
+def test_one_input_type_per_way_of_making_a_phantom(tmp_path):
+    """Phantom() / Phantom(name) / Phantom(description), and the named constructors for the
+    same and for a folder; a folder given to the plain call is refused naming from_folder. The
+    results compute the same gravity as the closed form of the same configuration (1e-12)."""
+    import shutil
+
+    from phantom_pin import describe
+    from phantom_pin.exceptions import InvalidInputError
+
+    folder = tmp_path / "mine"
+    shutil.copytree(CONFIG_DIR, folder)
+    theta = np.array([0.1, 0.4, 0.9])
+    reference = cf.gravity(theta, REPORT)
+    for phantom in (Phantom(), Phantom("premium_1_5"), Phantom(describe("premium_1_5")),
+                    Phantom.from_model("premium_1_5"), Phantom.from_folder(folder),
+                    Phantom.from_description(describe(folder))):
+        np.testing.assert_allclose(phantom.gravity(theta), reference, rtol=0, atol=1e-12 * np.abs(reference).max())
+    for bad, argument in ((folder, "source"), (str(folder), "source")):
+        with pytest.raises(InvalidInputError, match="Phantom.from_folder") as error:
+            Phantom(bad)
+        assert error.value.argument == argument
+    with pytest.raises(InvalidInputError) as error:
+        Phantom.from_model("nope")
+    assert error.value.argument == "name"
+    with pytest.raises(InvalidInputError) as error:
+        Phantom.from_description("premium_1_5")
+    assert error.value.argument == "description"

@@ -1,5 +1,5 @@
 """The one physical check of a link where it guards: the configuration (so `phantom-pin urdf`,
-describe() and Phantom(folder)), and physical.check_urdf of a URDF given to load()."""
+describe() and Phantom.from_folder(folder)), and physical.check_urdf of a URDF given to load()."""
 
 import shutil
 from pathlib import Path
@@ -51,7 +51,7 @@ def test_phantom_refuses_a_non_physical_configuration(tmp_path, override, messag
     for arg, name in FILES.items():
         (config / name).write_text(yaml.safe_dump(documents[arg]))
     with pytest.raises(ParameterFileError, match=message):
-        Phantom(config)
+        Phantom.from_folder(config)
 
 
 def test_load_refuses_a_non_physical_urdf(tmp_path):

@@ -53,14 +53,14 @@ def test_long_work_reports_its_share_done():
     decreasing."""
     import numpy as np
 
-    from phantom_pin import describe, simulate
+    from phantom_pin import Phantom, describe, simulate
     from phantom_pin.identification import excitation
 
     shares = []
     result = simulate([0.0, 0.3, 0.4], 0.05, progress=shares.append)
     assert len(shares) == len(result.t) + 1 and shares[0] == 0 and shares[-2:] == [50 / 51, 1.0]
     seen = []
-    excitation.optimise(describe(), 5.0, 3, samples=30, iterations=4, restarts=2, progress=seen.append)
+    excitation.optimise(Phantom(describe()), 5.0, 3, samples=30, iterations=4, restarts=2, progress=seen.append)
     for values in (shares, seen):
         assert np.all(np.diff(values) >= 0) and 0 <= values[0] and values[-1] <= 1
     assert len(seen) >= 2

@@ -4,7 +4,6 @@ Phantom stays the rigid body; this class holds the rest, from the same Config.""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import cast
 
 import numpy as np
@@ -22,10 +21,10 @@ class Device:
     """The PHANToM as a device: a Phantom plus its stops, friction, motors, encoders.
 
     ``Device()`` wraps ``Phantom()``; ``Device(phantom)`` wraps a Phantom you built;
-    ``Device(source)`` wraps ``Phantom(source)`` for a model name, a configuration folder
-    or a Description. The device numbers (``config.actuation`` and ``config.limits.stops``)
-    come from the Phantom's own configuration, so the transmission ratios, and hence the
-    currents and the armature, agree.
+    ``Device(source)`` wraps ``Phantom(source)`` for a model name or a Description (a folder
+    of one's own: ``Device(Phantom.from_folder(path))``). The device numbers
+    (``config.actuation`` and ``config.limits.stops``) come from the Phantom's own
+    configuration, so the transmission ratios, and hence the currents and the armature, agree.
 
     Joint vectors are the report's theta1..theta3 (rad), rates rad/s, torques N m at the
     joint, currents A in the motor windings; tip positions and forces are in the report's
@@ -46,11 +45,12 @@ class Device:
     ``ratios`` (3,), or None without public transmission ratios.
     """
 
-    def __init__(self, phantom: Phantom | Description | str | Path | None = None) -> None:
+    def __init__(self, phantom: Phantom | Description | str | None = None) -> None:
         if not isinstance(phantom, Phantom):
-            if phantom is not None and not isinstance(phantom, (Description, str, Path)):
-                raise InvalidInputError(f"expected a phantom_pin.Phantom, a Description, a model name, a "
-                                        f"configuration folder or None, got {phantom!r}", argument="phantom")
+            if phantom is not None and not isinstance(phantom, (Description, str)):
+                raise InvalidInputError(f"expected a phantom_pin.Phantom, a Description, a model name or None, got "
+                                        f"{phantom!r} (a configuration folder: Device(Phantom.from_folder(path)))",
+                                        argument="phantom")
             phantom = Phantom(phantom)
         self.phantom = phantom
         self.config: Config = phantom.config

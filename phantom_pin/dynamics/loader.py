@@ -54,7 +54,7 @@ def gravity_of(config: Config) -> pin.Motion:
     return pin.Motion(np.array([0.0, 0.0, -config.gravity]), np.zeros(3))
 
 
-def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader) -> pin.RobotWrapper:
+def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin.RobotWrapper:
     """The PHANToM as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
     joint1..3 = the report's theta1..3 in rad), with ``visual_model``,
     ``collision_model`` (every pair but the SRDF's disabled ones), the SRDF postures in
@@ -64,12 +64,16 @@ def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader)
 
     ``source`` is a PhantomLoader (sub)class, whose files are read (the default: the
     premium_1_5 model's committed files), a model name (phantom_pin.models(): its committed
-    files), a configuration folder, or a Description (phantom_pin.describe), whose texts are
-    used with PhantomLoader's other attributes.
+    files), or a Description (phantom_pin.describe; a configuration folder of one's own is
+    ``load(describe(folder))``), whose texts are used with PhantomLoader's other attributes.
     The URDF must pass physical.check_urdf. Raises ParameterFileError naming
     ``urdf_path`` or ``srdf_path`` for a missing, malformed or non-physical file.
     """
-    if isinstance(source, (Description, str, Path)):
+    if isinstance(source, Path) or (isinstance(source, str) and source not in MODELS):
+        raise InvalidInputError(f"expected a PhantomLoader class, a model name ({', '.join(MODELS)}) or a "
+                                f"Description, got {source!r}; for a configuration folder use "
+                                "load(describe(folder))", argument="source")
+    if isinstance(source, (Description, str)):
         description = description_of(source, "source")
         loader, urdf, srdf = PhantomLoader, description.urdf, description.srdf  # checked by describe()
         urdf_name, srdf_name = "source: the description's URDF", "source: the description's SRDF"
@@ -98,13 +102,13 @@ def load(source: type[PhantomLoader] | Description | str | Path = PhantomLoader)
     except (RuntimeError, ValueError, AttributeError) as error:  # Pinocchio's, several lines
         label, what = urdf_name.split(": ", 1)
         raise ParameterFileError(f"{label}: Pinocchio cannot load {what} ({_first_line(error)})") from error
-    if isinstance(source, (Description, str, Path)):  # a URDF file of one's own keeps Pinocchio's g
+    if isinstance(source, (Description, str)):  # a URDF file of one's own keeps Pinocchio's g
         model.gravity = gravity_of(description.config)
     robot = pin.RobotWrapper(model, *geometry)
     try:
         pin.loadReferenceConfigurationsFromXML(robot.model, srdf, False)
         if loader.has_rotor_parameters and (
-                not isinstance(source, (Description, str, Path)) or description.config.actuation.motor is not None):
+                not isinstance(source, (Description, str)) or description.config.actuation.motor is not None):
             load_rotor_parameters(robot.model, srdf)  # a model without public motor data has none
         robot.collision_model.addAllCollisionPairs()
         pin.removeCollisionPairsFromXML(robot.model, robot.collision_model, srdf, False)

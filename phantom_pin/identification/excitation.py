@@ -94,7 +94,7 @@ def _check_arguments(**values: float) -> None:
         raise InvalidInputError(f"torque_share: expected a share in (0, 1], got {values['torque_share']!r}")
 
 
-def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int = 5,  # noqa: C901 (closures of one problem)
+def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,  # noqa: C901 (closures of one problem)
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
              progress: Callable[[float], None] | None = None,
@@ -112,8 +112,8 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
     ``times`` (s, the file's samples; default: the same points), stepping back towards the
     start until the stops' margin and the torque share hold there too, and its condition
     numbers, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
-    called with the share of the SLSQP iterations done. ``model``: the Phantom (or its
-    Description, then loaded once more into Pinocchio) whose configuration is excited."""
+    called with the share of the SLSQP iterations done. ``model``: the Phantom whose
+    configuration is excited."""
     _check_arguments(period=period, harmonics=harmonics, samples=samples, margin=margin, torque_share=torque_share,
                      restarts=restarts, iterations=iterations, seed=seed, amplitude_weight=amplitude_weight)
     if progress is not None and not callable(progress):
@@ -122,9 +122,10 @@ def optimise(model: Phantom | Description, period: float = 5.0, harmonics: int =
         times = np.asarray(times, dtype=float)
         if times.ndim != 1 or not len(times) or not np.isfinite(times).all():
             raise InvalidInputError("times: expected a non-empty 1-D array of finite times (s)")
-    if not isinstance(model, (Phantom, Description)):
-        raise InvalidInputError(f"model: expected a phantom_pin.Phantom or Description, got {model!r}")
-    phantom = model if isinstance(model, Phantom) else Phantom(model)
+    if not isinstance(model, Phantom):
+        raise InvalidInputError(f"expected a phantom_pin.Phantom (Phantom(description) for a Description), got "
+                                f"{model!r}", argument="model")
+    phantom = model
     description = phantom.description
     limits = description.config.limits
     effort = continuous_effort(description)
