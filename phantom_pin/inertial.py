@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
+from typing import Protocol
 
 import numpy as np
 
@@ -94,7 +95,10 @@ def without_point_mass(body: Inertial, mass: float, point: tuple[float, float, f
     rest = m - mass
     com = (m * c - mass * p) / rest
     at_com = origin - _point(rest, com)
-    return Inertial(rest, vector3(float(v) for v in com),
+    # a coordinate that neither the body's centre nor the point leaves is the body's, as given
+    # (its type too: xacro prints an integer zero as 0, so generated files stay as they were)
+    kept = (given if given == 0 and p[k] == 0 else float(com[k]) for k, given in enumerate(body.com))
+    return Inertial(rest, vector3(kept),
                     tensor6(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
 
 
@@ -124,3 +128,45 @@ def problem(inertial: Inertial) -> str | None:
         return (f"principal moments of inertia at the centre of mass {listed} kg m^2 break the "
                 f"triangle inequality (a + b - c must be at least {TRIANGLE_SLACK:g} c)")
     return None
+
+
+class Lengths(Protocol):
+    """What the carving needs of the arm's lengths (m): l1 (the upper arm) and l3 (the crank)."""
+
+    @property
+    def l1(self) -> float: ...
+
+    @property
+    def l3(self) -> float: ...
+
+
+def carve(bodies: Mapping[str, Inertial], pin: Inertial, lengths: Lengths) -> dict[str, Inertial]:
+    """The seven links of the URDF (config.types.LINKS) of the mechanism's five rigid bodies
+    (config.types.BODIES) and a hinge pin (mass at its pivot, inertia about it; ``lengths``:
+    l1 and l3, m): the pin's mass at its pivot out of crank_link (0, 0, -l3) and
+    lower_bar_link (l1, 0, 0), the two pins' vertical moment out of turret_link; ``uncarve``
+    is its inverse."""
+    turret = bodies["turret_link"]
+    return {
+        "turret_link": Inertial(turret.mass, turret.com, (*turret.inertia[:5], turret.inertia[5] - 2 * pin.inertia[5])),
+        "upper_arm_link": bodies["upper_arm_link"],
+        "crank_link": without_point_mass(bodies["crank_link"], pin.mass, (0.0, 0.0, -lengths.l3)),
+        "crank_pin_link": pin,
+        "lower_bar_link": without_point_mass(bodies["lower_bar_link"], pin.mass, (lengths.l1, 0.0, 0.0)),
+        "forearm_pin_link": pin,
+        "forearm_link": bodies["forearm_link"],
+    }
+
+
+def uncarve(links: Mapping[str, Inertial], lengths: Lengths) -> dict[str, Inertial]:
+    """The five bodies (BODIES) of seven links: ``carve`` undone (a point mass taken out with a
+    negative mass is put back), for a model in the report's form as for one in full."""
+    pin = links["crank_pin_link"]
+    turret = links["turret_link"]
+    return {
+        "turret_link": Inertial(turret.mass, turret.com, (*turret.inertia[:5], turret.inertia[5] + 2 * pin.inertia[5])),
+        "upper_arm_link": links["upper_arm_link"],
+        "crank_link": without_point_mass(links["crank_link"], -pin.mass, (0.0, 0.0, -lengths.l3)),
+        "lower_bar_link": without_point_mass(links["lower_bar_link"], -pin.mass, (lengths.l1, 0.0, 0.0)),
+        "forearm_link": links["forearm_link"],
+    }

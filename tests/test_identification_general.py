@@ -17,10 +17,9 @@ from helpers import CONFIG
 from phantom_pin import Device, describe
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides
-from phantom_pin.config.bodies import uncarve
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.identification import io, simulation
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, uncarve
 
 #: Per body: factor on mass and inertia, centre of mass offset (m), products xy, xz, yz (kg m^2).
 CHANGES = {

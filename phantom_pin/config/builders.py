@@ -9,7 +9,6 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import cast
 
-from phantom_pin.config.bodies import carve, uncarve
 from phantom_pin.config.reader import TIMESTEP_RANGE, Reader
 from phantom_pin.config.types import (
     BODIES,
@@ -31,7 +30,7 @@ from phantom_pin.config.types import (
     Stops,
     freeze,
 )
-from phantom_pin.inertial import INERTIA_KEYS, Vector3, problem, tensor6, vector3
+from phantom_pin.inertial import INERTIA_KEYS, Vector3, carve, problem, tensor6, uncarve, vector3
 from phantom_pin.report.parameters import ReportParameters, Unprinted
 from phantom_pin.report.parameters import links as report_links
 

@@ -25,7 +25,6 @@ import dataclasses
 
 import numpy as np
 
-from phantom_pin.config.bodies import carve, uncarve
 from phantom_pin.config.types import BODIES
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
@@ -33,7 +32,7 @@ from phantom_pin.identification import constants, parameterization, physical
 from phantom_pin.identification.base import base_parameters, sample, words
 from phantom_pin.identification.cache import cached
 from phantom_pin.identification.regressor import INERTIAL_NAMES, Regressor
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem
+from phantom_pin.inertial import INERTIA_KEYS, Inertial, carve, problem, uncarve
 
 FRICTION = constants.FRICTION_NAMES
 #: The unit of each standard parameter (INERTIAL_NAMES order).

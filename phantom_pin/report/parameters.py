@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from phantom_pin.inertial import Inertial
+from phantom_pin.inertial import Inertial, carve
 
 
 @dataclasses.dataclass(frozen=True)
@@ -88,26 +88,20 @@ def links(p: ReportParameters, unprinted: Unprinted, rotor_inertia: float,
     Each hinge pin (mass and inertia at its pivot) is taken out of its neighbours: its mass
     at the pivot out of crank_link (the crank pin, l3 below the shoulder) and lower_bar_link
     (the forearm pin, at l1 along the bar), its vertical moment out of turret_link, so that
-    the 3-DoF dynamics stay the report's exactly. The arithmetic is that of the xacro that
-    generated the shipped URDF before links were described in full, operation for operation,
-    so that its numbers are unchanged to the last bit.
+    the 3-DoF dynamics stay the report's exactly: inertial.carve, the one carving (for a model
+    in full too), whose numbers are those of the xacro that generated the shipped URDF before
+    links were described in full, to the last bit (tests/test_description.py).
     """
     l1, l2, l3 = p.l1, p.l2, p.l3
-    pin_mass, (pin_xx, pin_yy, pin_zz) = unprinted.pin_mass, unprinted.pin_inertia
-    pin = _at_com(pin_mass, (0, 0, 0), pin_xx, pin_yy, pin_zz)
-    return {
+    pin_xx, pin_yy, pin_zz = unprinted.pin_inertia
+    bodies = {  # the five bodies as the report gives them, the rotors in the armature
         "turret_link": _at_com(unprinted.base_mass, (0, 0, 0), unprinted.base_inertia_zz,
-                               unprinted.base_inertia_xx,
-                               p.Ibaseyy - rotor_inertia * ratios[0]**2 - 2 * pin_zz),
+                               unprinted.base_inertia_xx, p.Ibaseyy - rotor_inertia * ratios[0]**2),
         "upper_arm_link": _about_origin(p.mbe, p.l5, 0, 0, p.Ibezz, p.Ibexx - rotor_inertia * ratios[1]**2,
                                         p.Ibeyy),
-        "crank_link": _about_origin(p.mdf - pin_mass, 0, 0, (p.mdf * p.l6 + pin_mass * l3) / (p.mdf - pin_mass),
-                                    p.Idfzz - pin_mass * l3**2,
-                                    p.Idfxx - rotor_inertia * ratios[2]**2 - pin_mass * l3**2, p.Idfyy),
-        "crank_pin_link": pin,
-        "lower_bar_link": _about_origin(p.mc - pin_mass, (p.mc * l1 / 2 - pin_mass * l1) / (p.mc - pin_mass), 0, 0,
-                                        p.Iczz, p.Icxx + p.mc * l1**2 / 4 - pin_mass * l1**2,
-                                        p.Icyy + p.mc * l1**2 / 4 - pin_mass * l1**2),
-        "forearm_pin_link": pin,
+        "crank_link": _about_origin(p.mdf, 0, 0, p.l6, p.Idfzz, p.Idfxx - rotor_inertia * ratios[2]**2, p.Idfyy),
+        "lower_bar_link": _about_origin(p.mc, l1 / 2, 0, 0, p.Iczz, p.Icxx + p.mc * l1**2 / 4,
+                                        p.Icyy + p.mc * l1**2 / 4),
         "forearm_link": _at_com(p.ma, (0, 0, l3 - l2 / 2), p.Iazz, p.Iaxx, p.Iayy),
     }
+    return carve(bodies, _at_com(unprinted.pin_mass, (0, 0, 0), pin_xx, pin_yy, pin_zz), p)
