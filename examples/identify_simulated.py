@@ -18,7 +18,7 @@ import numpy as np
 import common
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.identification import estimate, optimise, simulation
-from phantom_pin.identification.overlay import overlay
+from phantom_pin.identification.overlays import overlay
 
 #: The simulated device's friction (N m s/rad, N m) and torque noise (N m, 1 sigma).
 VISCOUS, COULOMB, NOISE = 6e-4, 0.012, 0.002

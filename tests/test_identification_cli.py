@@ -6,11 +6,11 @@ import pytest
 import yaml
 
 from helpers import CONFIG, CONFIG_DIR, REPORT
-from phantom_pin import closed_form, describe
+from phantom_pin import Phantom, closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.identification import io
 from phantom_pin.identification.excitation import continuous_effort
-from phantom_pin.identification.overlay import friction_overlay
+from phantom_pin.identification.overlays import friction_overlay
 
 DESCRIPTION = describe()
 EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
@@ -126,7 +126,7 @@ def test_excitation_respects_a_tight_torque_limit():
     from phantom_pin.identification import excitation
     from phantom_pin.report import closed_form
 
-    result = excitation.optimise(DESCRIPTION, torque_share=0.2, iterations=10, restarts=1)
+    result = excitation.optimise(Phantom(DESCRIPTION), torque_share=0.2, iterations=10, restarts=1)
     t = np.linspace(0, result.trajectory.period, 2001)
     theta, dtheta, ddtheta = result.trajectory(t)
     tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + 5e-4 * dtheta + 0.01 * np.sign(dtheta)
@@ -202,7 +202,8 @@ def test_the_excitation_holds_its_bounds_at_every_written_sample():
     from phantom_pin.identification import constants, excitation
 
     times = np.arange(5000) / 1000.0
-    result = excitation.optimise(DESCRIPTION, 5.0, 5, samples=12, iterations=40, restarts=1, seed=3, times=times)
+    result = excitation.optimise(Phantom(DESCRIPTION), 5.0, 5, samples=12, iterations=40, restarts=1, seed=3,
+                                 times=times)
     states = result.trajectory(times)
     torque = constants.regressor(*states, DESCRIPTION) @ constants.nominal(DESCRIPTION)
     assert CONFIG.limits.slack(states[0]).min() >= 0.05 - 1e-9
@@ -215,7 +216,7 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     rotors, friction, stops, saturation) -> identify (the general structure): the written
     overlay's mass matrix and gravity are the report's closed form within 0.5 % of their
     largest entries at 200 postures, and its friction the shipped law's within 1 %."""
-    from phantom_pin import Phantom, closed_form
+    from phantom_pin import closed_form
     from phantom_pin.config import read_overrides
     from phantom_pin.config.sampling import sample_postures
 

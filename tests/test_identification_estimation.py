@@ -150,8 +150,8 @@ def test_a_log_of_phantom_pins_own_simulator_gives_the_true_constants():
 def test_identify_writes_nothing_when_the_overlay_is_not_physical(tmp_path, capsys, monkeypatch):
     """The overlay is checked (describe() and its physical check of every link) before it is
     written: here that check refuses it, and no file appears."""
-    from phantom_pin.cli import identification
     from phantom_pin.exceptions import ParameterFileError
+    from phantom_pin.identification import overlays
 
     def refuse(*args, **kwargs):
         raise ParameterFileError("link forearm_link: mass must be positive (kg), got -1.0")
@@ -159,7 +159,7 @@ def test_identify_writes_nothing_when_the_overlay_is_not_physical(tmp_path, caps
     path = tmp_path / "log.csv"
     data = log()
     io.write_log(path, data.t, data.theta, data.tau)
-    monkeypatch.setattr(identification, "describe", refuse)
+    monkeypatch.setattr(overlays, "describe", refuse)
     assert main(["identify", str(path), "-o", str(tmp_path / "id.yaml"), "--torque-timing", "sampled",
                  "--structure", "report"]) == 2
     err = capsys.readouterr().err

@@ -12,11 +12,10 @@ import numpy as np
 from phantom_pin import drivers
 from phantom_pin.cli.common import description, overrides
 from phantom_pin.config import DEFAULT
-from phantom_pin.description.build import describe
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import estimation, excitation, io
-from phantom_pin.identification.overlay import overlay, write_overlay
+from phantom_pin.identification.overlays import overlay, write_overlay
 from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
@@ -165,11 +164,7 @@ def identify_command(args: argparse.Namespace) -> int:
     if fit.problems and not args.accept:
         more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
         raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--accept writes it anyway)")
-    keys, notes = overlay(fit, given, phantom.config)
-    try:  # the overlay must give a physical URDF (phantom_pin.description.physical.check_urdf)
-        describe(phantom.config.folder, overrides=keys)
-    except PhantomPinError as error:
-        raise PhantomPinError(f"identified parameters not physically valid: {error}") from None
+    keys, notes = overlay(fit, given, phantom.config)  # checked: a physical model, or nothing written
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
           f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g}")
     print("residual RMS per joint [N m]: " + ", ".join(
@@ -192,7 +187,7 @@ def identify_command(args: argparse.Namespace) -> int:
         print(note)
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
-    write_overlay(args.output, fit, args.log.name, given, phantom.config)
+    write_overlay(args.output, fit, args.log.name, keys, notes)
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
     print(f"wrote {args.output} (phantom-pin {chosen}urdf --params {args.output} -o my_phantom.urdf)")

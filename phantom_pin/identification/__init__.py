@@ -12,7 +12,7 @@ from phantom_pin.identification.base import base_parameters
 from phantom_pin.identification.estimation import Fit, estimate
 from phantom_pin.identification.excitation import Excitation, optimise
 from phantom_pin.identification.io import Log, read_log, read_trajectory, write_log
-from phantom_pin.identification.overlay import overlay, write_overlay
+from phantom_pin.identification.overlays import overlay, write_overlay
 from phantom_pin.identification.regressor import Regressor
 from phantom_pin.identification.simulation import track
 

@@ -89,7 +89,7 @@ class Fit:
     parameters, ``torque_rms`` the torque's RMS (N m); ``condition`` of the base regressor
     (columns scaled to unit norm); ``samples`` used; ``x``: the physical parameters
     (Structure.names: the structure's, then viscous1..3 N m s/rad, coulomb1..3 N m),
-    ``written`` = their beta, ``overrides`` their --params keys (without friction: overlay.overlay);
+    ``written`` = their beta, ``overrides`` their --params keys (without friction: overlays.overlay);
     ``comparison``: (name, residual RMS per joint, N m) of the other structure, or None;
     ``torque_scale`` (3,): the factors each joint's logged torque fits best with (joint 1's
     is 1), ``scaled_rms``: the residual with them; ``problems``: why the result should not be

@@ -123,8 +123,8 @@ def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,  # noqa: C
         if times.ndim != 1 or not len(times) or not np.isfinite(times).all():
             raise InvalidInputError("times: expected a non-empty 1-D array of finite times (s)")
     if not isinstance(model, Phantom):
-        raise InvalidInputError(f"expected a phantom_pin.Phantom (Phantom(description) for a Description), got "
-                                f"{model!r}", argument="model")
+        raise InvalidInputError(f"expected a phantom_pin.Phantom (Phantom(description) for a Description), got a "
+                                f"{type(model).__name__}", argument="model")
     phantom = model
     description = phantom.description
     limits = description.config.limits

@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin.config import MODEL_KEY, MODELS, REPORT_SEGMENTS, Config, section
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.description.build import describe
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
 from phantom_pin.identification.estimation import Fit
 
 
@@ -24,7 +25,7 @@ def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2)
     return mean if ok.all() else None
 
 
-def overlay(fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
+def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
     """The --params keys of an identification (estimation.Fit) on a model with the overrides
     ``given`` (those of the bodies it identified dropped: the segments and links), and the
     comment lines that explain its friction: one value per law, the joints' inverse-variance
@@ -33,7 +34,9 @@ def overlay(fit, given: dict | None = None, config: Config | None = None) -> tup
 
     With the ``config`` identified on, the keys carry what the fit is only valid with: its
     lengths l1, l2, l3 (m) and, for a named model, ``model`` (its name), which
-    phantom_pin.config.read checks against the model the keys are applied to."""
+    phantom_pin.config.read checks against the model the keys are applied to; and they are
+    checked to give a physical model of that configuration (describe() and its physical check
+    of every link): ParameterFileError otherwise, before anything is written."""
     if not isinstance(fit, Fit):
         raise InvalidInputError(f"fit: expected a phantom_pin.identification.Fit (estimate), got {fit!r}")
     if given is not None and not isinstance(given, dict):
@@ -58,14 +61,18 @@ def overlay(fit, given: dict | None = None, config: Config | None = None) -> tup
             keys[f"actuation.friction.{kind}"] = common
             notes.append(f"friction.{kind} per joint: {listed}; written {common:.4g}, the inverse-variance mean "
                          "of the physical values (0 or more)")
+    if config is not None:  # the overlay must give a physical URDF (description.physical.check_urdf)
+        try:
+            describe(config.folder, overrides=keys)
+        except PhantomPinError as error:
+            raise ParameterFileError(f"identified parameters not physically valid: {error}") from None
     return keys, notes
 
 
-def write_overlay(path: Path | str, fit, source: str, given: dict | None = None,
-                  config: Config | None = None) -> None:
-    """Write an identification (estimation.Fit) as a --params YAML file (dotted keys, SI units),
-    with the model's other overrides ``given`` and what ``config`` fixes (see ``overlay``)."""
-    keys, notes = overlay(fit, given, config)
+def write_overlay(path: Path | str, fit: Fit, source: str, keys: dict[str, object], notes: list[str]) -> None:
+    """Write an identification (estimation.Fit) as a --params YAML file (dotted keys, SI units):
+    the ``keys`` and ``notes`` that ``overlay`` gave, with the fit in comments; ``source``
+    names the log."""
     lines = [f"# Identified by phantom-pin identify from {source} ({fit.structure} structure): a --params",
              "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
              "# (docs/identification.md). SI units.",
