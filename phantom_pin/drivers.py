@@ -24,16 +24,29 @@ ROS ``joint_states`` (``joint_state_*``): the drivers publish waist = -angle1 = 
 shoulder = angle2 = theta2, elbow = angle3 - angle2 = theta3 - theta2 (fsuarez6/phantom_omni
 omni_common/src/omni_state.cpp lines 182-193 and 296-300; jhu-saw/sawSensablePhantom
 core/components/code/mtsSensableHD.cpp lines 417-419, ``q[0] = -q[0]; q[2] -= q[1]``;
-bgromov/sensable_phantom src/phantom_node.cpp lines 319-320), names optionally prefixed
-(their gimbal joints yaw, pitch, roll are not the report's and are ignored). The map is linear,
-so joint velocities convert as positions do. The drivers' efforts follow no common rule
+bgromov/sensable_phantom src/phantom_node.cpp lines 319-320), names optionally prefixed. The
+gimbal's yaw, pitch, roll are OpenHaptics' raw HD_CURRENT_GIMBAL_ANGLES g1..g3 (rad) in the
+Touch-era drivers (GIMBAL_CONVENTIONS["raw"]: jhu-saw/sawSensablePhantom since commit 69776dd,
+"Removing strange offsets on gimbal joints added to compensate for issues with old Omni";
+kinisi-robotics/phantom_touch_ros2 2bf5b20; CalaW/touch_ros2_control e1e181e), which are the
+model's joint4..joint6 (Phantom.stylus_pose). The fsuarez6/phantom_omni lineage (and its
+forks) publishes yaw = pi - g1, pitch = -g2 - 3 pi / 4, roll = -g3 - pi (omni_state.cpp lines
+188-193), tuned for the old FireWire Omni: GIMBAL_CONVENTIONS["omni_firewire"], a per-device
+convention to choose, not the default. The maps are affine, so joint velocities convert as
+positions do, without the offsets (``rates=True``). The drivers' efforts follow no common rule
 (sawSensablePhantom publishes OpenHaptics' raw joint torques): convert those with
 ``openhaptics_torque_to_tau``.
+
+HD_CURRENT_TRANSFORM (``pose_from_openhaptics_transform``): the 16 numbers of the stylus's
+column-major 4x4 transform, translation in mm, in OpenHaptics' axes, which are frame s's (its
+origin OpenHaptics' own: Ubitrack's formula puts it at the zero posture's tip, as frame s).
 
 Arrays: one vector (3,) or a batch (N, 3), as the rest of phantom_pin.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -42,6 +55,16 @@ from phantom_pin.validation import as_states, finite_result
 
 #: The names of the drivers' joint_states for theta1..theta3 (without prefix).
 JOINT_STATE_NAMES = ("waist", "shoulder", "elbow")
+#: The names of the drivers' joint_states for the stylus gimbal (without prefix).
+GIMBAL_STATE_NAMES = ("yaw", "pitch", "roll")
+#: How a driver publishes the gimbal: name -> (signs, offsets (rad)), published = sign * g +
+#: offset, g OpenHaptics' raw HD_CURRENT_GIMBAL_ANGLES (the module's doc gives the sources).
+GIMBAL_CONVENTIONS = {
+    "raw": ((1.0, 1.0, 1.0), (0.0, 0.0, 0.0)),
+    "omni_firewire": ((-1.0, -1.0, -1.0), (math.pi, -3 * math.pi / 4, -math.pi)),
+}
+#: m per mm (HD_CURRENT_TRANSFORM's and HD_CURRENT_POSITION's unit).
+METRE_PER_MM = 1e-3
 #: OpenHaptics' angle i = SIGN[i] * theta_i; its joint torque (mN m) = SIGN[i] * tau_i * 1000.
 _SIGN = np.array([-1.0, 1.0, 1.0])
 #: mN m per N m (HD_CURRENT_JOINT_TORQUE's unit).
@@ -82,21 +105,88 @@ def _prefix(prefix: object) -> str:
     return prefix
 
 
-def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:
-    """The report's theta (rad) of a driver's joint_states: ``names`` (sequence of str, as in
-    sensor_msgs/JointState, each joint of JOINT_STATE_NAMES with ``prefix`` exactly once;
-    others, such as the gimbal's, are ignored) and ``position`` (rad, one value per name, or
-    (N, len(names)) for a batch): theta = (waist, shoulder, shoulder + elbow). Velocities
-    (rad/s) convert the same way."""
+def _names(names: object, wanted: list[str]) -> list[str]:
+    """``names`` checked to be a sequence of str holding each of ``wanted`` exactly once."""
     if isinstance(names, str) or not all(isinstance(n, str) for n in np.asarray(names, dtype=object).ravel()):
         raise InvalidInputError(f"expected a sequence of joint names, got {names!r}", argument="names")
     given: list[str] = list(names)  # type: ignore[call-overload]  # checked above: an iterable of str
-    wanted = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
     missing = [name for name in wanted if given.count(name) != 1]
     if missing:
         raise InvalidInputError(f"must hold each of {', '.join(wanted)} exactly once; "
                                 f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not, in {given}",
                                 argument="names")
+    return given
+
+
+def _convention(convention: object) -> tuple[np.ndarray, np.ndarray]:
+    if not isinstance(convention, str) or convention not in GIMBAL_CONVENTIONS:
+        raise InvalidInputError(f"expected one of {', '.join(GIMBAL_CONVENTIONS)}, got {convention!r}",
+                                argument="convention")
+    signs, offsets = GIMBAL_CONVENTIONS[convention]
+    return np.array(signs), np.array(offsets)
+
+
+def gimbal_from_joint_state(names: object, position: object, prefix: str = "", convention: str = "raw",
+                            rates: bool = False) -> np.ndarray:
+    """OpenHaptics' raw gimbal angles g1..g3 (rad; the model's joint4..joint6) of a driver's
+    joint_states: ``names`` holding each of GIMBAL_STATE_NAMES with ``prefix`` once, ``position``
+    (rad) as theta_from_joint_state's; ``convention``: GIMBAL_CONVENTIONS' name of the driver's
+    (default "raw", the Touch-era drivers'). ``rates``: convert velocities (rad/s), without
+    the offsets."""
+    signs, offsets = _convention(convention)
+    given = _names(names, [_prefix(prefix) + name for name in GIMBAL_STATE_NAMES])
+    values, _ = as_states(position, "position", width=len(given))
+    published = np.stack([values[..., given.index(prefix + name)] for name in GIMBAL_STATE_NAMES], axis=-1)
+    with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result, naming position
+        return finite_result((published - (0 if rates else offsets)) * signs, "position")
+
+
+def joint_state_from_gimbal(gimbal: object, prefix: str = "", convention: str = "raw",
+                            rates: bool = False) -> tuple[list[str], np.ndarray]:
+    """(names, position) of the drivers' gimbal joint_states (GIMBAL_STATE_NAMES with
+    ``prefix``) for OpenHaptics' raw gimbal angles ``gimbal`` (rad), (3,) or (N, 3), in the
+    driver's ``convention``; ``rates``: velocities (rad/s), without the offsets."""
+    signs, offsets = _convention(convention)
+    g, _ = as_states(gimbal, "gimbal")
+    names = [_prefix(prefix) + name for name in GIMBAL_STATE_NAMES]
+    with np.errstate(over="ignore", invalid="ignore"):
+        return names, finite_result(signs * g + (0 if rates else offsets), "gimbal")
+
+
+def pose_from_openhaptics_transform(transform: object) -> np.ndarray:
+    """The stylus's pose (4, 4) in frame s (m) of OpenHaptics' HD_CURRENT_TRANSFORM: 16 numbers,
+    column-major, translation in mm (or (N, 16) for a batch); its rotation must be proper (a
+    rotation to 1e-6), else InvalidInputError naming ``transform``."""
+    flat, _ = as_states(transform, "transform", width=16)
+    pose = np.swapaxes(flat.reshape(flat.shape[:-1] + (4, 4)), -1, -2).copy()
+    rotation = pose[..., :3, :3]
+    if (not np.allclose(rotation @ np.swapaxes(rotation, -1, -2), np.eye(3), atol=1e-6)
+            or not np.allclose(np.linalg.det(rotation), 1.0, atol=1e-6)
+            or not np.allclose(pose[..., 3, :], [0, 0, 0, 1], atol=1e-12)):
+        raise InvalidInputError("is not a rigid transform (a rotation and a translation, column-major, "
+                                "last row 0 0 0 1)", argument="transform")
+    pose[..., :3, 3] *= METRE_PER_MM
+    return pose
+
+
+def openhaptics_transform_from_pose(pose: object) -> np.ndarray:
+    """HD_CURRENT_TRANSFORM's 16 numbers (column-major, mm) of a pose (4, 4) in frame s (m),
+    e.g. Phantom.stylus_pose's; (N, 16) of (N, 4, 4)."""
+    p = np.array(pose, dtype=float)
+    if p.shape[-2:] != (4, 4) or not np.isfinite(p).all():
+        raise InvalidInputError(f"expected finite 4x4 poses, got shape {p.shape}", argument="pose")
+    p[..., :3, 3] /= METRE_PER_MM
+    return np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,))
+
+
+def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:
+    """The report's theta (rad) of a driver's joint_states: ``names`` (sequence of str, as in
+    sensor_msgs/JointState, each joint of JOINT_STATE_NAMES with ``prefix`` exactly once;
+    others, such as the gimbal's (gimbal_from_joint_state), are ignored) and ``position`` (rad,
+    one value per name, or (N, len(names)) for a batch): theta = (waist, shoulder, shoulder +
+    elbow). Velocities (rad/s) convert the same way."""
+    wanted = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
+    given = _names(names, wanted)
     values, _ = as_states(position, "position", width=len(given))
     waist, shoulder, elbow = (values[..., given.index(name)] for name in wanted)
     with np.errstate(over="ignore"):  # reported by finite_result, naming position

@@ -44,7 +44,9 @@ def test_plain_xacro_of_every_model_passes_check_urdf(name, prefix, tmp_path):
     assert "Successfully Parsed XML" in result.stdout
     assert f"root Link: {prefix}base_link has 3 child(ren)" in result.stdout
     children = [line.split(":", 1)[1].strip() for line in result.stdout.splitlines() if "child(" in line]
-    assert len(children) == 12 and all(child.startswith(prefix) for child in children), children
+    # a stylus gimbal (gimbal.yaml) adds yaw_link, pitch_link, stylus_link and the stylus frames
+    gimbal = (model.config / "gimbal.yaml").exists()
+    assert len(children) == 12 + 5 * gimbal and all(child.startswith(prefix) for child in children), children
     assert {child[len(prefix):] for child in children} >= {"turret_link", "forearm_link", "tip", "report_s"}
 
 
@@ -70,17 +72,23 @@ def test_every_scene_steps_one_second_under_random_control_without_a_warning(nam
 def test_load_gives_the_three_report_joints_the_frames_and_the_srdf_postures(name):
     robot = load(name)
     limits = yaml.safe_load((MODELS[name].config / "joint_limits.yaml").read_text())
-    assert (robot.model.nq, robot.model.nv) == (3, 3)
+    gimbal_file = MODELS[name].config / "gimbal.yaml"
+    # a stylus gimbal's passive joints follow theta (the Touch's): its ranges are gimbal.yaml's
+    gimbal = yaml.safe_load(gimbal_file.read_text())["joints"] if gimbal_file.exists() else {}
+    limits.update(gimbal)
+    assert (robot.model.nq, robot.model.nv) == (3 + len(gimbal), 3 + len(gimbal))
     assert list(robot.model.names) == ["universe", "joint1", "joint2", "joint3",  # then the mimic joints
-                                       "crank_pin_a", "crank_pin_b", "forearm_pin_a", "forearm_pin_b"]
-    for frame in ("base_link", "report_s", "report_dynamics", "tip", "elbow"):
+                                       "crank_pin_a", "crank_pin_b", "forearm_pin_a", "forearm_pin_b", *gimbal]
+    stylus = ("stylus", "stylus_tip") if gimbal else ()
+    for frame in ("base_link", "report_s", "report_dynamics", "tip", "elbow", *stylus):
         assert robot.model.existFrame(frame), frame
-    for joint, lower, upper in zip(("joint1", "joint2", "joint3"), robot.model.lowerPositionLimit,
+    for joint, lower, upper in zip(("joint1", "joint2", "joint3", *gimbal), robot.model.lowerPositionLimit,
                                    robot.model.upperPositionLimit):
         assert (lower, upper) == (limits[joint]["lower"], limits[joint]["upper"])
+    rest = [0.0] * len(gimbal)  # the SRDF's postures set the arm: the gimbal stays at its zero
     for posture, theta in limits["postures"].items():
-        np.testing.assert_array_equal(robot.model.referenceConfigurations[posture], theta)
-    np.testing.assert_array_equal(robot.q0, limits["postures"]["resting"])
+        np.testing.assert_array_equal(robot.model.referenceConfigurations[posture], [*theta, *rest])
+    np.testing.assert_array_equal(robot.q0, [*limits["postures"]["resting"], *rest])
 
 
 @pytest.mark.parametrize("name", models())
@@ -95,7 +103,7 @@ def test_every_tip_follows_eq10_with_its_own_lengths(name):
     thetas = sample_postures(config.read(name).limits, 500, np.random.default_rng(3), draws=2000)
     assert len(thetas) == 500
     for theta in thetas:
-        pin.framesForwardKinematics(robot.model, data, theta)
+        pin.framesForwardKinematics(robot.model, data, np.concatenate([theta, np.zeros(robot.model.nq - 3)]))
         tip = data.oMf[robot.model.getFrameId("tip")]
         s = data.oMf[robot.model.getFrameId("report_s")]
         position = (s.actInv(tip)).translation

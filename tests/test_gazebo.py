@@ -74,7 +74,8 @@ def test_every_link_survives_with_its_mass_inertia_and_centre_of_mass(probe, nam
                                       *(float(i[k]) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")),
                                       *(float(v) for v in inertial.find("origin").get("xyz").split())]
         assert inertial.find("origin").get("rpy") == "0 0 0"
-    assert len(expected) == 8 and set(report["links"]) == set(expected)
+    gimbal = (MODELS[name].config / "gimbal.yaml").exists()  # yaw_link, pitch_link, stylus_link kept
+    assert len(expected) == 8 + 3 * gimbal and set(report["links"]) == set(expected)
     for link, values in expected.items():
         np.testing.assert_allclose(report["links"][link], values, rtol=1e-15, atol=0, err_msg=link)
 
@@ -93,7 +94,8 @@ def test_every_joint_survives_with_its_axis_limits_and_dynamics(probe, name):
     urdf = ET.parse(MODELS[name].urdf).getroot()
     report = parse(probe, MODELS[name].urdf)
     revolute = [j for j in urdf.findall("joint") if j.get("type") == "revolute"]
-    assert len(revolute) == 7 and set(report["joints"]) == {j.get("name") for j in revolute}
+    gimbal = (MODELS[name].config / "gimbal.yaml").exists()  # joint4..joint6
+    assert len(revolute) == 7 + 3 * gimbal and set(report["joints"]) == {j.get("name") for j in revolute}
     for joint in revolute:
         kind, parent, child, numbers = report["joints"][joint.get("name")]
         assert (kind, parent, child) == (REVOLUTE, joint.find("parent").get("link"), joint.find("child").get("link"))
@@ -115,7 +117,7 @@ def test_sdformat_12_drops_the_mimic_tags_and_the_massless_frames(probe, name):
     assert len(re.findall(r"<mimic ", text)) == 4
     report = parse(probe, MODELS[name].urdf)
     assert report["mimic"] == 0 and report["frames"] == {}
-    assert not {"tip", "report_s", "report_dynamics", "elbow"} & set(report["links"])
+    assert not {"tip", "report_s", "report_dynamics", "elbow", "stylus", "stylus_tip"} & set(report["links"])
 
 
 def test_without_the_housing_gazebo_drops_the_whole_arm(probe, tmp_path):
@@ -140,5 +142,5 @@ def test_a_world_link_around_the_macro_fixes_the_arm_to_gazebos_world(probe, tmp
     fixed = tmp_path / "fixed.urdf"
     ET.ElementTree(root).write(fixed)
     report = parse(probe, fixed)
-    assert report["errors"] == [] and len(report["links"]) == 8
+    assert report["errors"] == [] and len(report["links"]) == 8 + 3  # the Touch's gimbal links too
     assert report["joints"]["world_joint"][:3] == (3, "world", "base_link")

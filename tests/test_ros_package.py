@@ -83,14 +83,22 @@ def test_launch_file_shows_each_committed_robot(monkeypatch):
     spec = importlib.util.spec_from_file_location("display_launch", DESCRIPTION_DIR / "launch" / "display.launch.py")
     launch = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(launch)
-    argument, opaque = launch.generate_launch_description()
-    committed = sorted(p.stem for p in (DESCRIPTION_DIR / "urdf").glob("*.urdf"))
+    argument, convention, gui, opaque = launch.generate_launch_description()
+    committed = sorted(p.stem for p in (DESCRIPTION_DIR / "urdf").glob("*.urdf") if not p.stem.endswith("_driver"))
     assert sorted(argument.choices) == committed == sorted(m.urdf.stem for m in MODELS.values())
     for robot in [argument.default_value, *argument.choices]:
-        publisher, gui, rviz = opaque.function({"robot": robot})
-        assert publisher.package == "robot_state_publisher"
+        publisher, gui_node, rviz = opaque.function({"robot": robot, "convention": "report", "gui": "true"})
+        assert publisher.package == "robot_state_publisher" and gui_node.package == "joint_state_publisher_gui"
         assert publisher.parameters == [{"robot_description": (DESCRIPTION_DIR / "urdf" / f"{robot}.urdf").read_text()}]
     assert argument.default_value == "phantom_1_5"
+    # the Touch in the drivers' convention, its joint_states from a running driver (no GUI)
+    assert convention.choices == ["report", "driver"] and gui.default_value == "true"
+    publisher, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false"})
+    assert publisher.parameters == [{"robot_description": (DESCRIPTION_DIR / "urdf" /
+                                                           "phantom_touch_driver.urdf").read_text()}]
+    assert rviz.package == "rviz2"
+    with pytest.raises(RuntimeError, match="convention:=driver: no phantom_1_5_driver.urdf"):
+        opaque.function({"robot": "phantom_1_5", "convention": "driver", "gui": "true"})
 
 
 @pytest.mark.colcon
@@ -131,3 +139,10 @@ def test_colcon_builds_and_installs_the_package_and_xacro_reproduces_the_urdfs(t
         assert result.returncode == 0, result.stderr
         assert ET.canonicalize(result.stdout, strip_text=True) == \
             ET.canonicalize(model.urdf.read_text(), strip_text=True), model.name
+    # the Touch in the drivers' convention, from the installed top-level file
+    top = share / "urdf" / MODELS["touch"].urdf_xacro.name
+    result = subprocess.run([str(xacro), str(top), "convention:=driver"], capture_output=True, text=True,
+                            cwd=top.parent)
+    assert result.returncode == 0, result.stderr
+    assert ET.canonicalize(result.stdout, strip_text=True) == \
+        ET.canonicalize((share / "urdf" / "phantom_touch_driver.urdf").read_text(), strip_text=True)

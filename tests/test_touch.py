@@ -15,6 +15,7 @@ import pytest
 import yaml
 import yourdfpy
 
+from gimbal_reference import gimbal_gravity, gimbal_mass_matrix
 from phantom_pin import (
     Device,
     MissingDataError,
@@ -32,6 +33,18 @@ from phantom_pin.config.sampling import sample_postures
 from phantom_pin.identification import io, simulation
 from phantom_pin.identification import parameterization as pz
 from touch_reference import REFERENCE
+
+#: config/touch/gimbal.yaml's locked_at: the gimbal angles (rad) the arm's dynamics hold it at
+LOCKED = np.array(yaml.safe_load((MODELS["touch"].config / "gimbal.yaml").read_text())["locked_at"], float)
+
+
+def stylus_mass(theta: np.ndarray) -> np.ndarray:
+    """The locked stylus gimbal's share of M (gimbal_reference) at each of theta (N, 3)."""
+    return np.array([gimbal_mass_matrix(t, LOCKED) for t in theta])
+
+
+def stylus_gravity(theta: np.ndarray) -> np.ndarray:
+    return np.array([gimbal_gravity(t, LOCKED) for t in theta])
 
 FOLDER = MODELS["touch"].config
 MAX_FORCE = 3.3          # N, CHAI3D 3.3.0 src/devices/CPhantomDevices.cpp, "Touch"
@@ -81,8 +94,11 @@ def test_the_touch_is_the_reports_arm_at_its_size():
     assert (kinematics.l1, kinematics.l2) == (L1, L2)
     theta = sample_postures(phantom.config.limits, 200, np.random.default_rng(5), draws=800)
     report = phantom.config.report
-    np.testing.assert_allclose(phantom.mass_matrix(theta), closed_form.mass_matrix(theta, report), rtol=1e-12)
-    np.testing.assert_allclose(phantom.gravity(theta), closed_form.gravity(theta, report), rtol=1e-12, atol=1e-15)
+    # the report's arm (eqs 81-85, 93-94) carrying the stylus gimbal held at locked_at
+    np.testing.assert_allclose(phantom.mass_matrix(theta), closed_form.mass_matrix(theta, report) + stylus_mass(theta),
+                               rtol=1e-12, atol=1e-15)  # exact zeros against the reference's 1e-19 rounding
+    np.testing.assert_allclose(phantom.gravity(theta), closed_form.gravity(theta, report) + stylus_gravity(theta),
+                               rtol=1e-12, atol=1e-15)
     np.testing.assert_array_equal(phantom.model.armature, np.zeros(3))  # no public rotor data
 
 
@@ -189,8 +205,8 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     device = Device(describe("touch", overrides={**pz.overrides(x, estimate), "actuation.friction.viscous": VISCOUS,
                                                  "actuation.friction.coulomb": COULOMB}))
     log = simulation.track(device, t, theta, dtheta, tau, torque_noise=TORQUE_NOISE, quantization=False, seed=1)
-    np.testing.assert_allclose(closed_form.mass_matrix(theta[::500], truth), device.phantom.mass_matrix(theta[::500]),
-                               rtol=0, atol=1e-12)                      # the device is the truth
+    np.testing.assert_allclose(closed_form.mass_matrix(theta[::500], truth) + stylus_mass(theta[::500]),
+                               device.phantom.mass_matrix(theta[::500]), rtol=0, atol=1e-12)  # the device is the truth
     io.write_csv(tmp_path / "log.csv", io.LOG_COLUMNS,
                  np.column_stack([log.t, drivers.openhaptics_from_theta(log.theta),
                                   drivers.openhaptics_torque_from_tau(log.tau)]))
@@ -203,16 +219,19 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     rng = np.random.default_rng(21)
     theta = sample_postures(estimate.limits, 300, rng, draws=1200)
     dtheta, ddtheta = rng.uniform(-2, 2, theta.shape), rng.uniform(-20, 20, theta.shape)
-    truth_tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, truth)
+    stylus = Phantom("touch").inverse_dynamics(theta, dtheta, ddtheta) - closed_form.inverse_dynamics(
+        theta, dtheta, ddtheta, estimate.report)  # the locked stylus's share, the same on every device here
+    truth_tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, truth) + stylus
 
     def error(tau):
         return float(np.sqrt(((tau - truth_tau) ** 2).mean()) / np.sqrt((truth_tau ** 2).mean()))
-    before, after = error(closed_form.inverse_dynamics(theta, dtheta, ddtheta, estimate.report)), \
+    before, after = error(closed_form.inverse_dynamics(theta, dtheta, ddtheta, estimate.report) + stylus), \
         error(identified.inverse_dynamics(theta, dtheta, ddtheta))
     print(f"held-out: estimate {before:.4f}, identified {after:.4f}; friction "
           f"{identified.config.actuation.friction.viscous / VISCOUS - 1:+.3f}, "
           f"{identified.config.actuation.friction.coulomb / COULOMB - 1:+.3f}")
-    assert before > 0.1 and after < 0.01, (before, after)
+    # the estimate misses by 5.5 % (the stylus, the same on both, carries much of the torque)
+    assert before > 0.04 and after < 0.01, (before, after)
     assert identified.config.actuation.friction.viscous == pytest.approx(VISCOUS, rel=0.05)
     assert identified.config.actuation.friction.coulomb == pytest.approx(COULOMB, rel=0.05)
 
@@ -240,8 +259,8 @@ def test_the_command_line_serves_the_touch(capsys, tmp_path):
     masses = {name: link.inertial for name, link in urdf.link_map.items()
               if link.inertial is not None and name != "base_link"}  # the fixed housing's V is constant
 
-    def energy(q):
-        urdf.update_cfg(q)
+    def energy(q):  # the stylus gimbal at its zero, locked_at
+        urdf.update_cfg(dict(zip(("joint1", "joint2", "joint3"), q)))
         return 9.80665 * sum(i.mass * (urdf.get_transform(name) @ i.origin)[2, 3] for name, i in masses.items())
     h = 1e-6
     gradient = [(energy(theta + h * e) - energy(theta - h * e)) / (2 * h) for e in np.eye(3)]
@@ -282,7 +301,8 @@ def test_a_touch_trajectory_in_openhaptics_terms_is_tracked_and_identified(tmp_p
     estimate = describe("touch").config.report
     identified = Phantom(describe("touch", overrides=read_overrides(overlay)))
     theta = sample_postures(config.read("touch").limits, 200, np.random.default_rng(3), draws=800)
-    mass, gravity = closed_form.mass_matrix(theta, estimate), closed_form.gravity(theta, estimate)
+    mass = closed_form.mass_matrix(theta, estimate) + stylus_mass(theta)
+    gravity = closed_form.gravity(theta, estimate) + stylus_gravity(theta)
     assert np.abs(identified.mass_matrix(theta) - mass).max() < 2e-2 * np.abs(mass).max()
     assert np.abs(identified.gravity(theta) - gravity).max() < 2e-2 * np.abs(gravity).max()
     capsys.readouterr()

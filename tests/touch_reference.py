@@ -99,3 +99,31 @@ REFERENCE = {segment: {key: (None if value is None else
 if __name__ == "__main__":
     for segment, entry in REFERENCE.items():
         print(segment, entry)
+
+
+# -- the stylus gimbal (config/touch/gimbal.yaml) ---------------------------------------------
+# Its solids, transcribed from that file's comments, ABS of 1050 kg/m^3, in the report's axes
+# at g = 0 (x: the pitch axis, y: the yaw axis, z: the stylus, towards the user), about the
+# gimbal centre:
+#     yaw_link: a box 60 (x) by 17 (y) by 12 (z) mm, centred
+#     pitch_link: a cube of 17.4 mm, centred
+#     stylus_link: a solid cylinder of diameter 11.8 mm on z, from z = -39 mm (the tip) to +91 mm
+#
+#     GIMBAL_REFERENCE: {link: {"mass": kg, "first": [3] kg m, "second": {xx, yy, zz} kg m^2}}
+# (second moments about the gimbal centre; the products vanish by symmetry).
+
+ABS = sp.Rational(1050, 2700)  # the integrators' density is aluminium's; everything scales with it
+
+
+def _gimbal() -> dict[str, tuple]:
+    side = sp.Rational(174, 10) * MM
+    bodies = {"yaw_link": _box(60 * MM, 12 * MM, -sp.Rational(17, 2) * MM, sp.Rational(17, 2) * MM),
+              "pitch_link": _box(side, side, -side / 2, side / 2),
+              "stylus_link": _cylinder(sp.Rational(59, 10) * MM, 0, -39 * MM, 91 * MM, "z")}
+    return {name: (mass * ABS, [f * ABS for f in first], {k: v * ABS for k, v in second.items()})
+            for name, (mass, first, second) in bodies.items()}
+
+
+GIMBAL_REFERENCE = {name: {"mass": float(mass), "first": [float(f) for f in first],
+                           "second": {k: float(v) for k, v in second.items()}}
+                    for name, (mass, first, second) in _gimbal().items()}

@@ -9,13 +9,12 @@ import webbrowser
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
 from phantom_pin import verification
 from phantom_pin.cli import device
 from phantom_pin.cli.common import description, output, overrides, phantom, positive_integer, show, vector, warn_limits
 from phantom_pin.config import DEFAULT, MODELS
-from phantom_pin.description.build import links_yaml
+from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -32,15 +31,10 @@ def info(args: argparse.Namespace) -> int:
                "velocity": float(model.velocityLimit[i - 1]), "effort": float(model.effortLimit[i - 1]),
                "armature": float(model.armature[i - 1]),
                "ratio": None if actuation.ratios is None else actuation.ratios[i - 1]} for i in (1, 2, 3)]
-    tree = robot.coupling.tree
-    body: dict[int, str] = {}
-    for frame in tree.frames:  # the first body frame of a joint is its link
-        if frame.type == pin.FrameType.BODY:
-            body.setdefault(frame.parentJoint, frame.name)
-    links = [{"name": body[i], "mass": tree.inertias[i].mass,
-              "com": tree.inertias[i].lever.tolist(),
-              "inertia": [tree.inertias[i].inertia[j, k] for j, k in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))]}
-             for i in range(1, tree.njoints) if tree.inertias[i].mass > 0]
+    gimbal = robot.config.gimbal
+    every = {**robot.config.links, **(gimbal.links if gimbal else {})}  # the URDF's links, as configured
+    links: list[dict[str, Any]] = [{"name": name, "mass": float(link.mass), "com": [float(c) for c in link.com],
+                                    "inertia": [float(i) for i in link.inertia]} for name, link in every.items()]
     data: dict[str, Any] = {"model": robot.config.name, "joints": joints, "links": links,
             "rotor_inertia": None if actuation.motor is None else actuation.motor.rotor_inertia}
     lines = ["joint    lower[rad] upper[rad] vel[rad/s] effort[Nm] armature[kg m2] ratio"]
@@ -53,6 +47,16 @@ def info(args: argparse.Namespace) -> int:
               f"{vector(lk['inertia'], '{:.3e}')}" for lk in links]
     lines += ["", "rotor inertia: not public (no armature; the links carry the rotors)" if actuation.motor is None
               else f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
+    if gimbal is not None:
+        data["gimbal"] = {"joints": list(robot.gimbal_joints), "lower": list(gimbal.lower),
+                          "upper": list(gimbal.upper), "tip_offset": gimbal.tip_offset,
+                          "locked_at": list(gimbal.locked_at)}
+        ranges = ", ".join(f"{j} {lo:.3f}..{hi:.3f}"
+                           for j, lo, hi in zip(robot.gimbal_joints, gimbal.lower, gimbal.upper))
+        lines += ["", f"stylus gimbal (passive; OpenHaptics' raw gimbal angles) [rad]: {ranges}; tip "
+                      f"{gimbal.tip_offset} m along the stylus's -z; the arm's dynamics hold it at "
+                      f"{list(gimbal.locked_at)} rad",
+                  f"  source: {robot.config.sources['gimbal']}"]
     count = len(given)
     data["overrides"] = count
     lines.insert(0, f"model {robot.config.name}" + (f", with {count} overridden number(s) (--params/--set)"
@@ -125,6 +129,11 @@ def write(args: argparse.Namespace) -> int:
     robot_file = target.name if scene is None else os.path.relpath(target.resolve(), scene.resolve().parent)
     made = description(args, prefix=args.prefix, robot_file=robot_file)
     robot = (made.model or MODELS[DEFAULT]).robot_name
+    if args.kind == "urdf" and args.convention == "driver":
+        target.write_text(driver_urdf(made.config.folder if made.model is None else made.config.name,
+                                      prefix=args.prefix, overrides=overrides(args)))
+        print(f"wrote {target}")
+        return 0
     texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
     target.write_text(texts[args.kind])
     print(f"wrote {target}")
@@ -146,7 +155,7 @@ def show_command(args: argparse.Namespace) -> int:
     with Viewer(robot) as viewer:
         if args.tip_force is not None:
             viewer.set_force(args.tip_force)
-        viewer.show(robot.q0 if args.theta is None else args.theta)
+        viewer.show(robot.q0[:3] if args.theta is None else args.theta, args.gimbal)
         if args.html is not None:
             print(f"wrote {viewer.export_html(args.html, force=args.force)}")
             return 0
@@ -197,6 +206,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         command.add_argument("--prefix", default="")
         command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
         command.set_defaults(kind=kind, run=write)
+        if kind == "urdf":
+            command.add_argument("--convention", choices=CONVENTIONS, default="report",
+                                 help="joint names: report (joint1..3 = theta, the default) or driver "
+                                      "(the ROS drivers' waist, shoulder, elbow = theta3 - theta2, yaw, pitch, roll)")
         if kind == "mjcf":
             command.add_argument("--scene", help="also write a scene (floor, light, table) that "
                                                  "includes the MJCF of --output (same folder)")
@@ -204,6 +217,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--theta", metavar="T", help="posture (rad; default: the SRDF's resting)", **THREE)
     command.add_argument("--tip-force", metavar="F", help="force on the tip (N, frame s), drawn as an arrow",
                          **THREE)
+    command.add_argument("--gimbal", metavar="G", help="a stylus gimbal's angles (rad, OpenHaptics' raw "
+                                                       "gimbal angles; the Touch; default 0)", **THREE)
     command.add_argument("--html", help="write a self-contained HTML file instead of serving")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     command.add_argument("--open", action="store_true", help="open the live viewer in a browser")

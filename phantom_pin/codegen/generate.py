@@ -23,6 +23,7 @@ from typing import Any
 
 from phantom_pin.config import MODELS
 from phantom_pin.description.build import Description, describe, description_of
+from phantom_pin.description.gimbal import locked
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
 
 try:
@@ -176,7 +177,9 @@ class _Model:
     """The URDF's tree with its constants as SymPy matrices, for the symbolic passes."""
 
     def __init__(self, description: Description) -> None:
-        self.root, self.joints, links = _read_urdf(description.urdf, description.prefix)
+        gimbal = description.config.gimbal  # a stylus gimbal: held at locked_at, as Phantom holds it
+        urdf = description.urdf if gimbal is None else locked(description.urdf, description.prefix, gimbal.locked_at)
+        self.root, self.joints, links = _read_urdf(urdf, description.prefix)
         self.gravity = _num(description.config.gravity)
         self.armature = [_num(a) for a in description.config.actuation.armature]
         self.links = {}

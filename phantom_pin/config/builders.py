@@ -4,14 +4,18 @@ checked Reader into its typed dataclass, then every link through the one physica
 from __future__ import annotations
 
 import dataclasses
+import math
 import types
 from collections.abc import Mapping
 from pathlib import Path
 from typing import cast
 
+from phantom_pin.config.files import OPTIONAL
 from phantom_pin.config.reader import TIMESTEP_RANGE, Reader
 from phantom_pin.config.types import (
     BODIES,
+    GIMBAL_JOINTS,
+    GIMBAL_LINKS,
     INTEGRATORS,
     JOINTS,
     POSTURES,
@@ -21,6 +25,7 @@ from phantom_pin.config.types import (
     CoupledStops,
     Encoder,
     Friction,
+    Gimbal,
     Inertial,
     Kinematics,
     Limits,
@@ -36,7 +41,7 @@ from phantom_pin.report.parameters import links as report_links
 
 #: The ``sources`` entries each file must have (a non-empty text per section).
 SOURCES = {"actuation_file": ("transmission_ratio", "motor", "encoder", "friction"),
-           "joint_limits_file": ("stops",)}
+           "joint_limits_file": ("stops",), "gimbal_file": ("gimbal",)}
 
 
 def _kinematics(r: Reader) -> Kinematics:
@@ -168,7 +173,53 @@ def _mujoco(r: Reader) -> MujocoSettings:
 
 
 def _sources(r: Reader) -> dict[str, str]:
-    return {section: r.text(arg, "sources", section) for arg, sections in SOURCES.items() for section in sections}
+    return {section: r.text(arg, "sources", section) for arg, sections in SOURCES.items() for section in sections
+            if r.documents[arg] or arg not in OPTIONAL}
+
+
+def _gimbal(r: Reader) -> Gimbal | None:
+    """The stylus gimbal of gimbal.yaml (None without the file): its joints' ranges, and its three
+    links computed from the stated solids (ABS of ``density``), in the URDF link frames
+    (parallel to base_link at the zero configuration: a report vector (x, y, z) is (z, x, y)).
+
+    yaw_link, a box of size (a, b, c) along the report's (x, y, z), centred on the gimbal
+    centre: m = rho a b c, inertia about the centre m (b^2 + c^2) / 12 about x ... ; pitch_link,
+    a cube of side s: m = rho s^3, m s^2 / 6 about every axis; stylus_link, a solid cylinder of
+    diameter d and length L on the report's z from z = -tip_offset: m = rho pi d^2 L / 4, its
+    centre of mass at z = L / 2 - tip_offset, m d^2 / 8 about its axis, m (3 d^2 / 4 + L^2) / 12
+    across."""
+    arg = "gimbal_file"
+    if not r.documents[arg]:
+        return None
+    ranges = [r.interval(arg, ("joints",), j) for j in GIMBAL_JOINTS]
+    rho = r.number(arg, "density", positive=True)
+    a, b, c = r.vector(arg, "yoke", "size", length=3)
+    if min(a, b, c) <= 0:
+        raise r.error(arg, f"yoke.size must be positive, got {[a, b, c]!r}")
+    side = r.number(arg, "pitch_block", "size", positive=True)
+    diameter = r.number(arg, "stylus", "diameter", positive=True)
+    length = r.number(arg, "stylus", "length", positive=True)
+    tip = r.number(arg, "tip_offset", non_negative=True)
+    yoke = rho * a * b * c
+    block = rho * side**3
+    stylus = rho * math.pi * diameter**2 * length / 4
+    across = stylus * (3 * diameter**2 / 4 + length**2) / 12
+    links = {  # report (x, y, z) -> link frame (z, x, y): xx of the link is zz of the report
+        "yaw_link": Inertial(yoke, (0, 0, 0), (yoke * (a * a + b * b) / 12, 0, 0,
+                                                yoke * (c * c + b * b) / 12, 0, yoke * (c * c + a * a) / 12)),
+        "pitch_link": Inertial(block, (0, 0, 0), (block * side**2 / 6, 0, 0, block * side**2 / 6, 0,
+                                                  block * side**2 / 6)),
+        "stylus_link": Inertial(stylus, (length / 2 - tip, 0, 0), (stylus * diameter**2 / 8, 0, 0, across, 0, across)),
+    }
+    assert tuple(links) == GIMBAL_LINKS
+    locked = r.vector(arg, "locked_at", length=3)
+    for joint, angle, (lo, hi) in zip(GIMBAL_JOINTS, locked, ranges):
+        if not lo <= angle <= hi:
+            raise r.error(arg, f"locked_at: {joint} at {angle!r} rad is outside its range {lo!r} .. {hi!r}")
+    geometry = {key: r.node(arg, key) for key in ("yoke", "pitch_block", "stylus")}
+    return Gimbal(vector3(lo for lo, _ in ranges), vector3(hi for _, hi in ranges),
+                  r.number(arg, "velocity_limit", positive=True), tip, vector3(locked),
+                  types.MappingProxyType(links), cast(Mapping[str, object], freeze(geometry)))
 
 
 def _report(r: Reader, kinematics: Kinematics,
@@ -274,7 +325,7 @@ def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool)
     return Config(name, folder, overridden, kinematics, r.number("physical_parameters_file", "gravity", positive=True),
                   types.MappingProxyType(links), _housing(r), report, unprinted, actuation, _limits(r), _mujoco(r),
                   cast(Mapping[str, object], freeze(documents["visual_parameters_file"])),
-                  types.MappingProxyType(_sources(r)))
+                  types.MappingProxyType(_sources(r)), _gimbal(r))
 
 
 #: The keys of the report's form that feed each link, for error messages.

@@ -24,7 +24,11 @@ FILES = {
     "joint_limits_file": "joint_limits.yaml",
     "visual_parameters_file": "visual_parameters.yaml",
     "mjcf_file": "mjcf.yaml",
+    "gimbal_file": "gimbal.yaml",
 }
+#: The files a configuration may leave out (read as an empty mapping): a model without a
+#: public stylus gimbal has no gimbal.yaml.
+OPTIONAL = ("gimbal_file",)
 
 
 class _Loader(yaml.SafeLoader):
@@ -67,8 +71,10 @@ def is_number(value: object) -> bool:
 
 
 def read_documents(folder: Path) -> dict[str, dict]:
-    """Each parameter file of ``folder`` read once: its mapping by xacro argument name."""
-    return {arg: read_yaml(folder / name) for arg, name in FILES.items()}
+    """Each parameter file of ``folder`` read once: its mapping by xacro argument name (an
+    empty mapping for an OPTIONAL file the folder does not have)."""
+    return {arg: {} if arg in OPTIONAL and not (folder / name).exists() else read_yaml(folder / name)
+            for arg, name in FILES.items()}
 
 
 def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) -> dict[str, dict]:

@@ -26,6 +26,10 @@ LINKS = ("turret_link", "upper_arm_link", "crank_link", "crank_pin_link", "lower
          "forearm_pin_link", "forearm_link")
 #: The mechanism's five rigid bodies (the report's G, BE, DF, C, A): the links but the hinge pins.
 BODIES = ("turret_link", "upper_arm_link", "crank_link", "lower_bar_link", "forearm_link")
+#: The stylus gimbal's joints, the raw OpenHaptics gimbal angles g1..g3 (yaw, pitch, roll), and
+#: the links they carry (config/<model>/gimbal.yaml, where a model's gimbal is public).
+GIMBAL_JOINTS = ("joint4", "joint5", "joint6")
+GIMBAL_LINKS = ("yaw_link", "pitch_link", "stylus_link")
 #: The stop coordinates as linear maps of theta (rows): theta1, theta2, theta3, theta2 - theta3.
 STOP_COORDINATES = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, -1.0]])
 STOP_COORDINATES.flags.writeable = False
@@ -209,6 +213,28 @@ class Limits:
 
 
 @dataclasses.dataclass(frozen=True)
+class Gimbal:
+    """The stylus gimbal (gimbal.yaml): three passive revolute joints (GIMBAL_JOINTS) whose
+    axes meet at the arm's tip (eq. 10), their angles OpenHaptics' raw HD_CURRENT_GIMBAL_ANGLES
+    g1..g3 (rad): the stylus's rotation in frame s is Ry(theta1) Rx(-theta3) Ry(g1) Rx(-g2)
+    Rz(-g3) (report axes: x left, y up, z towards the user). ``lower``/``upper``: the joints'
+    ranges (rad); ``velocity``: their URDF speed limit (rad/s); ``tip_offset``: the stylus tip's
+    distance from the gimbal centre along the stylus's -z (m); ``locked_at``: the gimbal angles
+    (rad) at which the arm's 3-DoF dynamics (Phantom, simulate, Device, the identification) carry
+    the gimbal and stylus as a rigid load; ``links``: GIMBAL_LINKS in full (URDF link frames,
+    parallel to base_link at the zero configuration; kg, m, kg m^2); ``geometry``: the solids
+    those links are computed from and drawn as (read-only YAML data, m)."""
+
+    lower: tuple[float, float, float]
+    upper: tuple[float, float, float]
+    velocity: float
+    tip_offset: float
+    locked_at: tuple[float, float, float]
+    links: Mapping[str, Inertial]
+    geometry: Mapping[str, object]
+
+
+@dataclasses.dataclass(frozen=True)
 class Scene:
     """scene.xml's picture (m): the shoulder above the table top, the stand's radius, the
     table's size (x, y, z) and centre ahead of the shoulder, the floor below the table top."""
@@ -271,7 +297,8 @@ class Config:
     in the report's terms (else None: closed_form does not apply), and ``unprinted``, what
     its links need beyond them (report.parameters.Unprinted, or None); ``actuation``,
     ``limits`` (box and stops), ``mujoco``, ``visual`` (the primitive geometry, read-only
-    YAML data), ``sources`` (section -> where its numbers come from).
+    YAML data), ``sources`` (section -> where its numbers come from), ``gimbal``: the stylus
+    gimbal (Gimbal) where the model has a public one (the Touch), else None.
     """
 
     name: str
@@ -288,3 +315,4 @@ class Config:
     mujoco: MujocoSettings
     visual: Mapping[str, object]
     sources: Mapping[str, str]
+    gimbal: Gimbal | None = None

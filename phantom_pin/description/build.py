@@ -7,6 +7,7 @@ import dataclasses
 import functools
 import tempfile
 import xml.dom.minidom
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import cast
 
@@ -15,7 +16,7 @@ import yaml
 
 from phantom_pin import config as configuration
 from phantom_pin.config import Config, Model
-from phantom_pin.config.types import JOINTS, thaw
+from phantom_pin.config.types import GIMBAL_JOINTS, JOINTS, thaw
 from phantom_pin.description.mjcf import mjcf_texts
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
@@ -51,7 +52,7 @@ def links_yaml(config: Config, robot: str = "phantom_1_5") -> str:
     """The YAML text of ``config.links`` and of base_link's ``config.housing`` (links_file of
     the xacro), with its header. Numbers
     keep their type, so that xacro prints an exact zero given as an integer as ``0``."""
-    every = {"base_link": config.housing, **config.links}
+    every = {"base_link": config.housing, **config.links, **(config.gimbal.links if config.gimbal else {})}
     document = {"links": {name: {"mass": link.mass, "com": list(link.com),
                                  "inertia": dict(zip(INERTIA_KEYS, link.inertia))}
                           for name, link in every.items()}}
@@ -71,9 +72,15 @@ def _xacro_inputs(config: Config, folder: Path) -> dict[str, str]:
             "joint_torque_limit": dict(zip(JOINTS, a.effort)),
             "joint_velocity_limit": dict(zip(JOINTS, a.velocity))},
         "joint_limits_file": {**{j: {"lower": lo, "upper": hi} for j, lo, hi in zip(JOINTS, lim.lower, lim.upper)},
-                              "postures": {name: list(theta) for name, theta in lim.postures.items()}},
+                              "postures": {name: list(theta) for name, theta in lim.postures.items()},
+                              "stops": dataclasses.asdict(lim.stops.coupled)},
         "visual_parameters_file": thaw(config.visual),
     }
+    if config.gimbal is not None:
+        g = config.gimbal
+        documents["gimbal_file"] = {
+            "joints": {j: {"lower": lo, "upper": hi} for j, lo, hi in zip(GIMBAL_JOINTS, g.lower, g.upper)},
+            "velocity_limit": g.velocity, "tip_offset": g.tip_offset, **cast(dict, thaw(g.geometry))}
     paths = {}
     for arg, document in documents.items():
         paths[arg] = folder / f"{arg}.yaml"
@@ -112,6 +119,25 @@ def _model(config: Config) -> Model:
     return configuration.MODELS.get(config.name, configuration.MODELS[configuration.DEFAULT])
 
 
+def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | None,
+              convention: str = "report") -> tuple[Config, Model, str, str]:
+    """(config, model, URDF, SRDF) of a model name or folder: each file read once, xacro run on
+    the checked Config (``convention`` passed to the URDF's top-level xacro unless the report's)."""
+    if not isinstance(prefix, str):
+        raise InvalidInputError(f"prefix: expected a string, got {prefix!r}")
+    config = configuration.read(source, overrides)
+    model = _model(config)
+    arguments = {"prefix": prefix, **({} if convention == "report" else {"convention": convention})}
+    with tempfile.TemporaryDirectory() as folder:
+        inputs = _xacro_inputs(config, Path(folder))
+        urdf = _process(model.urdf_xacro, {**arguments, **inputs})
+        srdf = _process(model.srdf_xacro, {"name": model.robot_name, "prefix": prefix,
+                                           "actuation_file": inputs["actuation_file"],
+                                           "joint_limits_file": inputs["joint_limits_file"]})
+    check_urdf(urdf, "the generated URDF")
+    return config, model, urdf, srdf
+
+
 def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
              overrides: dict[str, object] | None = None, robot_file: str | None = None) -> Description:
     """The Description of a model name (phantom_pin.models()) or a configuration folder,
@@ -124,20 +150,30 @@ def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
     ``robot_file``: the name under which the scene includes the robot MJCF (default: the
     model's). InvalidInputError naming ``model`` or ``prefix`` for a bad argument.
     """
-    if not isinstance(prefix, str):
-        raise InvalidInputError(f"prefix: expected a string, got {prefix!r}")
-    config = configuration.read(source, overrides)
-    model = _model(config)
-    with tempfile.TemporaryDirectory() as folder:
-        inputs = _xacro_inputs(config, Path(folder))
-        urdf = _process(model.urdf_xacro, {"prefix": prefix, **inputs})
-        srdf = _process(model.srdf_xacro, {"name": model.robot_name, "prefix": prefix,
-                                           "actuation_file": inputs["actuation_file"],
-                                           "joint_limits_file": inputs["joint_limits_file"]})
-    check_urdf(urdf, "the generated URDF")
+    config, model, urdf, srdf = _generate(source, prefix, overrides)
     robot_file = model.mjcf.name if robot_file is None else robot_file
     mjcf, scene = mjcf_texts(urdf, srdf, config, prefix, robot_file, model.robot_name)
     return Description(config, configuration.MODELS.get(config.name), prefix, urdf, srdf, mjcf, scene, robot_file)
+
+
+#: The joint conventions the macro writes: the report's (joint1..joint3 = theta, joint4..joint6
+#: the raw gimbal angles) and the ROS drivers' (waist, shoulder, elbow = theta3 - theta2, yaw,
+#: pitch, roll; phantom_pin.drivers), for their joint_states in robot_state_publisher.
+CONVENTIONS = ("report", "driver")
+
+
+def driver_urdf(source: str | Path, *, prefix: str = "",
+                overrides: dict[str, object] | None = None) -> str:
+    """The URDF of a model name or configuration folder in the drivers' convention
+    (CONVENTIONS): the same links, inertials, frames and limits as describe()'s, jointed so that
+    a driver's joint_states move it unchanged (urdf/phantom_macro.xacro). For the tools that
+    take joint_states by name (robot_state_publisher, RViz, MoveIt); phantom_pin computes on
+    describe()'s URDF."""
+    config, model, urdf, _ = _generate(source, prefix, overrides, "driver")
+    if ET.fromstring(urdf).find(f"joint[@name='{prefix}waist']") is None:  # its top-level xacro has no convention
+        raise InvalidInputError(f"the drivers' convention is written for the Touch (model touch), whose drivers "
+                                f"publish it; {config.name} has none", argument="model")
+    return urdf
 
 
 @functools.cache

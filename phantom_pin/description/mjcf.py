@@ -5,6 +5,9 @@ joints and frames; the MJCF adds what the URDF cannot say in MuJoCo's terms:
 
 - the four mimic couplings of the parallelogram as ``<equality><joint>`` with the solver
   settings of config/mjcf.yaml (MuJoCo enforces them softly);
+- a stylus gimbal (the Touch's joint4..joint6, passive: no motor) held at the configuration's
+  ``gimbal.locked_at`` by one ``<equality><joint>`` each (named ``<joint>_lock``), as the arm's
+  dynamics in phantom_pin hold it; deactivate them (``model.eq_active0``) to let it swing;
 - the rotors' reflected inertia as joint ``armature`` (rotor_inertia * ratio^2, kg m^2);
 - one ``<motor>`` per actuated joint: gear = transmission ratio, so that the control is
   the motor-shaft torque (N m) and its range is the motor's max. continuous torque; without
@@ -29,6 +32,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from phantom_pin.config import Config, Scene
+from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.mimic import read_mimic_tags
 from phantom_pin.exceptions import ParameterFileError
 
@@ -235,6 +239,13 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
             "joint1": mimic.joint, "joint2": mimic.primary,
             "polycoef": _vec([mimic.offset, mimic.multiplier, 0, 0, 0]),
             "solref": solref, "solimp": _vec(settings.equality_solimp)})
+
+    if config.gimbal is not None:  # the passive gimbal held where phantom_pin's dynamics hold it
+        for gimbal_joint, angle in zip(GIMBAL_JOINTS, config.gimbal.locked_at):
+            ET.SubElement(equality, "joint", {
+                "name": f"{prefix}{gimbal_joint}_lock", "joint1": f"{prefix}{gimbal_joint}",
+                "polycoef": _vec([angle, 0, 0, 0, 0]),
+                "solref": solref, "solimp": _vec(settings.equality_solimp)})
 
     actuator = ET.SubElement(mujoco, "actuator")
     motor = config.actuation.motor

@@ -50,6 +50,9 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     gear = model.actuator_gear[actuators, 0].copy()
     low, high = model.actuator_ctrlrange[actuators, 0], model.actuator_ctrlrange[actuators, 1]
     data.qpos[qpos] = coupling.configuration(theta)
+    gimbal = description.config.gimbal
+    if gimbal is not None:  # its equalities hold it there (description.mjcf)
+        data.qpos[[model.joint(name).qposadr[0] for name in device.phantom.gimbal_joints]] = gimbal.locked_at
     data.qvel[dofs] = coupling.tangent(velocity)
     out_theta, out_dtheta = np.empty((samples, 3)), np.empty((samples, 3))
     commanded, applied = np.zeros((samples, 3)), np.zeros((samples, 3))

@@ -13,7 +13,9 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.config import MODELS, Config
+from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, description_of
+from phantom_pin.description.gimbal import locked
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.loader import gravity_of, load_rotor_parameters
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
@@ -99,6 +101,20 @@ def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Calla
     return method
 
 
+def _rooted_at(source: pin.Model, world_to_s: pin.SE3) -> pin.Model:
+    """A copy of ``source`` expressed in frame s: every placement on the world, joints' and
+    frames', premultiplied by ``world_to_s`` (gravity rotated alike)."""
+    model = source.copy()
+    for jid in range(1, model.njoints):
+        if model.parents[jid] == 0:
+            model.jointPlacements[jid] = world_to_s * model.jointPlacements[jid]
+    for frame in model.frames:
+        if frame.parentJoint == 0:
+            frame.placement = world_to_s * frame.placement
+    model.gravity = world_to_s.act(model.gravity)
+    return model
+
+
 class Phantom:
     """The PHANToM in the report's coordinates, computed by Pinocchio.
 
@@ -116,11 +132,19 @@ class Phantom:
     z forward); the tool frame t is ``tip``. Every method takes one state, shape (3,),
     or a batch, shape (N, 3), and returns fresh arrays.
 
+    The stylus gimbal (a model with one: the Touch, ``config.gimbal``): its joints
+    ``gimbal_joints`` (the URDF's joint4..joint6) are passive and their angles g, shape (3,)
+    or (N, 3), are OpenHaptics' raw gimbal angles (rad). The arm's dynamics (every method of
+    theta alone) carry the gimbal and stylus as a rigid load held at ``config.gimbal.locked_at``
+    (gravity(theta, gimbal) takes other angles); stylus_pose, stylus_tip_pose and
+    stylus_jacobian use all six angles.
+
     Attributes: ``description`` (the Description it was built from), ``config`` (its
     typed configuration), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's
-    rotor inertias times ratio^2), ``data``, ``coupling`` (the mimic-free tree model and
-    the coupling matrix read from the URDF's mimic tags), ``threads`` (OpenMP threads of
-    batched inverse dynamics).
+    rotor inertias times ratio^2; a gimbal locked), ``data``, ``coupling`` (the mimic-free
+    tree model and the coupling matrix read from the URDF's mimic tags), ``gimbal_joints``
+    (the gimbal's joint names, () without one), ``stylus_model`` (the six-joint mimic model
+    rooted at frame s, or None), ``threads`` (OpenMP threads of batched inverse dynamics).
     """
 
     def __init__(self, source: Description | str | None = None) -> None:
@@ -131,7 +155,10 @@ class Phantom:
         description = description_of(source, "source")
         self.description = description
         self.config: Config = description.config
-        self.coupling = Coupling(description.urdf)
+        gimbal, prefix = self.config.gimbal, description.prefix
+        self.gimbal_joints: tuple[str, ...] = () if gimbal is None else tuple(prefix + j for j in GIMBAL_JOINTS)
+        self.coupling = Coupling(description.urdf if gimbal is None else
+                                 locked(description.urdf, prefix, gimbal.locked_at))
         self.model: pin.Model = self.coupling.reduced
         for model in (self.model, self.coupling.tree):  # the configuration's g, along base_link's -z
             model.gravity = gravity_of(self.config)
@@ -148,6 +175,20 @@ class Phantom:
         self._kinematics_data = self._kinematics.createData()
         self.threads = os.cpu_count() or 1
         self._pool: pin.ModelPool | None = None
+        self.stylus_model: pin.Model | None = None
+        self._frame_stylus = self._frame_stylus_tip = -1
+        if gimbal is not None:  # the six-joint model, rooted at frame s as _kinematics
+            six = pin.buildModelFromXML(description.urdf, mimic=True)
+            six.gravity = gravity_of(self.config)
+            six_data = six.createData()
+            pin.framesForwardKinematics(six, six_data, pin.neutral(six))
+            self.stylus_model = _rooted_at(six, six_data.oMf[six.getFrameId("report_s")].inverse())
+            self._stylus_data = self.stylus_model.createData()
+            names = (*(f"{prefix}joint{j}" for j in (1, 2, 3)), *self.gimbal_joints)
+            #: the six-joint model's q of (theta, g): q[order] = (theta1..3, g1..3)
+            self._order = np.array([self.stylus_model.joints[self.stylus_model.getJointId(n)].idx_q for n in names])
+            self._frame_stylus = self.stylus_model.getFrameId(f"{prefix}stylus")
+            self._frame_stylus_tip = self.stylus_model.getFrameId(f"{prefix}stylus_tip")
 
     @classmethod
     def from_model(cls, name: str) -> Phantom:
@@ -170,17 +211,7 @@ class Phantom:
 
     # -- helpers ---------------------------------------------------------------------
     def _rooted_at(self, world_to_s: pin.SE3) -> pin.Model:
-        """A copy of the model expressed in frame s: every placement on the world, joints'
-        and frames', premultiplied by ``world_to_s`` (gravity rotated alike)."""
-        model = self.model.copy()
-        for jid in range(1, model.njoints):
-            if model.parents[jid] == 0:
-                model.jointPlacements[jid] = world_to_s * model.jointPlacements[jid]
-        for frame in model.frames:
-            if frame.parentJoint == 0:
-                frame.placement = world_to_s * frame.placement
-        model.gravity = world_to_s.act(model.gravity)
-        return model
+        return _rooted_at(self.model, world_to_s)
 
     @staticmethod
     def _states(names: tuple[str, ...], *values: object) -> list[np.ndarray]:
@@ -320,6 +351,54 @@ class Phantom:
             theta = np.array([t0 + scale * step[0], t1 + scale * step[1], t2 + scale * step[2]])
         return None
 
+    # -- the stylus (a model with a gimbal) ----------------------------------------------
+    def _stylus(self) -> tuple[pin.Model, pin.Data]:
+        if self.stylus_model is None:
+            raise InvalidInputError(f"the model {self.config.name!r} has no stylus gimbal (config.gimbal is None: "
+                                    "only a model whose gimbal is public, the Touch, has one)", argument="gimbal")
+        return self.stylus_model, self._stylus_data
+
+    def _six(self, theta: object, gimbal: object) -> np.ndarray:
+        """The six-joint model's configurations (..., 6) of checked theta and gimbal angles (rad)."""
+        self._stylus()
+        t, g = self._states(("theta", "gimbal"), theta, gimbal)
+        t, g = np.broadcast_arrays(t, g)
+        q = np.empty(t.shape[:-1] + (6,))
+        q[..., self._order[:3]], q[..., self._order[3:]] = t, g
+        return q
+
+    def _stylus_frame(self, frame: int, theta: object, gimbal: object, jacobian: bool = False) -> np.ndarray:
+        q = self._six(theta, gimbal)
+        model, data = self._stylus()
+
+        def one(configuration: np.ndarray) -> np.ndarray:
+            if jacobian:  # columns in (theta, g) order
+                return pin.computeFrameJacobian(model, data, configuration, frame, pin.WORLD)[:, self._order]
+            pin.forwardKinematics(model, data, configuration)
+            return pin.updateFramePlacement(model, data, frame).homogeneous
+
+        out = np.array([one(c) for c in q.reshape(-1, 6)])
+        return finite_result(out.reshape(q.shape[:-1] + out.shape[1:]), "theta, gimbal")
+
+    def stylus_pose(self, theta: object, gimbal: object) -> np.ndarray:
+        """Pose of the stylus frame in frame s: (..., 4, 4), metres. Its origin is the gimbal
+        centre (the tip of eq. 10), its rotation Ry(theta1) Rx(-theta3) Ry(g1) Rx(-g2) Rz(-g3)
+        (report axes; Ubitrack's stylus rotation of OpenHaptics' angles), +z along the stylus
+        towards its back end. ``theta`` (rad) and ``gimbal`` (OpenHaptics' raw gimbal angles,
+        rad), each (3,) or (..., 3). InvalidInputError naming ``gimbal`` for a model without one."""
+        return self._stylus_frame(self._frame_stylus, theta, gimbal)
+
+    def stylus_tip_pose(self, theta: object, gimbal: object) -> np.ndarray:
+        """Pose of the stylus tip in frame s: the stylus frame moved ``config.gimbal.tip_offset``
+        along its -z: (..., 4, 4), metres."""
+        return self._stylus_frame(self._frame_stylus_tip, theta, gimbal)
+
+    def stylus_jacobian(self, theta: object, gimbal: object) -> np.ndarray:
+        """Spatial Jacobian of the stylus frame in frame s (as spatial_jacobian, eq. 22):
+        (..., 6, 6), the twist (v, omega) in frame s (m/s, rad/s) per unit rate of (theta1..3,
+        g1..g3) (rad/s)."""
+        return self._stylus_frame(self._frame_stylus, theta, gimbal, jacobian=True)
+
     spatial_jacobian = _frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3),
         twist (v, omega) in frame s.
 
@@ -361,11 +440,19 @@ class Phantom:
         return self._tree_batch(pin.computeCoriolisMatrix, names, *self._states(names, theta, dtheta),
                                 before=(self.coupling.tree, self._tree_data))
 
-    def gravity(self, theta: object) -> np.ndarray:
+    def gravity(self, theta: object, gimbal: object = None) -> np.ndarray:
         """Gravity torque N(theta) (eqs 93-94): (..., 3), N m.
 
-        A batch: rnea at zero rates and accelerations, by rneaInParallel.
+        A batch: rnea at zero rates and accelerations, by rneaInParallel. ``gimbal`` (rad,
+        (3,) or (..., 3), a model with a gimbal only): the torques that hold the arm with the
+        stylus at those gimbal angles (the arm's rows of the six-joint model's gravity: the
+        passive gimbal's own torques are the hand's), instead of at ``locked_at``.
         """
+        if gimbal is not None:
+            q = self._six(theta, gimbal)
+            model, data = self._stylus()
+            out = _rows(pin.computeGeneralizedGravity, q.reshape(-1, 6), before=(model, data))
+            return finite_result(out[:, self._order[:3]].reshape(q.shape[:-1] + (3,)), "theta, gimbal")
         if _one(theta):  # the fast path
             try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 return pin.computeGeneralizedGravity(self.model, self.data, theta)

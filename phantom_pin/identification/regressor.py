@@ -57,6 +57,14 @@ class Regressor:
         self.names = ([f"{b}.{p}" for b in self.bodies for p in INERTIAL_NAMES]
                       + [f"rotor{j}" for j in (1, 2, 3)] + [f"viscous{j}" for j in (1, 2, 3)]
                       + [f"coulomb{j}" for j in (1, 2, 3)])
+        #: what each tree body carries beyond its URDF link, (n_inertial,): a stylus gimbal that
+        #: the Phantom's model holds locked on the forearm (Phantom's doc); zero elsewhere. A known
+        #: load: the structures add it to the parameters they identify, and the overlay leaves it out.
+        prefix, links = phantom.description.prefix, phantom.config.links
+        self.carried = np.concatenate([
+            self.tree.inertias[k + 1].toDynamicParameters() - links[body[len(prefix):]].dynamic_parameters()
+            if phantom.config.gimbal is not None and body[len(prefix):] == "forearm_link" else np.zeros(10)
+            for k, body in enumerate(self.bodies)])
         #: column slices: inertial (tree bodies), rotors, friction
         self.inertial = slice(0, self.n_inertial)
         self.rotors = slice(self.n_inertial, self.n_inertial + 3)

@@ -53,6 +53,7 @@ class Structured:
         self.regressor = regressor
         self.description = regressor.phantom.description
         self.affine, self.offset = parameterization.affine_map(self.description, regressor.bodies)
+        self.offset[regressor.inertial] += regressor.carried  # a locked stylus gimbal: a known load
         self.names = tuple(parameterization.SYMBOLS) + tuple(
             f"{kind}{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
 
@@ -94,7 +95,11 @@ class Structure:
         """physical.nearest: the consistent x whose base parameters are nearest to ``target`` in
         the metric W^T W (``weights``: the inverse covariance's root)."""
         n = len(self.names)
-        bodies = [(self.affine[rows], self.constant[rows]) for rows in
+        # the links themselves must be physical (as ``consistent`` checks them), not the tree
+        # bodies with a locked stylus gimbal's known load (regressor.carried) added
+        links = self.constant.copy()
+        links[self.regressor.inertial] -= self.regressor.carried
+        bodies = [(self.affine[rows], links[rows]) for rows in
                   (slice(10 * k, 10 * k + 10) for k in range(len(self.regressor.bodies)))]
         rotor = [self.rotor] if self.rotor is not None else []
         positive = (rotor if self.motor else []) + list(range(n - 6, n))
@@ -137,14 +142,15 @@ class General(Structure):
         # pi (the regressor's parameters) = A x + b: each tree link is its body less the
         # pins' shares (constant: carve), the pins are fixed, the rotors J r^2
         a, b = np.zeros((regressor.size, n)), np.zeros(regressor.size)
+        b[regressor.inertial] = regressor.carried  # a locked stylus gimbal: a known load
         for k, link in enumerate(regressor.bodies):
             name, rows = link[len(prefix):], slice(10 * k, 10 * k + 10)
             if name in BODIES:
                 i = BODIES.index(name)
                 a[rows, 10 * i:10 * i + 10] = np.eye(10)
-                b[rows] = config.links[name].dynamic_parameters() - self.bodies[name].dynamic_parameters()
+                b[rows] += config.links[name].dynamic_parameters() - self.bodies[name].dynamic_parameters()
             else:
-                b[rows] = config.links[name].dynamic_parameters()
+                b[rows] += config.links[name].dynamic_parameters()
         if self.motor:
             a[regressor.rotors, 50] = np.square(np.asarray(config.actuation.ratios, dtype=float))
         a[regressor.friction, n - 6:] = np.eye(6)

@@ -75,8 +75,10 @@ class Viewer:
     ``Viewer()`` starts a meshcat server in a child process (stopped by ``close()``,
     by leaving a ``with`` block, or at interpreter exit), loads ``phantom_pin.load()``
     (or the RobotWrapper you pass), frames the arm with the camera and shows the
-    robot's q0. Joint vectors are the report's theta1..theta3 (rad); the scene's
-    world frame is ``base_link`` (x forward, z up). ``url`` is the page to open.
+    robot's q0. Joint vectors are the report's theta1..theta3 (rad); a model with a stylus
+    gimbal (the Touch) draws the stylus at the ``gimbal`` angles given to show() (OpenHaptics'
+    raw gimbal angles, rad; default zero). The scene's world frame is ``base_link`` (x forward,
+    z up). ``url`` is the page to open.
     """
 
     def __init__(self, robot: pin.RobotWrapper | None = None) -> None:
@@ -96,7 +98,7 @@ class Viewer:
                                           axis_width=4)
             self._force = np.zeros(3)
             self.set_camera(CAMERA_POSITION)
-            self.show(self.robot.q0)
+            self.show(self.robot.q0[:3], self.robot.q0[3:] if self.robot.model.nq > 3 else None)
         except BaseException:
             self.server.stop()
             raise
@@ -124,9 +126,20 @@ class Viewer:
         # world: its position is given as (x, z, -y).
         self.scene["/Cameras/default/rotated/<object>"].set_property("position", [p[0], p[2], -p[1]])
 
-    def show(self, theta: object) -> None:
-        """Place the arm, its tip frame and the force arrow at ``theta`` (3,) (rad)."""
-        self.visualizer.display(as_state(theta, "theta"))
+    def _configuration(self, theta: object, gimbal: object = None) -> np.ndarray:
+        """The robot's q of ``theta`` (3,) and, for a model with a stylus gimbal, ``gimbal`` (3,)
+        (rad; None: zero); InvalidInputError naming ``gimbal`` for a model without one."""
+        q = as_state(theta, "theta")
+        if self.robot.model.nq == 3:
+            if gimbal is not None:
+                raise InvalidInputError("this model has no stylus gimbal", argument="gimbal")
+            return q
+        return np.concatenate([q, np.zeros(3) if gimbal is None else as_state(gimbal, "gimbal")])
+
+    def show(self, theta: object, gimbal: object = None) -> None:
+        """Place the arm, its tip frame and the force arrow at ``theta`` (3,) (rad), and the
+        stylus (a model with a gimbal) at ``gimbal`` (3,) (rad; default zero)."""
+        self.visualizer.display(self._configuration(theta, gimbal))
         self._draw_force()
 
     def set_force(self, force: object, scale: float = FORCE_SCALE) -> None:
@@ -191,7 +204,7 @@ class Viewer:
         frame_node = f"{self.visualizer.viewerFramesGroupName}/{model.frames[self._tip].name}"
         for instant, posture in zip(samples, postures):
             with animation.at_frame(self.scene, instant * _FPS) as frame:
-                pin.forwardKinematics(model, data, posture)
+                pin.forwardKinematics(model, data, self._configuration(posture))  # a stylus at zero
                 pin.updateGeometryPlacements(model, data, geometry, geometry_data)
                 for k, obj in enumerate(geometry.geometryObjects):
                     name = self.visualizer.getViewerNodeName(obj, pin.GeometryType.VISUAL)

@@ -4,9 +4,13 @@ and rviz2.
 
     ros2 launch phantom_description display.launch.py                      # the Premium 1.5
     ros2 launch phantom_description display.launch.py robot:=phantom_touch  # the Touch / Omni
+    # a Touch whose ROS driver publishes joint_states (waist, shoulder, elbow, yaw, pitch, roll):
+    ros2 launch phantom_description display.launch.py robot:=phantom_touch convention:=driver gui:=false
 
 ``robot`` names a committed URDF of share/phantom_description/urdf (phantom_1_5,
-phantom_1_5_cad, phantom_touch).
+phantom_1_5_cad, phantom_touch). ``convention``: report (joint1..joint6, the report's theta and
+the raw gimbal angles) or driver (the drivers' joint names and conventions: urdf/ROBOT_driver.urdf,
+committed for the Touch). ``gui``: false leaves joint_states to a running driver.
 """
 
 from pathlib import Path
@@ -18,23 +22,31 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 ROBOTS = ("phantom_1_5", "phantom_1_5_cad", "phantom_touch")
+CONVENTIONS = ("report", "driver")
 
 
 def _nodes(context):
     robot = LaunchConfiguration("robot").perform(context)
+    convention = LaunchConfiguration("convention").perform(context)
     share = Path(get_package_share_directory("phantom_description"))
-    robot_description = (share / "urdf" / f"{robot}.urdf").read_text()
-    return [
-        Node(package="robot_state_publisher", executable="robot_state_publisher",
-             parameters=[{"robot_description": robot_description}]),
-        Node(package="joint_state_publisher_gui", executable="joint_state_publisher_gui"),
-        Node(package="rviz2", executable="rviz2", arguments=["-f", "base_link"]),
-    ]
+    urdf = share / "urdf" / (f"{robot}.urdf" if convention == "report" else f"{robot}_driver.urdf")
+    if not urdf.is_file():
+        raise RuntimeError(f"convention:={convention}: no {urdf.name} for robot:={robot} "
+                           f"(the drivers' convention is committed for phantom_touch)")
+    nodes = [Node(package="robot_state_publisher", executable="robot_state_publisher",
+                  parameters=[{"robot_description": urdf.read_text()}])]
+    if LaunchConfiguration("gui").perform(context) == "true":
+        nodes.append(Node(package="joint_state_publisher_gui", executable="joint_state_publisher_gui"))
+    return [*nodes, Node(package="rviz2", executable="rviz2", arguments=["-f", "base_link"])]
 
 
 def generate_launch_description() -> LaunchDescription:
     return LaunchDescription([
         DeclareLaunchArgument("robot", default_value="phantom_1_5", choices=list(ROBOTS),
                               description="the model's URDF in share/phantom_description/urdf"),
+        DeclareLaunchArgument("convention", default_value="report", choices=list(CONVENTIONS),
+                              description="joint names: report (joint1..) or driver (waist, shoulder, elbow, ...)"),
+        DeclareLaunchArgument("gui", default_value="true", choices=["true", "false"],
+                              description="start joint_state_publisher_gui (false: a driver publishes joint_states)"),
         OpaqueFunction(function=_nodes),
     ])
