@@ -166,7 +166,10 @@ def identify_command(args: argparse.Namespace) -> int:
         raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--accept writes it anyway)")
     keys, notes = overlay(fit, given, phantom.config)  # checked: a physical model, or nothing written
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
-          f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g}")
+          f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
+          "(a diagnostic: the fit is judged by its predicted torques)")
+    for line in fit.prediction.lines():
+        print(line)
     print("residual RMS per joint [N m]: " + ", ".join(
         f"{r:.3g} ({100 * r / s:.2f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms))
           + "; of the written parameters: " + ", ".join(f"{r:.3g}" for r in fit.written_rms))
@@ -180,11 +183,15 @@ def identify_command(args: argparse.Namespace) -> int:
     elif fit.comparison is not None:
         print(f"the report's structure suffices for this log (within {estimation.NEEDS_GENERAL} times the general "
               "model's residual on every joint)")
-    print(f"{'':6} {'estimate':>12} {'std dev':>10} {'written':>12}  {'unit':9} base parameter")
+    print(f"{'':6} {'estimate':>12} {'std dev':>10} {'written':>12} {'log alone':>12} {'prior':>12}  {'unit':9} "
+          "base parameter")
     for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
-        print(f"beta{k + 1:<2} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {fit.written[k]:12.5g}  {unit:9} {name}")
+        print(f"beta{k + 1:<2} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {fit.written[k]:12.5g} {fit.log_beta[k]:12.5g} "
+              f"{fit.prior_beta[k]:12.5g}  {unit:9} {name}")
     for note in notes:
         print(note)
+    for warning in fit.prediction.warnings():
+        print(f"warning: {warning}")
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
     write_overlay(args.output, fit, args.log.name, keys, notes)
