@@ -14,7 +14,7 @@ import pytest
 from helpers import CONFIG
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import random_states
-from phantom_pin.identification import estimation, excitation, prediction, simulation
+from phantom_pin.identification import estimation, excitation, io, prediction, simulation
 from phantom_pin.identification.structures import General
 from test_identification_end_to_end import truth_overrides
 
@@ -53,11 +53,12 @@ def lab():
     the prior; the device's true model; the held-out sets."""
     description = describe(overrides=truth_overrides())
     device, truth = Device(description), Phantom(description)
-    fits = {name: estimation.estimate(lab_log(device, duration, amplitude, 1), PRIOR)
+    logs = {name: lab_log(device, duration, amplitude, 1)
             for name, duration, amplitude in (("narrow", 10, 0.1), ("wide", 60, 0.4))}
+    fits = {name: estimation.estimate(log, PRIOR) for name, log in logs.items()}
     _, theta, dtheta, ddtheta = sum_of_sines(20, 0.4, 99)
     held = {"trajectory": (theta[::10], dtheta[::10], ddtheta[::10]), "states": random_states(CONFIG.limits, 500, 7)}
-    return fits, truth, held
+    return fits, truth, held, logs
 
 
 def error(beta, truth, states):
@@ -75,7 +76,7 @@ def test_the_regularised_fit_is_never_worse_than_the_prior_on_held_out_motion(la
     model: at most 6 % from the narrow log, 0.44 % from the wide one), while the narrow log alone
     (no prior) is worse than the prior on joint 1 (286 % on the states): the prior holds what the
     log does not excite."""
-    fits, truth, held = lab
+    fits, truth, held, _ = lab
     for name, states in held.items():
         prior = error(fits["wide"].prior_beta, truth, states)
         for kind, fit in fits.items():
@@ -93,7 +94,7 @@ def test_the_regularised_fit_approaches_the_log_alone_as_the_excitation_grows(la
     284 % of the torque RMS from the narrow log (the prior holds what it does not excite), and by
     0.015 % at most from the wide one; the wide log's written model is as good as the log alone's
     (within 0.05 % of the torque RMS on every joint)."""
-    fits, truth, held = lab
+    fits, truth, held, _ = lab
     states = held["states"]
     phi = MODEL.regressor_of(*states)[0]
 
@@ -112,7 +113,7 @@ def test_the_predicted_uncertainty_is_the_error_the_device_shows(lab):
     to the torques) against the written model's actual error on 500 other states of the known
     device: within a factor 3 on every joint, for the narrow log (3-11 % predicted) and the wide
     one (0.1-0.7 %); the narrow log is warned about, naming what it leaves poorly excited."""
-    fits, truth, held = lab
+    fits, truth, held, _ = lab
     for kind, fit in fits.items():
         actual = error(fit.written, truth, held["states"])
         print(kind, "predicted", fit.prediction.states, "actual", actual)
@@ -155,3 +156,30 @@ def test_a_model_that_predicts_the_log_worse_than_the_prior_is_refused():
     assert worse.worse() == ("the identified model predicts the log's torques worse than the prior (residual "
                              "joint 2: 5 % of the torque RMS against the prior's 2 %): keep the configuration you "
                              "passed, or check the log's units, signs and timing")
+
+
+def test_identify_prints_and_writes_the_uncertainty_and_refuses_only_a_model_worse_than_the_prior(
+        lab, tmp_path, capsys, monkeypatch):
+    """identify on the narrow log: written (exit 0), with the predicted uncertainty and the warnings
+    naming the poorly excited directions, printed and in the overlay's header; with WORSE at 0.01
+    (a model leaving 1 % of the prior's residual on the log then counts as worse) the same log is refused
+    in one line naming both residuals, and nothing is written."""
+    from phantom_pin.cli import main
+
+    log = lab[3]["narrow"]
+    io.write_log(tmp_path / "log.csv", log.t, log.theta, log.tau)
+    assert main(["identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml")]) == 0
+    out = capsys.readouterr().out
+    header = (tmp_path / "id.yaml").read_text()
+    for text, prefix in ((out, ""), (header, "# ")):
+        assert f"{prefix}predicted torque uncertainty (1 sigma, share of the torque RMS per joint): " in text
+        assert f"{prefix}warning: predicted torque uncertainty over states inside the stops above 1 % on joint 1" \
+            in text
+        assert f"{prefix}warning: the log leaves poorly excited: lower_bar_link.mz: " in text
+    assert "# What the log does not excite comes from the model's values (the prior, within its stated 30 % " in header
+    monkeypatch.setattr(prediction, "WORSE", 0.01)
+    assert main(["identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "again.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(
+        "phantom-pin: error: the identified model predicts the log's torques worse than the prior (residual joint 1: ")
+    assert not (tmp_path / "again.yaml").exists()
