@@ -106,7 +106,7 @@ def _joints(shares: np.ndarray) -> str:
 
 
 def _percent(share: float) -> str:
-    return f"{100 * share:.2g} %" if share < 10 else "more than 1000 %"
+    return "more than 1000 %" if share > 10 else f"{100 * share:.2g} %" if share < 0.995 else f"{100 * share:.0f} %"
 
 
 def torque_sigma(phi: np.ndarray, covariance: np.ndarray) -> np.ndarray:
