@@ -204,3 +204,29 @@ def test_the_cad_device_identified_on_the_report_model_is_never_worse_than_the_p
         assert (written < 0.5 * prior).all() and error(wide.written, truth, states).max() < 5e-3
         assert np.abs(error(wide.written, truth, states) - error(wide.log_beta, truth, states)).max() < 5e-4
     assert narrow.problems == () and wide.problems == ()
+
+
+def test_the_estimate_with_the_prior_is_the_gauss_markov_formula():
+    """estimation._fit with a prior (beta_0, P) against the textbook formula on a seeded problem,
+    beta = (A + P^-1)^-1 (Phi_w^T y_w / s^2 + P^-1 beta_0), covariance (A + P^-1)^-1, A the log's
+    information (its own output, checked as Phi_w^T Phi_w / s^2 by the log alone's covariance):
+    within 1e-9; a prior 1e6 times looser gives the log alone's beta within 1e-6 of its standard
+    deviations, one 1e-6 times tighter the prior's within 1e-6 of the prior's."""
+    rng = np.random.default_rng(2)
+    phi = rng.normal(size=(200, 3, 5))
+    truth = rng.normal(size=5)
+    y = phi @ truth + rng.normal(size=(200, 3)) * [0.1, 0.2, 0.05]
+    root = rng.normal(size=(5, 5))
+    spread, beta0 = root @ root.T * 0.01, truth + rng.normal(size=5) * 0.3
+    beta, covariance, _, weight, information, alone = estimation._fit(phi, y, prior=(beta0, spread))
+    inverse = np.linalg.inv(spread)
+    log_covariance = estimation._fit(phi, y)[1]
+    np.testing.assert_allclose(np.linalg.inv(log_covariance), information, rtol=1e-9)
+    expected = np.linalg.solve(information + inverse, information @ alone + inverse @ beta0)
+    np.testing.assert_allclose(beta, expected, rtol=1e-9)
+    np.testing.assert_allclose(covariance, np.linalg.inv(information + inverse), rtol=1e-9, atol=1e-15)
+    sigma = np.sqrt(np.diag(log_covariance))
+    loose = estimation._fit(phi, y, prior=(beta0, spread * 1e12))[0]
+    assert (np.abs(loose - alone) < 1e-6 * sigma).all()
+    tight = estimation._fit(phi, y, prior=(beta0, spread * 1e-12))[0]
+    np.testing.assert_allclose(tight, beta0, rtol=1e-6)
