@@ -12,6 +12,12 @@ ordinary weighted least-squares estimate plus P^-1: where the log's information 
 / s^2 dwarfs P^-1 (an excitation trajectory: 1e6-1e12 times, direction by direction) the two
 agree to far below their standard deviations, and where it vanishes the estimate is beta_0.
 
+Chosen over the log-det (Bregman) divergence between the links' pseudo-inertias and the prior's
+(Lee, Wensing and Park 2020) because it acts on the base parameters, the only ones the torques
+determine: a closed form, the covariance the predicted torque uncertainty carries
+(prediction.py), and a weight that is the stated P against the log's own noise s^2, nothing to
+tune; the physical projection that follows (physical.py) keeps the log-det barrier.
+
 P is stated in the physical parameters x (structures.Structure.names) and carried to the base
 parameters, P = M diag((SPREAD scale)^2) M^T (beta = M x + offset): each entry of x independent,
 with standard deviation SPREAD (30 %) of its typical size ``scale`` (structures: for a body, m,
