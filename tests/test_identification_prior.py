@@ -163,7 +163,8 @@ def test_identify_prints_and_writes_the_uncertainty_and_refuses_only_a_model_wor
     """identify on the narrow log: written (exit 0), with the predicted uncertainty and the warnings
     naming the poorly excited directions, printed and in the overlay's header; with WORSE at 0.01
     (a model leaving 1 % of the prior's residual on the log then counts as worse) the same log is refused
-    in one line naming both residuals, and nothing is written."""
+    in one line naming both residuals, and nothing is written; a --prior-spread that is no relative
+    standard deviation is refused in one line naming it."""
     from phantom_pin.cli import main
 
     log = lab[3]["narrow"]
@@ -183,6 +184,12 @@ def test_identify_prints_and_writes_the_uncertainty_and_refuses_only_a_model_wor
     assert err.count("\n") == 1 and err.startswith(
         "phantom-pin: error: the identified model predicts the log's torques worse than the prior (residual joint 1: ")
     assert not (tmp_path / "again.yaml").exists()
+    for spread in ("0", "nan", "-0.3"):     # the prior's spread: a relative standard deviation > 0 (inf: none)
+        assert main(["identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "again.yaml"),
+                     "--prior-spread", spread]) == 2
+        err = capsys.readouterr().err
+        assert err == ("phantom-pin: error: --prior-spread: expected a relative standard deviation > 0 (inf: no "
+                       f"prior), got {float(spread)!r}\n")
 
 
 def test_the_cad_device_identified_on_the_report_model_is_never_worse_than_the_prior():

@@ -14,7 +14,7 @@ from phantom_pin.cli.common import description, overrides
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import estimation, excitation, io
+from phantom_pin.identification import estimation, excitation, io, prior
 from phantom_pin.identification.overlays import overlay, write_overlay
 from phantom_pin.progress import Progress
 
@@ -66,7 +66,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
-    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff"})
+    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
@@ -76,6 +76,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--structure", choices=("general", "report"), default="general",
                           help="general: the rigid body in full, every identifiable base parameter (default); "
                                "report: the report's eight constants (a model in the report's form)")
+    identify.add_argument("--prior-spread", type=float, default=prior.SPREAD,
+                          help="how far the device may lie from the configuration you pass (the prior), as a "
+                               "relative standard deviation of every physical parameter (default 0.3); what the log "
+                               "does not excite comes from the prior; inf: the log alone")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     identify.add_argument("--accept", action="store_true",
                           help="write the result even where the checks refuse it, each check's reason as a warning "
@@ -158,7 +162,7 @@ def identify_command(args: argparse.Namespace) -> int:
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
-                                  timing=args.torque_timing)
+                                  timing=args.torque_timing, prior_spread=args.prior_spread)
     finally:
         bar.close()
     if fit.problems and not args.accept:
