@@ -243,3 +243,19 @@ def test_the_estimate_with_the_prior_is_the_gauss_markov_formula():
     assert (np.abs(loose - alone) < 1e-6 * sigma).all()
     tight = estimation._fit(phi, y, prior=(beta0, spread * 1e-12))[0]
     np.testing.assert_allclose(tight, beta0, rtol=1e-6)
+
+
+def test_the_log_alones_covariance_is_infinite_where_it_sees_nothing():
+    """estimation.inverse_information: the inverse of a nonsingular information (units 1e-12 to
+    1e6 apart) within 1e-9, in the units that balance its diagonal; a singular one gives inf on
+    the variance of each parameter its null direction (a + b) involves, the inverse elsewhere."""
+    rng = np.random.default_rng(4)
+    root = rng.normal(size=(3, 3)) * [1e3, 1.0, 1e-6]
+    information = root.T @ root
+    d = np.sqrt(np.diag(information))                  # compared in the units that balance it
+    scaled = (estimation.inverse_information(information) * np.outer(d, d)) @ (information / np.outer(d, d))
+    np.testing.assert_allclose(scaled, np.eye(3), atol=1e-9)
+    v = np.array([[1, 1, 0], [1, -1, 0], [0, 0, np.sqrt(2)]]) / np.sqrt(2)
+    singular = v.T @ np.diag([0.0, 4.0, 100.0]) @ v
+    variance = np.diag(estimation.inverse_information(singular))
+    assert np.isinf(variance[:2]).all() and variance[2] == pytest.approx(0.01, rel=1e-12)
