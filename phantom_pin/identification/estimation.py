@@ -196,11 +196,10 @@ def _fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
     """Weighted least squares of y (N, 3) on phi (N, 3, P) over the equations ``moving`` (N, 3)
     (all by default): (beta, covariance, residual (N, 3; 0 where not fitted), joint weights
     (3,), the log's information Phi_w^T Phi_w / s^2, the log alone's beta), each joint weighted
-    by 1 / its residual
-    standard deviation. With ``prior`` (beta_0, P), the Gauss-Markov estimate with that prior
-    (module doc, step 2; prior.py), solved in the base parameters scaled by the prior's
-    standard deviations (a singular value decomposition: the log alone may leave directions
-    unconstrained)."""
+    by 1 / its residual standard deviation. With ``prior`` (beta_0, P), the Gauss-Markov estimate
+    with that prior (module doc, step 2; prior.py), solved in the base parameters scaled by the
+    prior's standard deviations (a singular value decomposition: the log alone may leave
+    directions unconstrained)."""
     p = phi.shape[-1]
     moving = np.ones(y.shape, bool) if moving is None else moving
     phi, y = phi * moving[..., None], y * moving
@@ -281,8 +280,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     ("general": the rigid body in full; "report": the report's structure, for a model in the
     report's form) and the nearest physically consistent parameters (module doc). Raises
     LogError for a log that cannot be identified at all (too short, too low a rate for
-    ``cutoff`` Hz, too poorly excited, constant torques); ``Fit.problems`` lists the reasons
-    a fitted result should not be written. ``timing``: how the torques relate to the times
+    ``cutoff`` Hz, constant torques; with ``prior_spread`` inf, a direction the log alone leaves
+    unconstrained); ``Fit.problems`` lists the reasons a fitted result should not be written.
+    ``timing``: how the torques relate to the times
     (TIMINGS: "held" commands, the default, or "sampled" values). ``prior_spread``: the prior's
     relative standard deviation of every physical parameter (prior.py; inf: the log alone).
     ``progress(share)`` is called as stages end."""
