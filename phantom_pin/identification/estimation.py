@@ -140,8 +140,8 @@ class Fit:
         more than NEEDS_GENERAL times its residual on a joint), else None."""
         if self.comparison is None:
             return None
-        general, report = (self.rms, self.comparison[1]) if self.structure == "general" else \
-            (self.comparison[1], self.rms)
+        general, report = (self.log_rms, self.comparison[1]) if self.structure == "general" else \
+            (self.comparison[1], self.log_rms)          # both the log alone's fits
         ratio = float((report / general).max())
         if ratio <= NEEDS_GENERAL:
             return None
