@@ -14,7 +14,7 @@ from phantom_pin.cli.common import description, overrides
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import estimation, excitation, io
+from phantom_pin.identification import estimation, excitation, io, prior
 from phantom_pin.identification.overlays import overlay, write_overlay
 from phantom_pin.progress import Progress
 
@@ -66,7 +66,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
-    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff"})
+    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
@@ -76,6 +76,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--structure", choices=("general", "report"), default="general",
                           help="general: the rigid body in full, every identifiable base parameter (default); "
                                "report: the report's eight constants (a model in the report's form)")
+    identify.add_argument("--prior-spread", type=float, default=prior.SPREAD,
+                          help="how far the device may lie from the configuration you pass (the prior), as a "
+                               "relative standard deviation of every physical parameter (default 0.3); what the log "
+                               "does not excite comes from the prior; inf: the log alone")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     identify.add_argument("--accept", action="store_true",
                           help="write the result even where the checks refuse it, each check's reason as a warning "
@@ -158,7 +162,7 @@ def identify_command(args: argparse.Namespace) -> int:
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
-                                  timing=args.torque_timing)
+                                  timing=args.torque_timing, prior_spread=args.prior_spread)
     finally:
         bar.close()
     if fit.problems and not args.accept:
@@ -166,7 +170,10 @@ def identify_command(args: argparse.Namespace) -> int:
         raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--accept writes it anyway)")
     keys, notes = overlay(fit, given, phantom.config)  # checked: a physical model, or nothing written
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
-          f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g}")
+          f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
+          "(a diagnostic: the fit is judged by its predicted torques)")
+    for line in fit.prediction.lines():
+        print(line)
     print("residual RMS per joint [N m]: " + ", ".join(
         f"{r:.3g} ({100 * r / s:.2f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms))
           + "; of the written parameters: " + ", ".join(f"{r:.3g}" for r in fit.written_rms))
@@ -180,11 +187,15 @@ def identify_command(args: argparse.Namespace) -> int:
     elif fit.comparison is not None:
         print(f"the report's structure suffices for this log (within {estimation.NEEDS_GENERAL} times the general "
               "model's residual on every joint)")
-    print(f"{'':6} {'estimate':>12} {'std dev':>10} {'written':>12}  {'unit':9} base parameter")
+    print(f"{'':6} {'estimate':>12} {'std dev':>10} {'written':>12} {'log alone':>12} {'prior':>12}  {'unit':9} "
+          "base parameter")
     for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
-        print(f"beta{k + 1:<2} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {fit.written[k]:12.5g}  {unit:9} {name}")
+        print(f"beta{k + 1:<2} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {fit.written[k]:12.5g} {fit.log_beta[k]:12.5g} "
+              f"{fit.prior_beta[k]:12.5g}  {unit:9} {name}")
     for note in notes:
         print(note)
+    for warning in fit.prediction.warnings():
+        print(f"warning: {warning}")
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
     write_overlay(args.output, fit, args.log.name, keys, notes)

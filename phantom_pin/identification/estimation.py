@@ -12,13 +12,19 @@ physically consistent parameters, and the checks that decide whether they may be
    and are computed at the kept samples. The filter's edge transients are cut and the
    samples decimated to about 5 times the cutoff.
 2. beta by ordinary least squares, then weighted by the inverse residual standard deviation
-   of each joint (Gauss-Markov); covariance s^2 (Phi_w^T Phi_w)^-1.
+   of each joint (Gauss-Markov): the log's information Phi_w^T Phi_w / s^2. With the prior
+   (prior.py: the configuration's own base parameters as the mean, a stated covariance P), the
+   Gauss-Markov estimate with that prior: covariance (Phi_w^T Phi_w / s^2 + P^-1)^-1, equal to
+   the log alone's s^2 (Phi_w^T Phi_w)^-1 where the log excites everything, the prior's where
+   it excites nothing. The base regressor's condition number (columns scaled to unit norm) is
+   a diagnostic only: the fit is judged by the torques it predicts (prediction.py).
 3. physical.nearest: the structure's parameters x (structures.py) whose base parameters are
    nearest to beta in the covariance's metric, with every link physical and friction >= 0.
-4. The checks (``Fit.problems``, each one line): torques unrelated to the motion, a
-   projection that moves an estimate far or flips its sign, negative friction, torques
-   whose size or sign disagree with the model's, joints whose torques fit markedly better
-   scaled (a wrong transmission ratio or amplifier sign), angles far beyond the stops.
+4. The checks (``Fit.problems``, each one line): a model that predicts the log worse than the
+   prior, torques unrelated to the motion, a projection that moves an estimate far or flips
+   its sign, negative friction, torques whose size or sign disagree with the model's, joints
+   whose torques fit markedly better scaled (a wrong transmission ratio or amplifier sign),
+   angles far beyond the stops.
 """
 
 from __future__ import annotations
@@ -27,19 +33,20 @@ import dataclasses
 from collections.abc import Callable
 
 import numpy as np
+import scipy.linalg
 import scipy.ndimage
 import scipy.signal
 
 from phantom_pin.config import Friction
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
+from phantom_pin.identification import prior as priors
 from phantom_pin.identification.io import Log
+from phantom_pin.identification.prediction import Prediction, judge
 from phantom_pin.identification.structures import STRUCTURES, Structure, friction_block
 
 #: Fewest periods of the cutoff the log must span (the filter's transients and edges).
 MIN_CYCLES = 10.0
-#: Largest accepted condition number of the base regressor (columns scaled to unit norm).
-MAX_CONDITION = 1e3
 #: Filter order and edge cut (s).
 FILTER_ORDER, EDGE = 4, 0.25
 #: Fewest log samples per second per hertz of cutoff: central differences of a motion at the
@@ -93,7 +100,12 @@ class Fit:
     ``comparison``: (name, residual RMS per joint, N m) of the other structure, or None;
     ``torque_scale`` (3,): the factors each joint's logged torque fits best with (joint 1's
     is 1), ``scaled_rms``: the residual with them; ``problems``: why the result should not be
-    written (one line each; empty for a usable log)."""
+    written (one line each; empty for a usable log). ``beta`` and ``sigma`` are the estimate
+    with the prior (module doc, step 2): ``prior_beta`` the prior's base parameters, ``log_beta``
+    and ``log_sigma`` the log's alone (inf where it leaves a direction unconstrained), ``log_rms``
+    its residual RMS per joint (N m: whether the torques follow the motion at all);
+    ``prediction``: the predicted torque uncertainty of the written parameters
+    (prediction.Prediction)."""
 
     structure: str
     names: tuple[str, ...]
@@ -112,6 +124,11 @@ class Fit:
     torque_scale: np.ndarray
     scaled_rms: np.ndarray
     problems: tuple[str, ...]
+    prior_beta: np.ndarray
+    log_beta: np.ndarray
+    log_sigma: np.ndarray
+    log_rms: np.ndarray
+    prediction: Prediction
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:
@@ -123,8 +140,8 @@ class Fit:
         more than NEEDS_GENERAL times its residual on a joint), else None."""
         if self.comparison is None:
             return None
-        general, report = (self.rms, self.comparison[1]) if self.structure == "general" else \
-            (self.comparison[1], self.rms)
+        general, report = (self.log_rms, self.comparison[1]) if self.structure == "general" else \
+            (self.comparison[1], self.log_rms)          # both the log alone's fits
         ratio = float((report / general).max())
         if ratio <= NEEDS_GENERAL:
             return None
@@ -174,10 +191,15 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Sa
     return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau[keep], friction, ~slow[keep].astype(bool))
 
 
-def _fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+def _fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
+         prior: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, ...]:
     """Weighted least squares of y (N, 3) on phi (N, 3, P) over the equations ``moving`` (N, 3)
     (all by default): (beta, covariance, residual (N, 3; 0 where not fitted), joint weights
-    (3,)), each joint weighted by 1 / its residual standard deviation."""
+    (3,), the log's information Phi_w^T Phi_w / s^2, the log alone's beta), each joint weighted
+    by 1 / its residual standard deviation. With ``prior`` (beta_0, P), the Gauss-Markov estimate
+    with that prior (module doc, step 2; prior.py), solved in the base parameters scaled by the
+    prior's standard deviations (a singular value decomposition: the log alone may leave
+    directions unconstrained)."""
     p = phi.shape[-1]
     moving = np.ones(y.shape, bool) if moving is None else moving
     phi, y = phi * moving[..., None], y * moving
@@ -187,10 +209,36 @@ def _fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None) -> tu
     joint_sigma = np.sqrt((residual**2).sum(axis=0) / np.maximum(moving.sum(axis=0) - p / 3, 1))
     weight = 1.0 / np.maximum(joint_sigma, 1e-300)
     weighted, yw = (phi * weight[:, None]).reshape(-1, p), (y * weight).reshape(-1)
-    beta = np.linalg.lstsq(weighted, yw, rcond=None)[0]
+    beta = log_beta = np.linalg.lstsq(weighted, yw, rcond=None)[0]
     rw = yw - weighted @ beta
-    covariance = (rw @ rw / (moving.sum() - p)) * np.linalg.inv(weighted.T @ weighted)
-    return beta, covariance, y - phi @ beta, weight
+    variance = rw @ rw / (moving.sum() - p)
+    information = weighted.T @ weighted / variance
+    if prior is None:
+        covariance = inverse_information(information)
+    else:
+        beta0, spread = prior
+        d = np.sqrt(np.diag(spread))                         # the prior's standard deviations
+        root = np.linalg.cholesky(spread / np.outer(d, d))   # of the scaled prior's correlation
+        inverse = scipy.linalg.solve_triangular(root, np.eye(p), lower=True)
+        stacked = np.vstack([weighted * d / np.sqrt(variance), inverse])
+        rhs = np.concatenate([yw / np.sqrt(variance), inverse @ (beta0 / d)])
+        u, sizes, vt = np.linalg.svd(stacked, full_matrices=False)
+        beta = d * (vt.T @ ((u.T @ rhs) / sizes))
+        covariance = (vt.T / sizes**2) @ vt * np.outer(d, d)
+    return beta, covariance, y - phi @ beta, weight, information, log_beta
+
+
+def inverse_information(information: np.ndarray) -> np.ndarray:
+    """The covariance of an information matrix (P, P), inf on the diagonal where it leaves a
+    direction unconstrained (scaled to a unit diagonal first: the units span 1e-12)."""
+    d = np.sqrt(np.maximum(np.diag(information), 1e-300))
+    values, vectors = np.linalg.eigh(information / np.outer(d, d))
+    if values.min() > 1e-13 * values.max():
+        return np.linalg.inv(information / np.outer(d, d)) / np.outer(d, d)
+    covariance = (vectors / np.maximum(values, 1e-300)) @ vectors.T / np.outer(d, d)
+    unconstrained = (vectors[:, values <= 1e-13 * values.max()] ** 2).sum(axis=1) > 1e-6
+    covariance[unconstrained, unconstrained] = np.inf
+    return covariance
 
 
 def _rms(residual: np.ndarray, moving: np.ndarray | None = None) -> np.ndarray:
@@ -226,16 +274,18 @@ MAX_TORQUE = 1e3
 
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",  # noqa: C901 (checks, then stages)
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
-             timing: str = "held") -> Fit:
+             timing: str = "held", prior_spread: float = priors.SPREAD) -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
     the prior, its friction law the friction columns): the base parameters of ``structure``
     ("general": the rigid body in full; "report": the report's structure, for a model in the
     report's form) and the nearest physically consistent parameters (module doc). Raises
     LogError for a log that cannot be identified at all (too short, too low a rate for
-    ``cutoff`` Hz, too poorly excited, constant torques); ``Fit.problems`` lists the reasons
-    a fitted result should not be written. ``timing``: how the torques relate to the times
-    (TIMINGS: "held" commands, the default, or "sampled" values). ``progress(share)`` is called
-    as stages end."""
+    ``cutoff`` Hz, constant torques; with ``prior_spread`` inf, a direction the log alone leaves
+    unconstrained); ``Fit.problems`` lists the reasons a fitted result should not be written.
+    ``timing``: how the torques relate to the times
+    (TIMINGS: "held" commands, the default, or "sampled" values). ``prior_spread``: the prior's
+    relative standard deviation of every physical parameter (prior.py; inf: the log alone).
+    ``progress(share)`` is called as stages end."""
     def stage(share: float) -> None:
         if progress is not None:
             progress(share)
@@ -247,6 +297,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
             raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
+    spread = priors.spread_argument(prior_spread)
     if progress is not None and not callable(progress):
         raise InvalidInputError(f"expected a callable (share) or None, got {progress!r}", argument="progress")
     duration = float(log.t[-1] - log.t[0])
@@ -290,13 +341,19 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     phi, y = phi * moving[..., None], (samples.tau - tau0) * moving
     stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)
-    condition = float(np.linalg.cond(stacked / np.where(norms > 0, norms, 1.0)))
-    if not condition <= MAX_CONDITION:
-        raise LogError(f"not exciting enough: the base regressor's condition number is {condition:.3g} "
-                       f"(at most {MAX_CONDITION:.0e}); log an excitation trajectory (phantom-pin excite)")
-    beta, covariance, residual, weight = _fit(phi, y, moving)
+    condition = float(np.linalg.cond(stacked / np.where(norms > 0, norms, 1.0)))     # a diagnostic
+    beta0, spread_covariance = priors.base_prior(model.matrix, model.offset, model.prior, model.scale,
+                                                 spread if np.isfinite(spread) else 1.0)
+    beta, covariance, residual, weight, information, log_beta = _fit(
+        phi, y, moving, (beta0, spread_covariance) if np.isfinite(spread) else None)
     sigma = np.sqrt(np.diag(covariance))
-    root = np.linalg.cholesky(np.linalg.inv(covariance)).T            # root^T root = covariance^-1
+    if not np.isfinite(sigma).all():
+        loose = ", ".join(model.base_names[k].split(" = ")[0][:40] for k in np.flatnonzero(~np.isfinite(sigma))[:3])
+        raise LogError(f"not exciting enough for the log alone: it leaves {loose} unconstrained; identify with "
+                       "the prior (a finite prior_spread)", argument="prior_spread")
+    correlation = covariance / np.outer(sigma, sigma)
+    values, vectors = np.linalg.eigh(correlation)      # root^T root = covariance^-1 (no Cholesky: it
+    root = (vectors / np.sqrt(np.maximum(values, 1e-300))).T / sigma   # may be singular to rounding)
     stage(0.5)
     x = model.nearest(beta, root, prior_weight)
     written = model.matrix @ x + model.offset
@@ -305,7 +362,10 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     scale, scaled_rms = _scaled(phi, y, weight, moving)
     fit = Fit(model.name, model.base_names, model.units, beta, sigma, _rms(residual, moving),
               _rms(y - phi @ written, moving), _rms(y, moving), condition, len(samples.theta), x, written,
-              model.overrides(x), comparison, scale, scaled_rms, ())
+              model.overrides(x), comparison, scale, scaled_rms, (), beta0, log_beta,
+              np.sqrt(np.diag(inverse_information(information))), _rms(y - phi @ log_beta, moving),
+              judge(model.regressor_of, phantom.config.limits, phi, y, moving, written, covariance, beta0,
+                    information, priors.typical(model.matrix, model.scale), model.base_names, spread))
     problems = _problems(fit, model, phi, y, log, phantom)
     stage(1.0)
     return dataclasses.replace(fit, problems=tuple(problems))
@@ -325,12 +385,15 @@ def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[s
 def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Log, phantom: Phantom) -> list[str]:
     """Why ``fit`` should not be written (module doc, step 4), most telling first."""
     problems = []
+    worse = fit.prediction.worse()
+    if worse is not None:
+        problems.append(worse)
     beyond = float(np.abs(phantom.config.limits.stops.penetration(log.theta)).max())
     if beyond > BEYOND_STOPS:
         problems.append(f"theta: the log's angles reach {beyond:.3g} rad beyond the stops; are they in degrees, or "
                         "in another convention? (the log holds the report's theta in rad, or use --convention "
                         "openhaptics)")
-    share = fit.rms / fit.torque_rms
+    share = fit.log_rms / fit.torque_rms      # the log alone's: the prior may pull a wrong log's fit
     if share.max() > MAX_RESIDUAL_SHARE:
         problems.append("the fit leaves " + ", ".join(f"{100 * s:.0f} %" for s in share) + " of the torque RMS "
                         f"(at most {100 * MAX_RESIDUAL_SHARE:.0f} %): the torques do not follow the motion; check "
@@ -359,7 +422,7 @@ def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: L
                         "physical arm; check torque signs, units and transmission ratios")
     off = np.abs(fit.torque_scale - 1)
     if off.max() > RATIO_SHARE and ((fit.scaled_rms / fit.torque_rms) ** 2).sum() < \
-            MARKED_IMPROVEMENT * ((fit.rms / fit.torque_rms) ** 2).sum():
+            MARKED_IMPROVEMENT * ((fit.log_rms / fit.torque_rms) ** 2).sum():
         ratios = phantom.config.actuation.ratios
         joints = [j for j in (1, 2) if off[j] > RATIO_SHARE]
         flipped = [j for j in joints if fit.torque_scale[j] < 0]
@@ -371,7 +434,8 @@ def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: L
                       "joint torques (N m at the joint: motor torque x ratio)")
         problems.insert(0, ", ".join(f"tau{j + 1}" for j in joints) + " fit markedly better scaled by "
                         + ", ".join(f"{fit.torque_scale[j]:.4g}" for j in joints)
-                        + " against tau1 (residual " + ", ".join(f"{100 * s:.2g} %" for s in fit.rms / fit.torque_rms)
+                        + " against tau1 (residual "
+                        + ", ".join(f"{100 * s:.2g} %" for s in fit.log_rms / fit.torque_rms)
                         + " -> " + ", ".join(f"{100 * s:.2g} %" for s in fit.scaled_rms / fit.torque_rms)
                         + f"): {cause}")
     return problems

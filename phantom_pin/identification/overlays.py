@@ -1,6 +1,6 @@
 """A Fit (estimation.estimate) as a --params overlay: the keys of the identified bodies, the
 friction where the joints agree, and what the fit is only valid with (its model and lengths),
-written as a YAML file with the fit in comments (docs/identification.md, step 8)."""
+written as a YAML file with the fit in comments (docs/identification.md, step 9)."""
 
 from __future__ import annotations
 
@@ -76,14 +76,19 @@ def write_overlay(path: Path | str, fit: Fit, source: str, keys: dict[str, objec
     lines = [f"# Identified by phantom-pin identify from {source} ({fit.structure} structure): a --params",
              "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
              "# (docs/identification.md). SI units.",
-             f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g}; "
-             "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms),
-             "# base parameters (estimate +- standard deviation; of the written parameters):"]
+             f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
+             "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms)]
+    lines += [f"# {line}" for line in fit.prediction.lines()]
+    lines += [f"# warning: {line}" for line in fit.prediction.warnings()]
+    lines += ["# base parameters (estimate with the prior +- standard deviation; of the written parameters; "
+              "of the log alone; the prior's):"]
     for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
         lines.append(f"#   beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written "
-                     f"{fit.written[k]:.6g}: {name}")
+                     f"{fit.written[k]:.6g}; log alone {fit.log_beta[k]:.6g}; prior {fit.prior_beta[k]:.6g}: {name}")
     lines += [f"# {note}" for note in notes]
     lines += [f"# problem, written with --accept: {problem}" for problem in fit.problems]
-    lines += ["# Directions the torques do not determine are kept near the model's values (the prior)."]
+    lines += ["# What the log does not excite comes from the model's values (the prior, within its stated "
+              f"{100 * fit.prediction.spread:.0f} % spread)." if np.isfinite(fit.prediction.spread) else
+              "# Directions the torques do not determine are kept near the model's values (the prior)."]
     lines += [f"{key}: {value!r}" for key, value in keys.items()]
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
