@@ -264,3 +264,20 @@ def test_one_input_type_per_way_of_making_a_phantom(tmp_path):
     with pytest.raises(InvalidInputError) as error:
         Phantom.from_description("premium_1_5")
     assert error.value.argument == "description"
+
+
+def test_a_prefixed_description_gives_the_same_phantom():
+    """describe(prefix=...) names every link and frame with the prefix (a second arm beside the
+    first): its Phantom computes exactly what the unprefixed one does (before, it raised
+    IndexError looking up report_s)."""
+    from phantom_pin import describe
+
+    theta = np.array([0.2, 0.6, 0.9])
+    for name in ("premium_1_5", "touch"):
+        plain, left = Phantom(name), Phantom(describe(name, prefix="left_"))
+        np.testing.assert_array_equal(left.forward_kinematics(theta), plain.forward_kinematics(theta))
+        np.testing.assert_allclose(left.gravity(theta), plain.gravity(theta), rtol=1e-14, atol=1e-16)
+    touch, left = Phantom("touch"), Phantom(describe("touch", prefix="left_"))
+    gimbal = np.array([0.3, -0.2, 0.5])
+    np.testing.assert_allclose(left.stylus_tip_pose(theta, gimbal), touch.stylus_tip_pose(theta, gimbal),
+                               rtol=0, atol=1e-15)

@@ -70,6 +70,7 @@ def _stub_modules(share: Path) -> dict[str, types.ModuleType]:
     modules["launch"].LaunchDescription = lambda entities: entities
     modules["launch.actions"].DeclareLaunchArgument = recorder("DeclareLaunchArgument")
     modules["launch.actions"].OpaqueFunction = recorder("OpaqueFunction")
+    modules["launch.actions"].ExecuteProcess = recorder("ExecuteProcess")
     modules["launch.substitutions"].LaunchConfiguration = LaunchConfiguration
     modules["launch_ros.actions"].Node = recorder("Node")
     return modules
@@ -83,22 +84,32 @@ def test_launch_file_shows_each_committed_robot(monkeypatch):
     spec = importlib.util.spec_from_file_location("display_launch", DESCRIPTION_DIR / "launch" / "display.launch.py")
     launch = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(launch)
-    argument, convention, gui, opaque = launch.generate_launch_description()
+    argument, convention, gui, node, opaque = launch.generate_launch_description()
     committed = sorted(p.stem for p in (DESCRIPTION_DIR / "urdf").glob("*.urdf") if not p.stem.endswith("_driver"))
     assert sorted(argument.choices) == committed == sorted(m.urdf.stem for m in MODELS.values())
     for robot in [argument.default_value, *argument.choices]:
-        publisher, gui_node, rviz = opaque.function({"robot": robot, "convention": "report", "gui": "true"})
+        publisher, gui_node, rviz = opaque.function({"robot": robot, "convention": "report", "gui": "true",
+                                                     "node": "false"})
         assert publisher.package == "robot_state_publisher" and gui_node.package == "joint_state_publisher_gui"
         assert publisher.parameters == [{"robot_description": (DESCRIPTION_DIR / "urdf" / f"{robot}.urdf").read_text()}]
     assert argument.default_value == "phantom_1_5"
     # the Touch in the drivers' convention, its joint_states from a running driver (no GUI)
     assert convention.choices == ["report", "driver"] and gui.default_value == "true"
-    publisher, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false"})
+    publisher, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false",
+                                       "node": "false"})
     assert publisher.parameters == [{"robot_description": (DESCRIPTION_DIR / "urdf" /
                                                            "phantom_touch_driver.urdf").read_text()}]
     assert rviz.package == "rviz2"
     with pytest.raises(RuntimeError, match="convention:=driver: no phantom_1_5_driver.urdf"):
-        opaque.function({"robot": "phantom_1_5", "convention": "driver", "gui": "true"})
+        opaque.function({"robot": "phantom_1_5", "convention": "driver", "gui": "true", "node": "false"})
+    # phantom_pin's node beside robot_state_publisher: the command line the README gives, which
+    # parses (the model is the robot's)
+    assert node.default_value == "false"
+    publisher, ours, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false",
+                                             "node": "true"})
+    assert ours.cmd == ["phantom-pin", "--model", "touch", "ros2"]
+    from phantom_pin.cli.app import parser
+    assert parser().parse_args(ours.cmd[1:]).run.__name__ == "ros2"
 
 
 @pytest.mark.colcon

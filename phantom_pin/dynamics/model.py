@@ -166,8 +166,8 @@ class Phantom:
             load_rotor_parameters(self.model, description.srdf)
         self.data = self.model.createData()
         self._tree_data = self.coupling.tree.createData()
-        self._frame_s = self.model.getFrameId("report_s")
-        self._frame_tip = self.model.getFrameId("tip")
+        self._frame_s = self.model.getFrameId(prefix + "report_s")
+        self._frame_tip = self.model.getFrameId(prefix + "tip")
         pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
         # report_s is fixed to the world: a copy of the model whose world is frame s gives
         # g_st and J^s directly (its joints' placements on the world premultiplied by g_s^-1)
@@ -182,7 +182,7 @@ class Phantom:
             six.gravity = gravity_of(self.config)
             six_data = six.createData()
             pin.framesForwardKinematics(six, six_data, pin.neutral(six))
-            self.stylus_model = _rooted_at(six, six_data.oMf[six.getFrameId("report_s")].inverse())
+            self.stylus_model = _rooted_at(six, six_data.oMf[six.getFrameId(prefix + "report_s")].inverse())
             self._stylus_data = self.stylus_model.createData()
             names = (*(f"{prefix}joint{j}" for j in (1, 2, 3)), *self.gimbal_joints)
             #: the six-joint model's q of (theta, g): q[order] = (theta1..3, g1..3)
@@ -367,7 +367,20 @@ class Phantom:
         q[..., self._order[:3]], q[..., self._order[3:]] = t, g
         return q
 
+    def _one_six(self, theta: np.ndarray, gimbal: np.ndarray) -> np.ndarray:
+        """The six-joint model's q of one finite (theta, gimbal) (the fast paths)."""
+        q = np.empty(6)
+        q[self._order[:3]], q[self._order[3:]] = theta, gimbal
+        return q
+
     def _stylus_frame(self, frame: int, theta: object, gimbal: object, jacobian: bool = False) -> np.ndarray:
+        model = self.stylus_model
+        if _one(theta) and _one(gimbal) and model is not None and not jacobian:  # the fast path
+            try:
+                pin.forwardKinematics(model, self._stylus_data, self._one_six(theta, gimbal))
+                return pin.updateFramePlacement(model, self._stylus_data, frame).homogeneous
+            except TypeError:
+                pass
         q = self._six(theta, gimbal)
         model, data = self._stylus()
 
@@ -449,6 +462,12 @@ class Phantom:
         passive gimbal's own torques are the hand's), instead of at ``locked_at``.
         """
         if gimbal is not None:
+            if _one(theta) and _one(gimbal) and self.stylus_model is not None:  # the fast path
+                try:
+                    return pin.computeGeneralizedGravity(self.stylus_model, self._stylus_data,
+                                                         self._one_six(theta, gimbal))[self._order[:3]]
+                except TypeError:
+                    pass
             q = self._six(theta, gimbal)
             model, data = self._stylus()
             out = _rows(pin.computeGeneralizedGravity, q.reshape(-1, 6), before=(model, data))

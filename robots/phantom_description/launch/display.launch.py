@@ -6,22 +6,28 @@ and rviz2.
     ros2 launch phantom_description display.launch.py robot:=phantom_touch  # the Touch / Omni
     # a Touch whose ROS driver publishes joint_states (waist, shoulder, elbow, yaw, pitch, roll):
     ros2 launch phantom_description display.launch.py robot:=phantom_touch convention:=driver gui:=false
+    # ... and phantom_pin's node beside it (pip install 'phantom_pin[ros2]'): gravity torques and poses
+    ros2 launch phantom_description display.launch.py robot:=phantom_touch convention:=driver gui:=false node:=true
 
 ``robot`` names a committed URDF of share/phantom_description/urdf (phantom_1_5,
 phantom_1_5_cad, phantom_touch). ``convention``: report (joint1..joint6, the report's theta and
 the raw gimbal angles) or driver (the drivers' joint names and conventions: urdf/ROBOT_driver.urdf,
-committed for the Touch). ``gui``: false leaves joint_states to a running driver.
+committed for the Touch). ``gui``: false leaves joint_states to a running driver. ``node``: true
+also runs ``phantom-pin --model MODEL ros2`` (phantom_pin.ros2: joint_states in; gravity_torque,
+gravity_torque_openhaptics, tip_pose, stylus_pose and model_joint_states out).
 """
 
 from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 ROBOTS = ("phantom_1_5", "phantom_1_5_cad", "phantom_touch")
+#: phantom_pin's model name of each robot (`phantom-pin --model`).
+MODELS = {"phantom_1_5": "premium_1_5", "phantom_1_5_cad": "premium_1_5_cad", "phantom_touch": "touch"}
 CONVENTIONS = ("report", "driver")
 
 
@@ -37,6 +43,8 @@ def _nodes(context):
                   parameters=[{"robot_description": urdf.read_text()}])]
     if LaunchConfiguration("gui").perform(context) == "true":
         nodes.append(Node(package="joint_state_publisher_gui", executable="joint_state_publisher_gui"))
+    if LaunchConfiguration("node").perform(context) == "true":
+        nodes.append(ExecuteProcess(cmd=["phantom-pin", "--model", MODELS[robot], "ros2"], output="screen"))
     return [*nodes, Node(package="rviz2", executable="rviz2", arguments=["-f", "base_link"])]
 
 
@@ -48,5 +56,7 @@ def generate_launch_description() -> LaunchDescription:
                               description="joint names: report (joint1..) or driver (waist, shoulder, elbow, ...)"),
         DeclareLaunchArgument("gui", default_value="true", choices=["true", "false"],
                               description="start joint_state_publisher_gui (false: a driver publishes joint_states)"),
+        DeclareLaunchArgument("node", default_value="false", choices=["true", "false"],
+                              description="also run phantom_pin's ROS 2 node (phantom-pin ros2)"),
         OpaqueFunction(function=_nodes),
     ])

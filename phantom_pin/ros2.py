@@ -1,0 +1,232 @@
+"""A ROS 2 node: the drivers' joint_states in, the gravity torques and the tip's and stylus's
+poses out, per message, with the message's stamp (the ``ros2`` extra: rclpy and the message
+packages from PyPI).
+
+Input, ``joint_states`` (sensor_msgs/JointState): the Touch-era drivers' names (``waist,
+shoulder, elbow`` with the elbow relative to the shoulder, and, for a model with a stylus
+gimbal, ``yaw, pitch, roll``, OpenHaptics' raw gimbal angles; phantom_pin.drivers), or the
+model's own (``joint1..joint3``, ``joint4..joint6``), each with the node's prefix. Other
+names are ignored; without the gimbal's names the gimbal is taken at its ``locked_at``.
+
+Output, every message carrying the input's header stamp:
+
+- ``gravity_torque`` (sensor_msgs/JointState): the joint torques that hold the arm (N m), as
+  effort on the input's own joint names: for the drivers' names the torques conjugate to
+  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3), tau the report's
+  (Phantom.gravity); for the model's names tau itself. Position and velocity are empty.
+- ``gravity_torque_openhaptics`` (sensor_msgs/JointState): the same torques as
+  HD_CURRENT_JOINT_TORQUE takes them (mN m, on OpenHaptics' angles and signs:
+  drivers.openhaptics_torque_from_tau), named ``turret, thigh, shin`` (OpenHaptics' guide).
+- ``tip_pose`` (geometry_msgs/PoseStamped): the tool frame t (the gimbal centre) in
+  ``base_link`` (REP-103: x forward, y left, z up; metres).
+- ``stylus_pose`` (geometry_msgs/PoseStamped, a model with a gimbal): the stylus tip, with the
+  stylus's orientation (Phantom.stylus_tip_pose), in ``base_link``.
+- ``model_joint_states`` (sensor_msgs/JointState): every joint of the model's URDF (the mimic
+  joints of the parallelogram included), rad, for robot_state_publisher with that URDF.
+
+A message with a missing name, a length that does not match its names, a value that is not
+finite or an angle more than a turn beyond the stops is dropped with one warning per second
+naming the field; the node keeps running. Quality of service: the subscription is best effort
+(a 1 kHz sensor stream: it matches reliable and best-effort publishers alike), depth 1000 (1 s
+at 1 kHz, so that a burst is not lost); the publishers reliable, depth 1000.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from phantom_pin import drivers
+from phantom_pin.config.types import GIMBAL_JOINTS, JOINTS
+from phantom_pin.dynamics.coupling import Coupling
+from phantom_pin.dynamics.model import Phantom
+from phantom_pin.exceptions import InvalidInputError
+
+#: The topics, by role: the input and the five outputs (module doc), relative names.
+TOPICS = {"joint_states": "joint_states", "gravity_torque": "gravity_torque",
+          "gravity_torque_openhaptics": "gravity_torque_openhaptics", "tip_pose": "tip_pose",
+          "stylus_pose": "stylus_pose", "model_joint_states": "model_joint_states"}
+#: OpenHaptics' names of its three joints (its reference guide: "Turet Left +, Thigh Up +, Shin Up +").
+OPENHAPTICS_NAMES = ("turret", "thigh", "shin")
+#: A message is dropped when an angle lies more than this beyond its stop (rad): a turn.
+BEYOND = 2 * math.pi
+#: Queue depth of the subscription and the publishers (messages): 1 s at 1 kHz.
+DEPTH = 1000
+
+
+@dataclasses.dataclass(frozen=True)
+class Output:
+    """What one joint_states message gives: the input's names and the gravity torques on them
+    (N m), OpenHaptics' torques (mN m), the tip's and the stylus's poses in base_link ((4, 4)
+    m; the stylus's None without a gimbal) and the model's every joint (names, rad)."""
+
+    names: tuple[str, ...]
+    effort: np.ndarray
+    openhaptics: np.ndarray
+    tip: np.ndarray
+    stylus: np.ndarray | None
+    model_names: tuple[str, ...]
+    model_positions: np.ndarray
+
+
+class Bridge:
+    """The node's computation, without ROS: ``__call__(names, positions)`` -> Output, or
+    InvalidInputError naming the field of a message that must be dropped. The joint and frame
+    names carry the prefix of the Phantom's description (describe(..., prefix=...))."""
+
+    def __init__(self, phantom: Phantom) -> None:
+        if not isinstance(phantom, Phantom):
+            raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
+        self.phantom = phantom
+        self.prefix = prefix = phantom.description.prefix
+        config = phantom.config
+        self.gimbal = config.gimbal
+        self.driver_names = tuple(prefix + n for n in drivers.JOINT_STATE_NAMES)
+        self.driver_gimbal = tuple(prefix + n for n in drivers.GIMBAL_STATE_NAMES)
+        self.model_arm = tuple(prefix + n for n in JOINTS)
+        self.model_gimbal = tuple(prefix + n for n in GIMBAL_JOINTS)
+        # box of each input angle: the stops a turn wide on each side (theta; the gimbal's ranges)
+        stops = config.limits.stops
+        self.lower = np.array([*stops.lower, *(self.gimbal.lower if self.gimbal else ())]) - BEYOND
+        self.upper = np.array([*stops.upper, *(self.gimbal.upper if self.gimbal else ())]) + BEYOND
+        description = phantom.description
+        self.full = Coupling(description.urdf)  # every joint of the URDF, the gimbal free
+        self.model_names = tuple(self.full.tree.names[1:])
+        # base_link <- frame s: poses of Phantom (frame s) to base_link (REP-103)
+        data = phantom.model.createData()
+        pin.framesForwardKinematics(phantom.model, data, pin.neutral(phantom.model))
+        self.base_from_s = data.oMf[phantom.model.getFrameId(prefix + "report_s")].homogeneous.copy()
+
+    def _values(self, names: Sequence[str], positions: Sequence[float]) -> tuple[dict[str, float], bool]:
+        """The input by name, and whether it uses the drivers' names (else the model's)."""
+        given = list(names)
+        if len(positions) != len(given):
+            raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
+        values = dict(zip(given, (float(p) for p in positions)))
+        driver = all(n in values for n in self.driver_names)
+        if not driver and not all(n in values for n in self.model_arm):
+            raise InvalidInputError(f"missing {', '.join(n for n in self.driver_names if n not in values)} (or "
+                                    f"{', '.join(self.model_arm)}), in {given}", argument="name")
+        return values, driver
+
+    def __call__(self, names: Sequence[str], positions: Sequence[float]) -> Output:
+        values, driver = self._values(names, positions)
+        arm = [values[n] for n in (self.driver_names if driver else self.model_arm)]
+        theta = np.array([arm[0], arm[1], arm[1] + arm[2]]) if driver else np.array(arm)
+        gimbal_names = self.driver_gimbal if driver else self.model_gimbal
+        gimbal = None
+        if self.gimbal is not None and all(n in values for n in gimbal_names):
+            gimbal = np.array([values[n] for n in gimbal_names])  # raw angles (the Touch-era drivers')
+        state = np.concatenate([theta, gimbal if gimbal is not None else
+                                (self.gimbal.locked_at if self.gimbal else [])])
+        if not np.isfinite(state).all():
+            raise InvalidInputError("not finite (NaN or inf)", argument="position")
+        outside = [i for i in range(len(state)) if not self.lower[i] <= state[i] <= self.upper[i]]
+        if outside:
+            label = ("theta1", "theta2", "theta3", "gimbal1", "gimbal2", "gimbal3")[outside[0]]
+            raise InvalidInputError(f"{label} = {state[outside[0]]:.4g} rad is more than a turn beyond its stop",
+                                    argument="position")
+        phantom = self.phantom
+        tau = phantom.gravity(theta) if gimbal is None else phantom.gravity(theta, gimbal)
+        effort = np.array([tau[0], tau[1] + tau[2], tau[2]]) if driver else tau
+        tip = self.base_from_s @ phantom.forward_kinematics(theta)
+        stylus = None if gimbal is None else self.base_from_s @ phantom.stylus_tip_pose(theta, gimbal)
+        return Output(tuple(self.driver_names if driver else self.model_arm), effort,
+                      drivers.openhaptics_torque_from_tau(tau), tip, stylus, self.model_names,
+                      self.full.configuration(state))
+
+
+def _pose(message, pose: np.ndarray, stamp, frame: str) -> None:
+    """Fill a geometry_msgs/PoseStamped from a (4, 4) pose (m)."""
+    message.header.stamp, message.header.frame_id = stamp, frame
+    p = message.pose.position
+    p.x, p.y, p.z = (float(v) for v in pose[:3, 3])
+    q = pin.Quaternion(pose[:3, :3])
+    o = message.pose.orientation
+    o.x, o.y, o.z, o.w = float(q.x), float(q.y), float(q.z), float(q.w)
+
+
+def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: str = "phantom_pin"):
+    """The rclpy node (rclpy.init must have run): subscribes TOPICS["joint_states"] (renamed by
+    ``topics``) and publishes the module doc's outputs per message; names with the prefix of
+    the Phantom's description."""
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.node import Node
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+
+    bridge = Bridge(phantom)
+    prefix = bridge.prefix
+    names = {**TOPICS, **(topics or {})}
+    unknown = sorted(set(names) - set(TOPICS))
+    if unknown:
+        raise InvalidInputError(f"unknown topic roles {unknown} (known: {', '.join(TOPICS)})", argument="topics")
+    base = prefix + "base_link"
+
+    class GravityNode(Node):
+        def __init__(self) -> None:
+            super().__init__(name)
+            reliable = QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+            self.outputs = {role: self.create_publisher(kind, names[role], reliable) for role, kind in (
+                ("gravity_torque", JointState), ("gravity_torque_openhaptics", JointState),
+                ("tip_pose", PoseStamped), ("model_joint_states", JointState),
+                *((("stylus_pose", PoseStamped),) if bridge.gimbal is not None else ()))}
+            self.create_subscription(JointState, names["joint_states"], self.on_joint_states,
+                                     QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT))
+            self.dropped = 0
+
+        def on_joint_states(self, message) -> None:
+            try:
+                out = bridge(message.name, message.position)
+            except InvalidInputError as error:
+                self.dropped += 1
+                self.get_logger().warning(f"dropped a joint_states message: {error}", throttle_duration_sec=1.0)
+                return
+            stamp = message.header.stamp
+            effort = JointState()
+            effort.header.stamp, effort.header.frame_id = stamp, message.header.frame_id
+            effort.name, effort.effort = list(out.names), [float(v) for v in out.effort]
+            self.outputs["gravity_torque"].publish(effort)
+            hd = JointState()
+            hd.header.stamp = stamp
+            hd.name, hd.effort = [prefix + n for n in OPENHAPTICS_NAMES], [float(v) for v in out.openhaptics]
+            self.outputs["gravity_torque_openhaptics"].publish(hd)
+            tip = PoseStamped()
+            _pose(tip, out.tip, stamp, base)
+            self.outputs["tip_pose"].publish(tip)
+            if out.stylus is not None:
+                stylus = PoseStamped()
+                _pose(stylus, out.stylus, stamp, base)
+                self.outputs["stylus_pose"].publish(stylus)
+            full = JointState()
+            full.header.stamp = stamp
+            full.name, full.position = list(out.model_names), [float(v) for v in out.model_positions]
+            self.outputs["model_joint_states"].publish(full)
+
+    return GravityNode()
+
+
+def spin(phantom: Phantom, topics: Mapping[str, str] | None = None) -> int:
+    """Run the node until SIGINT or SIGTERM (rclpy's signal handlers shut the context down);
+    0 on a clean stop."""
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.signals import SignalHandlerOptions
+
+    rclpy.init(signal_handler_options=SignalHandlerOptions.ALL)
+    try:
+        node = make_node(phantom, topics)
+        node.get_logger().info(f"phantom_pin {phantom.config.name}: {TOPICS['joint_states']} -> gravity, poses")
+        try:
+            rclpy.spin(node)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            pass
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.try_shutdown()
+    return 0

@@ -1,0 +1,260 @@
+"""The ROS 2 node (phantom_pin.ros2, `phantom-pin ros2`): its computation against the closed form,
+the gimbal's rigid-body reference and the URDF's mimic semantics written here; then the real
+node over loopback with the real rclpy (PyPI's wheels): a driver's joint_states replayed at
+1 kHz for 2 s, every message it publishes checked, counted and timed, bad messages dropped
+with a warning, and a clean stop on SIGINT and SIGTERM."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+from gimbal_reference import gimbal_gravity, openhaptics, ubitrack
+from helpers import CONFIG_DIR
+from phantom_pin import InvalidInputError, Phantom, closed_form
+from phantom_pin.ros2 import Bridge
+
+TOUCH = CONFIG_DIR.parent / "touch"
+KINEMATICS = yaml.safe_load((TOUCH / "kinematics.yaml").read_text())
+GIMBAL = yaml.safe_load((TOUCH / "gimbal.yaml").read_text())
+LIMITS = yaml.safe_load((TOUCH / "joint_limits.yaml").read_text())["stops"]
+DRIVER = ("waist", "shoulder", "elbow", "yaw", "pitch", "roll")
+
+
+@pytest.fixture(scope="module")
+def touch() -> Phantom:
+    return Phantom("touch")
+
+
+def driver_states(n: int, seed: int) -> np.ndarray:
+    """``n`` seeded joint_states positions in the drivers' convention (waist, shoulder, elbow =
+    theta3 - theta2, raw gimbal), inside the Touch's stops and gimbal ranges (its YAML)."""
+    rng = np.random.default_rng(seed)
+    joints = ("joint1", "joint2", "joint3")
+    theta = rng.uniform([LIMITS[j]["lower"] for j in joints], [LIMITS[j]["upper"] for j in joints], (8 * n, 3))
+    keep = ((theta[:, 1] - theta[:, 2] <= LIMITS["theta2_minus_theta3_max"])
+            & (theta[:, 2] - theta[:, 1] <= LIMITS["theta3_minus_theta2_max"]))
+    theta = theta[keep][:n]
+    ranges = GIMBAL["joints"]
+    g = rng.uniform([ranges[j]["lower"] for j in ("joint4", "joint5", "joint6")],
+                    [ranges[j]["upper"] for j in ("joint4", "joint5", "joint6")], (n, 3))
+    return np.column_stack([theta[:, 0], theta[:, 1], theta[:, 2] - theta[:, 1], g])
+
+
+def base_from_s() -> np.ndarray:
+    """report_s in base_link (the macro's frame: at (l1, 0, -l2), the report's x, y, z along
+    base_link's y, z, x)."""
+    out = np.eye(4)
+    out[:3, :3] = [[0, 0, 1], [1, 0, 0], [0, 1, 0]]
+    out[:3, 3] = KINEMATICS["l1"], 0, -KINEMATICS["l2"]
+    return out
+
+
+def expected(report, position: np.ndarray) -> dict:
+    """What the node must publish for one drivers' message, from the closed form (eqs 10, 93-94),
+    the gimbal's reference load and Ubitrack's stylus rotation, and the URDF's mimic tags."""
+    waist, shoulder, elbow, *g = position
+    theta, g = np.array([waist, shoulder, shoulder + elbow]), np.array(g)
+    tau = closed_form.gravity(theta, report) + gimbal_gravity(theta, g)
+    tip = base_from_s() @ closed_form.forward_kinematics(theta, report)
+    position_s, rotation = ubitrack(openhaptics(theta, g))
+    stylus = np.eye(4)
+    stylus[:3, :3], stylus[:3, 3] = rotation, position_s - GIMBAL["tip_offset"] * rotation[:, 2]
+    model = {"joint1": theta[0], "joint2": theta[1], "joint3": theta[2], "crank_pin_a": -theta[2],
+             "crank_pin_b": theta[1], "forearm_pin_a": -theta[1], "forearm_pin_b": theta[2],
+             "joint4": g[0], "joint5": g[1], "joint6": g[2]}
+    return {"effort": np.array([tau[0], tau[1] + tau[2], tau[2]]),
+            "openhaptics": 1000 * np.array([-tau[0], tau[1], tau[2]]),
+            "tip": tip, "stylus": base_from_s() @ stylus, "model": model}
+
+
+def test_the_bridge_gives_the_closed_forms_torques_and_poses(touch):
+    """The drivers' six names, shuffled among others: effort conjugate to the drivers'
+    coordinates, OpenHaptics' mN m, the tip and the stylus tip in base_link, every URDF joint:
+    1e-12 (N m, mN m to 1e-9, m)."""
+    bridge = Bridge(touch)
+    names = ["roll", "extra", "elbow", "waist", "yaw", "shoulder", "pitch"]
+    for position in driver_states(100, seed=1):
+        values = dict(zip(DRIVER, position))
+        out = bridge(names, [values.get(n, 7.0) for n in names])
+        reference = expected(touch.config.report, position)
+        assert out.names == ("waist", "shoulder", "elbow")
+        assert np.abs(out.effort - reference["effort"]).max() < 1e-12
+        assert np.abs(out.openhaptics - reference["openhaptics"]).max() < 1e-9
+        assert np.abs(out.tip - reference["tip"]).max() < 1e-12
+        assert np.abs(out.stylus - reference["stylus"]).max() < 1e-12
+        assert dict(zip(out.model_names, out.model_positions)) == pytest.approx(reference["model"], abs=1e-15)
+
+
+def test_the_bridge_takes_the_models_names_and_a_prefix(touch):  # noqa: ARG001
+    """joint1..joint6 with a prefix: the torques are the report's tau themselves."""
+    from phantom_pin import describe
+
+    bridge = Bridge(Phantom(describe("touch", prefix="left_")))
+    position = driver_states(1, seed=2)[0]
+    theta = [position[0], position[1], position[1] + position[2]]
+    out = bridge([f"left_joint{k}" for k in range(1, 7)], [*theta, *position[3:]])
+    tau = closed_form.gravity(np.array(theta), touch.config.report) + gimbal_gravity(np.array(theta), position[3:])
+    assert out.names == ("left_joint1", "left_joint2", "left_joint3") and np.abs(out.effort - tau).max() < 1e-12
+
+
+@pytest.mark.parametrize("names, position, field", [
+    (["waist", "shoulder"], [0.1, 0.2], "name"),
+    (list(DRIVER), [0.1, 0.2, 0.3], "position"),
+    (list(DRIVER), [0.1, float("nan"), 0.3, 0, 0, 0], "position"),
+    (list(DRIVER), [0.1, 0.2, 0.3, 0, 12.0, 0], "position"),
+    (list(DRIVER), [-9.0, 0.2, 0.3, 0, 0, 0], "position"),
+])
+def test_a_bad_message_is_refused_naming_its_field(touch, names, position, field):
+    with pytest.raises(InvalidInputError) as error:
+        Bridge(touch)(names, position)
+    assert error.value.argument == field
+
+
+# -- the real node over loopback ------------------------------------------------------------------
+
+RATE, SECONDS = 1000.0, 2.0
+
+
+def _environment() -> dict[str, str]:
+    """Loopback only, and a ROS domain of this test run alone."""
+    return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+            "ROS_DOMAIN_ID": str(1 + os.getpid() % 100), "PYTHONUNBUFFERED": "1"}
+
+
+def _start_node() -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "--model", "touch", "ros2"],
+                            env=_environment(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _stop(process: subprocess.Popen, sig: int) -> tuple[int, str]:
+    process.send_signal(sig)
+    try:
+        _, err = process.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+        raise AssertionError(f"the node did not stop on signal {sig}: {err}") from None
+    return process.returncode, err
+
+
+def test_the_node_answers_a_1khz_driver_stream_over_loopback(touch):
+    """2000 drivers' messages at 1 kHz: every one answered on every topic with its stamp and
+    frame, equal to the closed form (1e-12); a bad message dropped with one warning naming its
+    field, the node still answering; SIGTERM stops it cleanly. The node's latency per message
+    (when it published its answer minus the input's stamp, both the system clock) printed."""
+    os.environ.update({k: v for k, v in _environment().items() if k.startswith("ROS_")})
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+
+    process = _start_node()
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    try:
+        node = rclpy.create_node("driver_replay", context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        qos = QoSProfile(depth=5000, reliability=ReliabilityPolicy.RELIABLE)
+        publisher = node.create_publisher(JointState, "joint_states", qos)
+        received: dict[str, list] = {t: [] for t in ("gravity_torque", "gravity_torque_openhaptics", "tip_pose",
+                                                       "stylus_pose", "model_joint_states")}
+        clock = node.get_clock()
+        for topic, kind in (("gravity_torque", JointState), ("gravity_torque_openhaptics", JointState),
+                            ("tip_pose", PoseStamped), ("stylus_pose", PoseStamped),
+                            ("model_joint_states", JointState)):
+            # the message info's source timestamp: when the node published it (ns, the system clock)
+            node.create_subscription(kind, topic, lambda m, info, t=topic: received[t].append(
+                (m, info["source_timestamp"])), qos)
+        deadline = time.monotonic() + 30
+        while publisher.get_subscription_count() < 1 or any(
+                node.count_publishers(t) < 1 for t in received):
+            assert process.poll() is None, process.communicate()[1]
+            assert time.monotonic() < deadline, "the node did not appear on the loopback within 30 s"
+            executor.spin_once(timeout_sec=0.05)
+        time.sleep(0.5)  # discovery completes both ways
+        states = driver_states(int(RATE * SECONDS), seed=3)
+        start = time.monotonic()
+        for k, position in enumerate(states):
+            message = JointState()
+            message.header.stamp = clock.now().to_msg()
+            message.header.frame_id = f"{k}"
+            message.name, message.position = list(DRIVER), [float(v) for v in position]
+            publisher.publish(message)
+            while time.monotonic() < start + (k + 1) / RATE:
+                executor.spin_once(timeout_sec=0)
+        end = time.monotonic() + 5
+        while time.monotonic() < end and min(len(v) for v in received.values()) < len(states):
+            executor.spin_once(timeout_sec=0.01)
+        counts = {t: len(v) for t, v in received.items()}
+        print(f"\nros2 node: {len(states)} messages at {RATE:.0f} Hz; received {counts}")
+        assert all(c == len(states) for c in counts.values()), counts
+        latencies = []
+        report = touch.config.report
+        for k, ((effort, at), (hd, _), (tip, _), (stylus, _), (full, _)) in enumerate(zip(*received.values())):
+            index = int(effort.header.frame_id)
+            stamp = effort.header.stamp
+            assert all(m.header.stamp == stamp for m in (hd, tip, stylus, full))
+            assert tip.header.frame_id == stylus.header.frame_id == "base_link"
+            latencies.append((at - (stamp.sec * 10**9 + stamp.nanosec)) * 1e-9)
+            if k % 10:
+                continue  # the reference is slow in Python: every tenth message
+            reference = expected(report, states[index])
+            assert list(effort.name) == ["waist", "shoulder", "elbow"]
+            assert np.abs(np.array(effort.effort) - reference["effort"]).max() < 1e-12
+            assert np.abs(np.array(hd.effort) - reference["openhaptics"]).max() < 1e-9
+            for pose, want in ((tip, reference["tip"]), (stylus, reference["stylus"])):
+                p, q = pose.pose.position, pose.pose.orientation
+                assert np.abs(np.array([p.x, p.y, p.z]) - want[:3, 3]).max() < 1e-12
+                w, x, y, z = q.w, q.x, q.y, q.z
+                rotation = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+                assert np.abs(rotation - want[:3, :3]).max() < 1e-12
+            assert dict(zip(full.name, full.position)) == pytest.approx(reference["model"], abs=1e-15)
+        median, p99 = np.percentile(latencies, [50, 99]) * 1e3
+        first = received["tip_pose"][0][0].header.stamp
+        span = (received["tip_pose"][-1][1] - (first.sec * 10**9 + first.nanosec)) * 1e-9
+        print(f"ros2 node latency per message: median {median:.2f} ms, 99th percentile {p99:.2f} ms; "
+              f"{len(states) / span:.0f} messages answered per second")
+        # bad messages: dropped, one warning naming the field, the node still answers
+        before = len(received["tip_pose"])
+        for bad in ([0.1, float("nan"), 0.3, 0, 0, 0], [0.1, 0.2]):
+            message = JointState()
+            message.name, message.position = list(DRIVER), bad
+            publisher.publish(message)
+        good = JointState()
+        good.header.stamp = clock.now().to_msg()
+        good.name, good.position = list(DRIVER), [float(v) for v in states[0]]
+        publisher.publish(good)
+        end = time.monotonic() + 5
+        while time.monotonic() < end and len(received["tip_pose"]) < before + 1:
+            executor.spin_once(timeout_sec=0.01)
+        assert len(received["tip_pose"]) == before + 1 and process.poll() is None
+    finally:
+        rclpy.try_shutdown(context=context)
+        code, err = _stop(process, signal.SIGTERM)
+    warnings = [line for line in err.splitlines() if "dropped a joint_states message" in line]
+    assert len(warnings) == 1 and "position" in warnings[0], err  # throttled: one per second
+    assert code == 0, err
+
+
+def test_the_node_stops_cleanly_on_sigint_and_refuses_bad_arguments_in_one_line():
+    process = _start_node()
+    time.sleep(3)
+    assert process.poll() is None, process.communicate()[1]
+    code, err = _stop(process, signal.SIGINT)
+    assert code == 0 and "Traceback" not in err, err
+    result = subprocess.run([sys.executable, "-m", "phantom_pin.cli", "ros2", "--topic", "bogus=x"],
+                            env=_environment(), capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert "--topic" in result.stderr
