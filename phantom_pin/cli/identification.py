@@ -47,6 +47,17 @@ def _writable(path: Path) -> None:
         raise PhantomPinError(f"--output: cannot write in {folder}")
 
 
+def _delay(text: str | None) -> float | None:
+    """--delay's seconds (None: estimate it), checked by estimation.delay_argument."""
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise PhantomPinError(f"--delay: expected seconds (a number such as 0.001), got {text!r}") from None
+    return estimation.delay_argument(value)
+
+
 def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add the excite and identify subcommands to the phantom-pin parser."""
     excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
@@ -66,13 +77,17 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
-    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread"})
+    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread",
+                                                                 "delay": "--delay"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "
                                "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
+    identify.add_argument("--delay", default=None, metavar="SECONDS",
+                          help="how long after the positions they belong to the torques were logged, s (default: "
+                               "estimated from the log, between -5 and +5 ms); corrected for in the fit")
     identify.add_argument("--structure", choices=("general", "report"), default="general",
                           help="general: the rigid body in full, every identifiable base parameter (default); "
                                "report: the report's eight constants (a model in the report's form)")
@@ -158,11 +173,12 @@ def identify_command(args: argparse.Namespace) -> int:
                               "gives its links in full (use --structure general)")
     if not (math.isfinite(args.cutoff) and args.cutoff > 0):
         raise PhantomPinError(f"--cutoff: expected a finite positive frequency (Hz), got {args.cutoff!r}")
+    delay = _delay(args.delay)
     log = io.read_log(args.log, args.convention)
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
-                                  timing=args.torque_timing, prior_spread=args.prior_spread)
+                                  timing=args.torque_timing, prior_spread=args.prior_spread, delay=delay)
     finally:
         bar.close()
     if fit.problems and not args.accept:
@@ -172,6 +188,8 @@ def identify_command(args: argparse.Namespace) -> int:
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
           f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
           "(a diagnostic: the fit is judged by its predicted torques)")
+    for line in fit.timing_lines():
+        print(line)
     for line in fit.prediction.lines():
         print(line)
     print("residual RMS per joint [N m]: " + ", ".join(
@@ -196,6 +214,8 @@ def identify_command(args: argparse.Namespace) -> int:
         print(note)
     for warning in fit.prediction.warnings():
         print(f"warning: {warning}")
+    if fit.timing_warning() is not None:
+        print(f"warning: {fit.timing_warning()}")
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
     write_overlay(args.output, fit, args.log.name, keys, notes)

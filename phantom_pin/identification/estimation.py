@@ -76,7 +76,10 @@ class Samples:
     """The filtered log at its kept samples: theta (N, 3) rad, dtheta rad/s, ddtheta rad/s^2,
     tau N m, the regressor's friction columns filtered as tau, ``friction`` (N, 3, 6):
     viscous1..3 then coulomb1..3, and ``moving`` (N, 3): whether each joint's equation is
-    fitted (its rate stays above MIN_SPEED over the filter's span around the sample)."""
+    fitted (its rate stays above MIN_SPEED over the filter's span around the sample);
+    ``filtered_tau`` the filtered torques at every logged sample (N m, before the timing's and
+    the delay's shift), ``index`` the kept samples' rows in the log, ``rate`` the log's (Hz):
+    what ``lagged`` reads the torques at another lag from."""
 
     theta: np.ndarray
     dtheta: np.ndarray
@@ -84,6 +87,9 @@ class Samples:
     tau: np.ndarray
     friction: np.ndarray
     moving: np.ndarray
+    filtered_tau: np.ndarray | None = None
+    index: np.ndarray | None = None
+    rate: float = 0.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -105,7 +111,11 @@ class Fit:
     and ``log_sigma`` the log's alone (inf where it leaves a direction unconstrained), ``log_rms``
     its residual RMS per joint (N m: whether the torques follow the motion at all);
     ``prediction``: the predicted torque uncertainty of the written parameters
-    (prediction.Prediction)."""
+    (prediction.Prediction). ``delay`` (s): how long after their positions the torques were
+    logged, corrected for in the fit; ``delay_estimated``: whether it came from the log;
+    ``timing`` the torque timing fitted (TIMINGS); ``timing_residual``: each timing's weighted
+    residual (the sum over the joints of the residual's mean square over the torque's, at zero
+    delay when it is estimated, else at the given one), the smaller fitting the log better."""
 
     structure: str
     names: tuple[str, ...]
@@ -129,6 +139,41 @@ class Fit:
     log_sigma: np.ndarray
     log_rms: np.ndarray
     prediction: Prediction
+    delay: float = 0.0
+    delay_estimated: bool = False
+    timing: str = "held"
+    timing_residual: dict[str, float] = dataclasses.field(default_factory=dict)
+
+    def timing_lines(self) -> list[str]:
+        """The delay (estimated or given, ms) and which timing fits the log better, one line each."""
+        how = "estimated from the log" if self.delay_estimated else "given"
+        lines = [f"delay between positions and torques: {1e3 * self.delay:.3f} ms ({how}; the torques are read "
+                 f"that long after their positions, then the {self.timing} timing's lag)"]
+        if len(self.timing_residual) == 2:
+            best = min(self.timing_residual, key=lambda name: self.timing_residual[name])
+            at = "no delay" if self.delay_estimated else f"the given {1e3 * self.delay:.3g} ms delay"
+            lines.append(f"torque timing: {best} fits the log better with {at} (weighted residual: "
+                         + ", ".join(f"{name} {100 * np.sqrt(value / 3):.3g} %" for name, value in
+                                     self.timing_residual.items())
+                         + f" of the torque RMS); identified as {self.timing}"
+                         + ("; the estimated delay absorbs the timings' half-sample difference" if
+                            self.delay_estimated else ""))
+        return lines
+
+    def timing_warning(self) -> str | None:
+        """One line when the timing given fits the log worse than the other by more than
+        TIMING_MARGIN of its weighted residual, else None."""
+        if len(self.timing_residual) != 2:
+            return None
+        other = next(name for name in self.timing_residual if name != self.timing)
+        chosen, alternative = self.timing_residual[self.timing], self.timing_residual[other]
+        if chosen <= (1 + TIMING_MARGIN) * alternative:
+            return None
+        return (f"--torque-timing {self.timing} fits the log worse than {other} (weighted residual "
+                f"{chosen / alternative:.3g} times, more than {1 + TIMING_MARGIN:g})"
+                + (f" with no delay: the estimated delay, {1e3 * self.delay:.3f} ms, takes up the half sample "
+                   f"between them; if the log has no delay, identify with --torque-timing {other}"
+                   if self.delay_estimated else f"; identify with --torque-timing {other}"))
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:
@@ -159,11 +204,70 @@ MIN_SPEED = 0.01
 #: next (a servo loop's zero-order hold: the default), or "sampled", the torque at that instant
 #: (a torque sensor, or torques computed from the motion).
 TIMINGS = ("held", "sampled")
+#: The lag (in samples) of each timing's torque behind the positions it belongs to.
+HOLD = {"held": 0.5, "sampled": 0.0}
+#: The delays (s) the estimate searches: torques logged up to 5 ms before or after the
+#: positions they belong to (a servo loop at 1 kHz logs within a few samples); found on a grid
+#: of GRID_STEP s, then refined by a parabola through the grid's best three (sub-sample).
+DELAY_BRACKET, GRID_STEP = (-5e-3, 5e-3), 2.5e-4
+#: The delays (s) estimate accepts when given: from the bracket's start to a tenth of a second
+#: (less than the filter's edge cut, EDGE: the shifted torques stay inside the log).
+DELAY_RANGE = (DELAY_BRACKET[0], 0.1)
+#: The timing given fits "markedly" worse than the other when its weighted residual (the sum
+#: of the joints' squared residual shares) exceeds the other's by this share: then a warning.
+TIMING_MARGIN = 0.05
 
 
-def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Samples:
+def delay_argument(delay: object) -> float | None:
+    """``delay`` (s) checked: None (estimate it) or a finite number in DELAY_RANGE;
+    InvalidInputError naming ``delay`` otherwise."""
+    if delay is None:
+        return None
+    if isinstance(delay, bool) or not isinstance(delay, (int, float, np.floating, np.integer)) \
+            or not np.isfinite(delay) or not DELAY_RANGE[0] <= delay <= DELAY_RANGE[1]:
+        raise InvalidInputError(f"expected seconds between {DELAY_RANGE[0]:g} and {DELAY_RANGE[1]:g} (the torques "
+                                f"logged that long after their positions), or None to estimate it; got {delay!r}",
+                                argument="delay")
+    return float(delay)
+
+
+def _criterion(phi: np.ndarray, moving: np.ndarray, torque_rms: np.ndarray) -> Callable[[np.ndarray], float]:
+    """The weighted residual of a fit of torques y (N, 3) on phi (N, 3, P) over the equations
+    ``moving``: the sum over the joints of the residual's mean square over their torque's
+    (torque_rms, N m), after the least-squares fit with those fixed weights (a projection,
+    factored once: the regressor does not depend on the lag)."""
+    weight = 1.0 / np.maximum(torque_rms, 1e-300)
+    mask = moving * weight
+    counts = np.maximum(moving.sum(axis=0), 1)
+    q = np.linalg.qr((phi * mask[..., None]).reshape(-1, phi.shape[-1]))[0]
+
+    def weighted(y: np.ndarray) -> float:
+        yw = (y * mask).reshape(-1)
+        r = (yw - q @ (q.T @ yw)).reshape(y.shape)
+        return float(((r**2).sum(axis=0) / counts).sum())
+    return weighted
+
+
+def _estimate_lag(samples: Samples, tau0: np.ndarray, weighted: Callable[[np.ndarray], float],
+                  hold: float) -> float:
+    """The delay (s) in DELAY_BRACKET whose shifted torques minimise ``weighted`` (grid, then a
+    parabola through the best three points), the timing's ``hold`` (samples) added to the lag."""
+    assert samples.filtered_tau is not None and samples.index is not None
+    grid = np.arange(DELAY_BRACKET[0], DELAY_BRACKET[1] + GRID_STEP / 2, GRID_STEP)
+    values = np.array([weighted(lagged(samples.filtered_tau, samples.rate, samples.index, hold / samples.rate - d)
+                                - tau0) for d in grid])
+    k = int(np.clip(np.argmin(values), 1, len(grid) - 2))
+    left, middle, right = values[k - 1:k + 2]
+    curvature = left - 2 * middle + right
+    step = 0.5 * (left - right) / curvature if curvature > 0 else 0.0
+    return float(grid[k] + np.clip(step, -1.0, 1.0) * GRID_STEP)
+
+
+def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay: float = 0.0) -> Samples:
     """The log filtered at ``cutoff`` (Hz), with the friction columns of ``law`` (Friction.torque
-    with unit coefficients), edges cut, decimated (module doc, step 1); ``timing`` (TIMINGS)."""
+    with unit coefficients), edges cut, decimated (module doc, step 1); ``timing`` (TIMINGS);
+    ``delay`` (s): the torques were logged that long after the positions they belong to, so
+    the torque of the positions at t_k is read at t_k + delay (then the hold's half sample)."""
     rate = log.rate
     if not 0 < cutoff * RATE_PER_CUTOFF <= rate:
         raise LogError(f"{cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
@@ -172,6 +276,7 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Sa
     sos = scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
     theta = scipy.signal.sosfiltfilt(sos, log.theta, axis=0)
     tau = scipy.signal.sosfiltfilt(sos, log.tau, axis=0)
+    smooth = tau
     if timing == "held":
         # the torque logged at t_k acts until t_k+1 (zero-order hold): low-passed, it is the
         # smooth signal half a period late; read it at t_k - 1/(2 rate), halfway back (without
@@ -188,7 +293,20 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held") -> Sa
     friction = friction_block(columns[keep])
     span = max(1, int(round(rate / cutoff)))
     slow = scipy.ndimage.maximum_filter1d((np.abs(dtheta) < MIN_SPEED).astype(np.uint8), 2 * span + 1, axis=0)
-    return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau[keep], friction, ~slow[keep].astype(bool))
+    index = np.arange(len(log.t))[keep]
+    tau = tau[keep] if delay == 0 else lagged(smooth, rate, index, HOLD[timing] / rate - delay)
+    return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau, friction, ~slow[keep].astype(bool),
+                   smooth, index, rate)
+
+
+def lagged(smooth: np.ndarray, rate: float, index: np.ndarray, lag: float) -> np.ndarray:
+    """The filtered torques ``smooth`` (N, 3; N m, at ``rate`` Hz) read ``lag`` seconds before
+    the samples ``index``, by linear interpolation (the torques are low-passed far below the
+    rate: at a 20 Hz cutoff and 1 kHz, interpolation errs by 0.2 % of the cutoff's component)."""
+    at = index - lag * rate
+    low = np.clip(np.floor(at).astype(int), 0, len(smooth) - 2)
+    share = np.clip(at - low, 0.0, 1.0)[:, None]
+    return (1 - share) * smooth[low] + share * smooth[low + 1]
 
 
 def _fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
@@ -274,7 +392,7 @@ MAX_TORQUE = 1e3
 
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",  # noqa: C901 (checks, then stages)
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
-             timing: str = "held", prior_spread: float = priors.SPREAD) -> Fit:
+             timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0) -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
     the prior, its friction law the friction columns): the base parameters of ``structure``
     ("general": the rigid body in full; "report": the report's structure, for a model in the
@@ -285,6 +403,14 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     ``timing``: how the torques relate to the times
     (TIMINGS: "held" commands, the default, or "sampled" values). ``prior_spread``: the prior's
     relative standard deviation of every physical parameter (prior.py; inf: the log alone).
+    ``delay`` (s): how long after the positions they belong to the torques were logged (the
+    torque of the positions at t is read at t + delay), or None to estimate it: the delay in
+    DELAY_BRACKET whose shifted torques leave the smallest weighted residual (_criterion). The
+    regressor does not depend on the delay, only the torques do; a wrong delay leaves about
+    (delay error) x dtau/dt in them, whose jerk-driven part no column of the regressor holds, so
+    the residual grows with the error on either side and its minimum is the true delay.
+    Both timings are also fitted (at zero delay when it is estimated, else at the given one):
+    ``Fit.timing_residual``, ``Fit.timing_lines``, ``Fit.timing_warning``.
     ``progress(share)`` is called as stages end."""
     def stage(share: float) -> None:
         if progress is not None:
@@ -298,6 +424,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
             raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
     spread = priors.spread_argument(prior_spread)
+    delay = delay_argument(delay)
     if progress is not None and not callable(progress):
         raise InvalidInputError(f"expected a callable (share) or None, got {progress!r}", argument="progress")
     duration = float(log.t[-1] - log.t[0])
@@ -325,7 +452,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise LogError(f"{', '.join(constant)}: constant torque{'s' if len(constant) > 1 else ''} over the whole "
                        "log: nothing to identify (the log must hold the torques commanded during the motion)")
     model = STRUCTURES[structure](phantom)
-    samples = filtered(log, cutoff, phantom.config.actuation.friction, timing)
+    samples = filtered(log, cutoff, phantom.config.actuation.friction, timing, 0.0 if delay is None else delay)
     stage(0.1)
     if len(samples.theta) < 50:
         raise LogError(f"too short: {len(samples.theta)} samples after filtering at {cutoff:g} Hz and cutting "
@@ -338,6 +465,17 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise LogError(f"too little motion: joint(s) {still} move faster than {MIN_SPEED} rad/s in fewer than 50 "
                        f"samples filtered at {cutoff:g} Hz; log an excitation trajectory (phantom-pin excite), or "
                        "filter less")
+    smooth, index = samples.filtered_tau, samples.index
+    assert smooth is not None and index is not None
+    weighted = _criterion(phi, moving, _rms(smooth[index] - tau0, moving))    # the same for any timing
+    estimated = delay is None
+    if delay is None:
+        delay = _estimate_lag(samples, tau0, weighted, HOLD[timing])
+        samples = dataclasses.replace(samples, tau=lagged(smooth, samples.rate, index,
+                                                          HOLD[timing] / samples.rate - delay))
+    at = 0.0 if estimated else delay
+    timing_residual = {name: weighted(lagged(smooth, samples.rate, index, HOLD[name] / samples.rate - at) - tau0)
+                       for name in TIMINGS}
     phi, y = phi * moving[..., None], (samples.tau - tau0) * moving
     stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)
@@ -365,7 +503,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
               model.overrides(x), comparison, scale, scaled_rms, (), beta0, log_beta,
               np.sqrt(np.diag(inverse_information(information))), _rms(y - phi @ log_beta, moving),
               judge(model.regressor_of, phantom.config.limits, phi, y, moving, written, covariance, beta0,
-                    information, priors.typical(model.matrix, model.scale), model.base_names, spread))
+                    information, priors.typical(model.matrix, model.scale), model.base_names, spread),
+              delay, estimated, timing, timing_residual)
     problems = _problems(fit, model, phi, y, log, phantom)
     stage(1.0)
     return dataclasses.replace(fit, problems=tuple(problems))
