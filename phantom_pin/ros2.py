@@ -216,22 +216,36 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
 
 
 def spin(phantom: Phantom, topics: Mapping[str, str] | None = None) -> int:
-    """Run the node until SIGINT or SIGTERM (rclpy's signal handlers shut the context down);
-    0 on a clean stop."""
+    """Run the node until SIGINT or SIGTERM; 0 on a clean stop. The executor spins in a thread;
+    the signals set a flag that the main thread reads every 0.1 s, then shuts the executor down
+    (rclpy's own handlers are not installed: with them, a SIGTERM now and then left the node
+    spinning in CI)."""
+    import signal
+    import threading
+
     import rclpy
-    from rclpy.executors import ExternalShutdownException
+    from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
-    rclpy.init(signal_handler_options=SignalHandlerOptions.ALL)
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     try:
         node = make_node(phantom, topics)
         node.get_logger().info(f"phantom_pin {phantom.config.name}: {TOPICS['joint_states']} -> gravity, poses")
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        worker = threading.Thread(target=executor.spin, name="phantom_pin executor", daemon=True)
+        worker.start()
         try:
-            rclpy.spin(node)
-        except (KeyboardInterrupt, ExternalShutdownException):
-            pass
+            while not stop.wait(0.1) and worker.is_alive():
+                pass
         finally:
+            executor.shutdown(timeout_sec=5.0)
+            worker.join(timeout=5.0)
             node.destroy_node()
     finally:
         rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return 0
