@@ -252,10 +252,23 @@ def test_the_node_answers_a_1khz_driver_stream_over_loopback(touch):
     assert code == 0, err
 
 
+def _wait_ready(process: subprocess.Popen, timeout: float = 60.0) -> None:
+    """Read the node's log until it says it spins (its model built, rclpy up)."""
+    import selectors
+
+    selector = selectors.DefaultSelector()
+    selector.register(process.stderr, selectors.EVENT_READ)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if selector.select(timeout=0.5) and "joint_states -> gravity" in process.stderr.readline():
+            return
+        assert process.poll() is None, process.communicate()[1]
+    raise AssertionError("the node did not start within 60 s")
+
+
 def test_the_node_stops_cleanly_on_sigint_and_refuses_bad_arguments_in_one_line():
     process = _start_node()
-    time.sleep(3)
-    assert process.poll() is None, process.communicate()[1]
+    _wait_ready(process)
     code, err = _stop(process, signal.SIGINT)
     assert code == 0 and "Traceback" not in err, err
     result = subprocess.run([sys.executable, "-m", "phantom_pin.cli", "ros2", "--topic", "bogus=x"],
