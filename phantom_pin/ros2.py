@@ -29,7 +29,7 @@ finite or an angle more than a turn beyond the stops is dropped with one warning
 naming the field; the node keeps running. Quality of service: the subscription is best effort
 (a 1 kHz sensor stream: it matches reliable and best-effort publishers alike), keep last 10: a
 node slower than the stream answers the newest messages, not a growing backlog (rclpy's Python
-executor answers about 770 messages per second on a 2-core machine, tests/test_ros2.py); the
+executor answers 690-840 messages per second on a 2-core machine, tests/test_ros2.py); the
 publishers reliable, depth 100.
 """
 

@@ -3,14 +3,13 @@
 The arm's 3-DoF dynamics (Phantom, simulate, Device, the identification) carry the gimbal and
 the stylus as a rigid load on the forearm, at the configuration's ``gimbal.locked_at``: their
 URDF is the description's with joint4..joint6 made fixed joints whose origins hold the
-rotation the angles give (Rodrigues' formula about each joint's axis). At those angles every
+rotation the angles give (pinocchio.exp3 about each joint's axis). At those angles every
 link's pose, and so the arm's mass matrix and gravity, equal the six-joint model's.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -23,14 +22,6 @@ from phantom_pin.exceptions import ParameterFileError
 
 if TYPE_CHECKING:
     from phantom_pin.description.build import Description
-
-
-def _rotation(axis: Sequence[float], angle: float) -> np.ndarray:
-    """Rodrigues' rotation (3, 3) by ``angle`` (rad) about the unit vector ``axis``."""
-    k = np.asarray(axis, float)
-    k = k / np.linalg.norm(k)
-    cross = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
 
 
 def locked(urdf_xml: str, prefix: str, angles: Sequence[float]) -> str:
@@ -47,7 +38,8 @@ def locked(urdf_xml: str, prefix: str, angles: Sequence[float]) -> str:
         if origin is None:
             origin = ET.SubElement(joint, "origin", {"xyz": "0 0 0"})
         rpy = np.array([float(v) for v in origin.get("rpy", "0 0 0").split()])
-        turned = pin.rpy.rpyToMatrix(rpy) @ _rotation(axis, float(angle))
+        direction = np.asarray(axis, float) / np.linalg.norm(axis)
+        turned = pin.rpy.rpyToMatrix(rpy) @ pin.exp3(direction * float(angle))  # Rodrigues' formula
         origin.set("rpy", " ".join(repr(float(v)) for v in pin.rpy.matrixToRpy(turned)))
         joint.set("type", "fixed")
         for tag in ("axis", "limit", "dynamics"):
