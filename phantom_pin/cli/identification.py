@@ -85,6 +85,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "
                                "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
+    identify.add_argument("--fixed-gains", action="store_true",
+                          help="take the log's torques as they are (default: estimate each joint's torque gain "
+                               "relative to joint 1, correct the model for it and report it)")
     identify.add_argument("--delay", default=None, metavar="SECONDS",
                           help="how long after the positions they belong to the torques were logged, s (default: "
                                "estimated from the log, between -5 and +5 ms); corrected for in the fit")
@@ -178,7 +181,8 @@ def identify_command(args: argparse.Namespace) -> int:
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
-                                  timing=args.torque_timing, prior_spread=args.prior_spread, delay=delay)
+                                  timing=args.torque_timing, prior_spread=args.prior_spread, delay=delay,
+                                  gains=not args.fixed_gains)
     finally:
         bar.close()
     if fit.problems and not args.accept:
@@ -188,7 +192,7 @@ def identify_command(args: argparse.Namespace) -> int:
     print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
           f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
           "(a diagnostic: the fit is judged by its predicted torques)")
-    for line in fit.timing_lines():
+    for line in fit.timing_lines() + fit.gain_lines():
         print(line)
     for line in fit.prediction.lines():
         print(line)
@@ -212,10 +216,8 @@ def identify_command(args: argparse.Namespace) -> int:
               f"{fit.prior_beta[k]:12.5g}  {unit:9} {name}")
     for note in notes:
         print(note)
-    for warning in fit.prediction.warnings():
+    for warning in fit.prediction.warnings() + [w for w in (fit.timing_warning(), fit.gain_warning()) if w]:
         print(f"warning: {warning}")
-    if fit.timing_warning() is not None:
-        print(f"warning: {fit.timing_warning()}")
     for problem in fit.problems:
         print(f"warning (written with --accept): {problem}")
     write_overlay(args.output, fit, args.log.name, keys, notes)

@@ -18,13 +18,22 @@ physically consistent parameters, and the checks that decide whether they may be
    the log alone's s^2 (Phi_w^T Phi_w)^-1 where the log excites everything, the prior's where
    it excites nothing. The base regressor's condition number (columns scaled to unit norm) is
    a diagnostic only: the fit is judged by the torques it predicts (prediction.py).
+   With ``gains`` (the default), each joint's torque gain relative to joint 1 is estimated
+   with beta (_solve_gains, a prior of 1 +- GAIN_SPREAD): the log's tau_j times g_j is the
+   joint's torque in joint 1's scale (a torque constant, amplifier gain or transmission ratio
+   off on one joint). Every link's parameters appear in several joints' equations (joint 1's
+   holds every link), so one joint's scale against the others is in the log; the overall
+   scale is not (all torques and all parameters scaled alike fit equally), hence joint 1 as
+   the reference. A gain is corrected where the log shows it differs from 1 (GAIN_EVIDENCE),
+   and beta estimated again with the others at 1.
 3. physical.nearest: the structure's parameters x (structures.py) whose base parameters are
    nearest to beta in the covariance's metric, with every link physical and friction >= 0.
 4. The checks (``Fit.problems``, each one line): a model that predicts the log worse than the
    prior, torques unrelated to the motion, a projection that moves an estimate far or flips
-   its sign, negative friction, torques whose size or sign disagree with the model's, joints
-   whose torques fit markedly better scaled (a wrong transmission ratio or amplifier sign),
-   angles far beyond the stops.
+   its sign, negative friction, torques whose size or sign disagree with the model's, a joint
+   whose gain is negative (amplifier polarity) or outside GAIN_BOUNDS (a unit), angles far
+   beyond the stops. The gains are reported (``Fit.gain_lines``); those corrected, with what
+   to write into the driver (``Fit.gain_warning``).
 """
 
 from __future__ import annotations
@@ -60,10 +69,23 @@ MAX_RESIDUAL_SHARE = 0.15
 MAX_SHIFT_SIGMA, SHIFT_SHARE = 10.0, 0.1
 #: The logged torques fit the model best scaled by s: refused outside these bounds (a unit).
 TORQUE_SCALE = (1 / 3, 3.0)
-#: A joint whose torque fits better scaled: flagged if the sum of the joints' squared residual
-#: shares drops below this share of the unscaled fit's and the scale differs from 1 by more
-#: than RATIO_SHARE.
-MARKED_IMPROVEMENT, RATIO_SHARE = 0.75, 0.01
+#: The prior's standard deviation of each joint's torque gain relative to joint 1 (module doc,
+#: step 2): a torque constant or amplifier gain is specified to a few percent, a transmission
+#: ratio misread (11.2 for 11.6) is 3.5 % off; the log decides (a 60 s log: +-0.05 %).
+GAIN_SPREAD = 0.05
+#: A relative gain outside these bounds is no tolerance but a mistake (a unit, another joint's
+#: ratio): refused; a negative one is a flipped amplifier.
+GAIN_BOUNDS = (0.5, 2.0)
+#: A gain is corrected (and the driver told: Fit.gain_warning) where the log shows it differs
+#: from 1: by more than GAIN_NOTED and GAIN_EVIDENCE standard deviations; else it stays 1 and
+#: the estimate is only reported. Four, not two or three: a closed-loop log's torque noise moves
+#: the joints it drives, which biases the estimate beyond its standard deviation (measured:
+#: -0.5 to -0.9 % on 60 s sum-of-sines logs with 1 % torque noise, 1-1.7 sigma; up to 3.5 sigma
+#: on excite's 10 s trajectory with 2 mN m); correcting such a gain would cost 0.5-0.9 % of
+#: held-out accuracy where the drives are right.
+GAIN_NOTED, GAIN_EVIDENCE = 0.005, 4.0
+#: Gauss-Newton steps of the gains at most, and the change of a gain's inverse that ends them.
+GAIN_ITERATIONS, GAIN_TOLERANCE = 20, 1e-10
 #: Angles further than this (rad) beyond the stops are not of the arm.
 BEYOND_STOPS = 0.2
 #: The report's structure needs the general model when it leaves more than this times the
@@ -104,8 +126,11 @@ class Fit:
     (Structure.names: the structure's, then viscous1..3 N m s/rad, coulomb1..3 N m),
     ``written`` = their beta, ``overrides`` their --params keys (without friction: overlays.overlay);
     ``comparison``: (name, residual RMS per joint, N m) of the other structure, or None;
-    ``torque_scale`` (3,): the factors each joint's logged torque fits best with (joint 1's
-    is 1), ``scaled_rms``: the residual with them; ``problems``: why the result should not be
+    ``gains`` (3,): each joint's torque gain relative to joint 1 as corrected (the log's tau_j
+    times gains_j is the torque the model predicts; joint 1's is 1; 1 where not corrected),
+    ``gains_estimated``: (estimates (3,), standard deviations (3,)), all 1 and 0 when not
+    estimated, ``ratios`` the model's transmission ratios (None: not public),
+    for the hint of a misread one; ``problems``: why the result should not be
     written (one line each; empty for a usable log). ``beta`` and ``sigma`` are the estimate
     with the prior (module doc, step 2): ``prior_beta`` the prior's base parameters, ``log_beta``
     and ``log_sigma`` the log's alone (inf where it leaves a direction unconstrained), ``log_rms``
@@ -131,8 +156,8 @@ class Fit:
     written: np.ndarray
     overrides: dict
     comparison: tuple[str, np.ndarray] | None
-    torque_scale: np.ndarray
-    scaled_rms: np.ndarray
+    gains: np.ndarray
+    gains_estimated: tuple[np.ndarray, np.ndarray]
     problems: tuple[str, ...]
     prior_beta: np.ndarray
     log_beta: np.ndarray
@@ -143,6 +168,7 @@ class Fit:
     delay_estimated: bool = False
     timing: str = "held"
     timing_residual: dict[str, float] = dataclasses.field(default_factory=dict)
+    ratios: tuple[float, float, float] | None = None
 
     def timing_lines(self) -> list[str]:
         """The delay (estimated or given, ms) and which timing fits the log better, one line each."""
@@ -174,6 +200,38 @@ class Fit:
                 + (f" with no delay: the estimated delay, {1e3 * self.delay:.3f} ms, takes up the half sample "
                    f"between them; if the log has no delay, identify with --torque-timing {other}"
                    if self.delay_estimated else f"; identify with --torque-timing {other}"))
+
+    def gain_lines(self) -> list[str]:
+        """The joints' torque gains relative to joint 1, estimated and corrected, one line (none
+        when not estimated)."""
+        values, sigma = self.gains_estimated
+        if not sigma.any():
+            return []
+        return ["torque gains relative to joint 1 (the log's torques times these are the model's): " + ", ".join(
+            f"joint{j + 1} {values[j]:.6g} +- {sigma[j]:.2g} ("
+            + ("corrected in the written model" if self.gains[j] != 1 else
+               f"within {GAIN_EVIDENCE:g} standard deviations or {100 * GAIN_NOTED:g} % of 1: kept at 1") + ")"
+            for j in (1, 2))]
+
+    def gain_warning(self) -> str | None:
+        """One line naming the gains corrected (what to write into the driver), or those kept at 1
+        that the estimate puts more than GAIN_NOTED from it (the log cannot tell), else None."""
+        off = [j for j in (1, 2) if self.gains[j] != 1 and GAIN_BOUNDS[0] <= self.gains[j] <= GAIN_BOUNDS[1]]
+        values, sigma = self.gains_estimated
+        unsure = [j for j in (1, 2) if self.gains[j] == 1 and abs(values[j] - 1) > GAIN_NOTED]
+        if not off and unsure:
+            return (", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in unsure)
+                    + f": kept at 1, the log cannot show it differs (needs {GAIN_EVIDENCE:g} standard deviations); "
+                    "a log that moves joint 1 more (phantom-pin excite) would tell")
+        if not off:
+            return None
+        hint = "" if self.ratios is None else " (or were they converted with transmission ratio " + ", ".join(
+            f"{self.ratios[j] / self.gains[j]:.4g} instead of the model's {self.ratios[j]:.4g}" for j in off) + "?)"
+        return (", ".join(f"tau{j + 1}" for j in off) + " are " + ", ".join(f"{self.gains[j]:.4g}" for j in off)
+                + " times joint 1's torque scale: corrected in the written model; multiply "
+                + ", ".join(f"joint {j + 1}'s" for j in off) + " torque constant in your driver by "
+                + ", ".join(f"{self.gains[j]:.4g}" for j in off)
+                + f" so that its commands are the model's torques{hint}")
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:
@@ -365,23 +423,6 @@ def _rms(residual: np.ndarray, moving: np.ndarray | None = None) -> np.ndarray:
     return np.sqrt((residual**2 * moving).sum(axis=0) / np.maximum(moving.sum(axis=0), 1))
 
 
-def _scaled(phi: np.ndarray, y: np.ndarray, weight: np.ndarray,
-            moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The factors s (3,) (s_1 = 1) with which the joints' torques fit best, s_j y_j = Phi_j beta
-    (a linear least-squares problem in beta, s_2, s_3), and the residual RMS per joint in the
-    log's torque units."""
-    n, _, p = phi.shape
-    rows = np.zeros((3, n, p + 2))
-    rows[:, :, :p] = phi.transpose(1, 0, 2) * weight[:, None, None]
-    rows[1, :, p] = -y[:, 1] * weight[1]
-    rows[2, :, p + 1] = -y[:, 2] * weight[2]
-    rhs = np.zeros((3, n))
-    rhs[0] = y[:, 0] * weight[0]
-    solution = np.linalg.lstsq(rows.reshape(-1, p + 2), rhs.reshape(-1), rcond=None)[0]
-    scale = np.array([1.0, *solution[p:]])
-    return scale, _rms((phi @ solution[:p]) / np.where(scale != 0, scale, 1.0) - y, moving)
-
-
 #: Angles further than this beyond the stops (rad) are no posture of the arm: refused before
 #: the fit, as simulate refuses such a start.
 NO_POSTURE = 2 * np.pi
@@ -392,7 +433,8 @@ MAX_TORQUE = 1e3
 
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",  # noqa: C901 (checks, then stages)
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
-             timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0) -> Fit:
+             timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
+             gains: bool = True) -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
     the prior, its friction law the friction columns): the base parameters of ``structure``
     ("general": the rigid body in full; "report": the report's structure, for a model in the
@@ -410,7 +452,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     (delay error) x dtau/dt in them, whose jerk-driven part no column of the regressor holds, so
     the residual grows with the error on either side and its minimum is the true delay.
     Both timings are also fitted (at zero delay when it is estimated, else at the given one):
-    ``Fit.timing_residual``, ``Fit.timing_lines``, ``Fit.timing_warning``.
+    ``Fit.timing_residual``, ``Fit.timing_lines``, ``Fit.timing_warning``. ``gains``: estimate each
+    joint's torque gain relative to joint 1 (module doc, step 2; ``Fit.gains``), or take the
+    log's torques as they are (False).
     ``progress(share)`` is called as stages end."""
     def stage(share: float) -> None:
         if progress is not None:
@@ -432,6 +476,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise LogError(f"{cutoff:g} Hz is too low for a {duration:.3g} s log (the filter needs at least "
                        f"{MIN_CYCLES:g} of its periods in the log: {MIN_CYCLES / duration:.3g} Hz or more)",
                        argument="cutoff")
+    if not isinstance(gains, bool):
+        raise InvalidInputError(f"expected True (estimate the joints' relative torque gains) or False, got {gains!r}",
+                                argument="gains")
     if timing not in TIMINGS:
         raise InvalidInputError(f"expected one of {', '.join(TIMINGS)}, got {timing!r}", argument="timing")
     if structure not in STRUCTURES:
@@ -469,21 +516,41 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     assert smooth is not None and index is not None
     weighted = _criterion(phi, moving, _rms(smooth[index] - tau0, moving))    # the same for any timing
     estimated = delay is None
-    if delay is None:
-        delay = _estimate_lag(samples, tau0, weighted, HOLD[timing])
-        samples = dataclasses.replace(samples, tau=lagged(smooth, samples.rate, index,
-                                                          HOLD[timing] / samples.rate - delay))
-    at = 0.0 if estimated else delay
+    at = delay = 0.0 if delay is None else delay
     timing_residual = {name: weighted(lagged(smooth, samples.rate, index, HOLD[name] / samples.rate - at) - tau0)
                        for name in TIMINGS}
-    phi, y = phi * moving[..., None], (samples.tau - tau0) * moving
+    phi = phi * moving[..., None]
     stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)
     condition = float(np.linalg.cond(stacked / np.where(norms > 0, norms, 1.0)))     # a diagnostic
     beta0, spread_covariance = priors.base_prior(model.matrix, model.offset, model.prior, model.scale,
                                                  spread if np.isfinite(spread) else 1.0)
-    beta, covariance, residual, weight, information, log_beta = _fit(
-        phi, y, moving, (beta0, spread_covariance) if np.isfinite(spread) else None)
+    p = phi.shape[-1]
+    prior = (beta0, spread_covariance) if np.isfinite(spread) else None
+    guess = np.ones(3)
+    for _ in range(2 if estimated and gains else 1):   # the delay again with the gains: a joint's scale moves it
+        if estimated:
+            delay = _estimate_lag(dataclasses.replace(samples, filtered_tau=smooth * guess), tau0, weighted,
+                                  HOLD[timing])
+            samples = dataclasses.replace(samples, tau=lagged(smooth, samples.rate, index,
+                                                              HOLD[timing] / samples.rate - delay))
+        solved = _solve_gains(phi, samples.tau, tau0, moving, prior, (1, 2) if gains else ())
+        estimated_gains = solved[-1]
+        guess = estimated_gains[0]
+    if gains:            # correct only the gains the log shows to differ from 1 (module doc, step 2)
+        shown = tuple(j for j in (1, 2) if abs(estimated_gains[0][j] - 1) >
+                      max(GAIN_NOTED, GAIN_EVIDENCE * estimated_gains[1][j]))
+        solved = solved if shown == (1, 2) else _solve_gains(phi, samples.tau, tau0, moving, prior, shown)
+    beta, covariance, information, log_beta, log_rms, (gain, _) = solved
+    log_sigma = np.sqrt(np.diag(inverse_information(information)))[:p]
+    if information.shape[0] > p:      # beta's marginal: its covariance block, the information's Schur complement
+        information = information[:p, :p] - information[:p, p:] @ np.linalg.solve(information[p:, p:],
+                                                                                 information[p:, :p])
+    covariance, log_beta = covariance[:p, :p], log_beta[:p]
+    logged = (samples.tau - tau0) * moving
+    samples = dataclasses.replace(samples, tau=samples.tau * gain)     # in joint 1's torque scale
+    y = (samples.tau - tau0) * moving
+    residual = y - phi @ beta
     sigma = np.sqrt(np.diag(covariance))
     if not np.isfinite(sigma).all():
         loose = ", ".join(model.base_names[k].split(" = ")[0][:40] for k in np.flatnonzero(~np.isfinite(sigma))[:3])
@@ -497,17 +564,50 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     written = model.matrix @ x + model.offset
     stage(0.7)
     comparison = _comparison(model, phantom, samples)
-    scale, scaled_rms = _scaled(phi, y, weight, moving)
     fit = Fit(model.name, model.base_names, model.units, beta, sigma, _rms(residual, moving),
               _rms(y - phi @ written, moving), _rms(y, moving), condition, len(samples.theta), x, written,
-              model.overrides(x), comparison, scale, scaled_rms, (), beta0, log_beta,
-              np.sqrt(np.diag(inverse_information(information))), _rms(y - phi @ log_beta, moving),
+              model.overrides(x), comparison, gain, estimated_gains, (), beta0, log_beta, log_sigma, log_rms,
               judge(model.regressor_of, phantom.config.limits, phi, y, moving, written, covariance, beta0,
                     information, priors.typical(model.matrix, model.scale), model.base_names, spread),
-              delay, estimated, timing, timing_residual)
-    problems = _problems(fit, model, phi, y, log, phantom)
+              delay, estimated, timing, timing_residual, phantom.config.actuation.ratios)
+    problems = _problems(fit, model, phi, logged, log, phantom)
     stage(1.0)
     return dataclasses.replace(fit, problems=tuple(problems))
+
+
+def _solve_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.ndarray,
+                 prior: tuple[np.ndarray, np.ndarray] | None, free: tuple[int, ...]) -> tuple:
+    """The estimate of beta with the torque gains of the joints ``free`` (of 1, 2; the others
+    1): tau_j = (Phi_j beta + tau0_j) / g_j (module doc, step 2) solved by Gauss-Newton in beta
+    and the inverse gains, linear about the last estimate, the inverse gains' columns being the
+    model's torques: free of the log's noise (its own torques there would let a smaller inverse
+    gain shrink the residual, biasing the gains). ``phi`` (N, 3, P) and ``tau``, ``tau0`` (N, 3;
+    N m) the regressor, the logged and the known torques, ``prior`` (beta_0, P) or None. Returns
+    (beta, covariance, information (of beta and the free inverse gains), the log alone's beta
+    and residual RMS per joint in joint 1's scale (N m), (gains (3,), standard deviations (3,)))."""
+    p, scale = phi.shape[-1], np.ones(3)
+    beta = _fit(phi, (tau - tau0) * moving, moving, prior)[0]       # the gains at 1: where to start
+    if prior is not None:
+        prior = (np.concatenate([prior[0], np.zeros(len(free))]),
+                 scipy.linalg.block_diag(prior[1], GAIN_SPREAD**2 * np.eye(len(free))))
+    for _ in range(GAIN_ITERATIONS):
+        predicted = (phi @ beta + tau0) * moving
+        columns = np.zeros((*tau.shape, len(free)))
+        for k, j in enumerate(free):
+            columns[:, j, k] = predicted[:, j]
+        system = np.concatenate([phi * scale[:, None], columns], axis=-1)
+        rhs = (tau - scale * tau0) * moving
+        if prior is not None:         # the inverse gains' prior mean is 1: their change's, 1 - scale
+            prior = (np.concatenate([prior[0][:p], 1.0 - scale[list(free)]]), prior[1])
+        solution, covariance, _, _, information, log_beta = _fit(system, rhs, moving, prior)
+        beta, change = solution[:p], solution[p:]
+        scale[list(free)] += change
+        if not free or np.abs(change).max() <= GAIN_TOLERANCE:
+            break
+    log_rms = _rms(rhs - system @ log_beta, moving) / scale
+    sigma = np.zeros(3)
+    sigma[list(free)] = np.sqrt(np.diag(covariance)[p:]) / scale[list(free)] ** 2
+    return beta, covariance, information, log_beta, log_rms, (1.0 / scale, sigma)
 
 
 def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[str, np.ndarray] | None:
@@ -522,7 +622,8 @@ def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[s
 
 
 def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Log, phantom: Phantom) -> list[str]:
-    """Why ``fit`` should not be written (module doc, step 4), most telling first."""
+    """Why ``fit`` should not be written (module doc, step 4), most telling first; ``y`` the
+    logged torques less the known ones (N m, before the gains' correction)."""
     problems = []
     worse = fit.prediction.worse()
     if worse is not None:
@@ -539,7 +640,8 @@ def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: L
                         "that theta and tau are the same samples, in rad and N m")
     prior = phi @ (model.matrix @ model.prior + model.offset)
     size = float((y * prior).sum() / (prior * prior).sum())
-    if not TORQUE_SCALE[0] <= size <= TORQUE_SCALE[1]:
+    scaled = TORQUE_SCALE[0] <= size <= TORQUE_SCALE[1]
+    if not scaled:
         problems.append(f"tau: the logged torques are {size:.3g} times the model's prediction along the motion"
                         + ("; are their signs flipped (amplifier polarity)?" if size < 0 else
                            "; are they in another unit (N m at the joint, not mN m or motor torques)?"))
@@ -559,22 +661,17 @@ def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: L
                         f"{fit.beta[k]:.4g} to {fit.written[k]:.4g} {fit.units[k]} ({moved[k] / fit.sigma[k]:.3g} "
                         f"standard deviations{', a flipped sign' if flipped else ''}): the estimate is not of a "
                         "physical arm; check torque signs, units and transmission ratios")
-    off = np.abs(fit.torque_scale - 1)
-    if off.max() > RATIO_SHARE and ((fit.scaled_rms / fit.torque_rms) ** 2).sum() < \
-            MARKED_IMPROVEMENT * ((fit.log_rms / fit.torque_rms) ** 2).sum():
-        ratios = phantom.config.actuation.ratios
-        joints = [j for j in (1, 2) if off[j] > RATIO_SHARE]
-        flipped = [j for j in joints if fit.torque_scale[j] < 0]
-        hint = "" if ratios is None else " (" + ", ".join(
-            f"ratio {ratios[j] / fit.torque_scale[j]:.4g} instead of the model's {ratios[j]:.4g}"
-            for j in joints if j not in flipped) + ")"
-        cause = (", ".join(f"tau{j + 1}" for j in flipped) + "'s sign is flipped (amplifier polarity)" if flipped
-                 else f"were the joint torques converted with other transmission ratios{hint}? The log must hold "
-                      "joint torques (N m at the joint: motor torque x ratio)")
-        problems.insert(0, ", ".join(f"tau{j + 1}" for j in joints) + " fit markedly better scaled by "
-                        + ", ".join(f"{fit.torque_scale[j]:.4g}" for j in joints)
-                        + " against tau1 (residual "
-                        + ", ".join(f"{100 * s:.2g} %" for s in fit.log_rms / fit.torque_rms)
-                        + " -> " + ", ".join(f"{100 * s:.2g} %" for s in fit.scaled_rms / fit.torque_rms)
-                        + f"): {cause}")
+    flipped = [j for j in (1, 2) if fit.gains[j] < 0 and scaled]     # the whole log's scale first
+    odd = [j for j in (1, 2) if not GAIN_BOUNDS[0] <= fit.gains[j] <= GAIN_BOUNDS[1] and j not in flipped and scaled]
+    if flipped:
+        problems.insert(0, ", ".join(f"tau{j + 1}" for j in flipped) + " fit" + ("s" if len(flipped) == 1 else "")
+                        + " the model only as " + ", ".join(f"{fit.gains[j]:.3g}" for j in flipped)
+                        + " times joint 1's torque scale: " + ", ".join(f"tau{j + 1}" for j in flipped)
+                        + "'s sign is flipped (amplifier polarity)")
+    if odd:
+        problems.insert(0, ", ".join(f"tau{j + 1}" for j in odd) + " fit the model "
+                        + ", ".join(f"{fit.gains[j]:.3g}" for j in odd) + " times joint 1's torque scale (outside "
+                        f"{GAIN_BOUNDS[0]:g}-{GAIN_BOUNDS[1]:g}: no tolerance of a drive): were they converted with "
+                        "another joint's transmission ratio or unit? The log must hold joint torques (N m at the "
+                        "joint: motor torque x ratio)")
     return problems

@@ -79,7 +79,8 @@ def write_overlay(path: Path | str, fit: Fit, source: str, keys: dict[str, objec
              f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
              "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms)]
     lines += [f"# {line}" for line in fit.timing_lines()]
-    lines += [] if fit.timing_warning() is None else [f"# warning: {fit.timing_warning()}"]
+    lines += [f"# {line}" for line in fit.gain_lines()]
+    lines += [f"# warning: {w}" for w in (fit.timing_warning(), fit.gain_warning()) if w is not None]
     lines += [f"# {line}" for line in fit.prediction.lines()]
     lines += [f"# warning: {line}" for line in fit.prediction.warnings()]
     lines += ["# base parameters (estimate with the prior +- standard deviation; of the written parameters; "
