@@ -14,10 +14,10 @@ Stability: a run (0.4 s) is stable when the peak-to-peak penetration over its la
 less than half that over its first 0.1 s (the bounce decays); the highest stable stiffness of
 a rate is the last of a geometric grid (250 N/m x sqrt 2 ** k) before the first unstable one.
 Colgate and Schenkel's passivity condition b > K T / 2 + |B| gives K < 2 b / T, with b the
-device's physical damping at the tip along the wall normal, b_n = b_joint n^T (J J^T)^-1 n,
-b_joint the viscous friction. Passivity is sufficient, not necessary: the device's Coulomb
-friction dissipates too (it stops the arm dead below its level), so the measured limit may
-exceed the bound.
+device's physical damping at the tip along the wall normal, b_n = n^T J^-T B J^-1 n, B the
+diagonal of each joint's viscous friction (b n^T (J J^T)^-1 n when the joints agree).
+Passivity is sufficient, not necessary: the device's Coulomb friction dissipates too (it
+stops the arm dead below its level), so the measured limit may exceed the bound.
 """
 
 from __future__ import annotations
@@ -101,10 +101,10 @@ def main(argv: list[str] | None = None) -> None:
     posture = np.array(args.posture)
     if not device.within_limits(posture):
         raise PhantomPinError(f"--posture: {args.posture} rad is outside the device's stops")
-    p = device.config.actuation.friction
+    viscous = np.diag(device.config.actuation.friction.viscous)         # N m s/rad, each joint's
     jacobian = device.tip_jacobian(posture)
-    mobility = NORMAL @ np.linalg.inv(jacobian @ jacobian.T) @ NORMAL     # 1/m^2
-    damping = p.viscous * mobility                                       # N s/m at the tip
+    inverse = np.linalg.inv(jacobian)                                    # rad/m: joint rates of a tip velocity
+    damping = NORMAL @ inverse.T @ viscous @ inverse @ NORMAL            # N s/m at the tip
     tip_mass = 1.0 / (NORMAL @ jacobian @ np.linalg.inv(device.phantom.mass_matrix(posture)) @ jacobian.T @ NORMAL)
 
     figure, (penetration_axis, force_axis, sweep_axis) = plt.subplots(3, 1, figsize=(8, 10), constrained_layout=True)

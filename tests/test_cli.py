@@ -428,6 +428,6 @@ def test_info_says_when_overrides_apply(tmp_path, capsys):
     assert capsys.readouterr().out.splitlines()[0] == "model premium_1_5, with 2 overridden number(s) (--params/--set)"
     assert main(["info", "--params", str(overlay), "--set", "l2=0.21", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    assert data["overrides"] == 3 and data["device"]["friction"]["coulomb"] == 0.02
+    assert data["overrides"] == 3 and data["device"]["friction"]["coulomb"] == [0.02] * 3
     assert main(["info", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["overrides"] == 0

@@ -72,7 +72,7 @@ def test_the_shipped_configuration_cannot_be_changed():
         c.visual["colors"]["arm"] = [0, 0, 0, 1]
     with pytest.raises(TypeError):
         c.sources["friction"] = "mine"
-    assert Device().config.actuation.friction.viscous == 5.0e-4
+    assert Device().config.actuation.friction.viscous == (5.0e-4,) * 3
 
 
 def _defaults(function):

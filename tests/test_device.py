@@ -193,7 +193,7 @@ def test_encoder_resolution_counts_and_tip_resolution(device, states):
 # -- parameters ------------------------------------------------------------------------
 def test_shipped_device_numbers_and_sources(device):
     friction, stops, sources = device.config.actuation.friction, device.config.limits.stops, device.config.sources
-    assert (friction.viscous, friction.coulomb) == (VISCOUS, COULOMB)
+    assert (friction.viscous, friction.coulomb) == ((VISCOUS,) * 3, (COULOMB,) * 3)
     assert (stops.stiffness, stops.damping) == (K_STOP, B_STOP)
     np.testing.assert_allclose(stops.lower, np.radians([-90, -124, -29]), rtol=1e-15)
     np.testing.assert_allclose(stops.upper, np.radians([90, 119, 214]), rtol=1e-15)

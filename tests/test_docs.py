@@ -45,9 +45,10 @@ def test_simulation_doc_quotes_the_shipped_friction_and_stops():
     text = " ".join((ROOT / "docs" / "simulation.md").read_text().split())   # lines joined
     device = Device()
     friction, stops = device.config.actuation.friction, device.config.limits.stops
-    assert f"viscous {friction.viscous:g} N m s/rad, Coulomb {friction.coulomb:g} N m" in text
+    assert friction.uniform     # the doc quotes one level for every joint
+    assert f"viscous {friction.viscous[0]:g} N m s/rad, Coulomb {friction.coulomb[0]:g} N m" in text
     assert f"K = {stops.stiffness:g} N m/rad, B = {stops.damping:g} N m s/rad" in text
     count = device.encoder_resolution[0]
     quoted = re.search(r"\(([0-9.e-]+) rad at joint 1\) unless σ0 < (\d+) N m/rad", text)
     assert abs(float(quoted[1]) / count - 1) < 5e-3                      # rounded to 3 digits
-    assert int(quoted[2]) == round(friction.coulomb / count)
+    assert int(quoted[2]) == round(friction.coulomb[0] / count)

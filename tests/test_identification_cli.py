@@ -10,7 +10,6 @@ from phantom_pin import Phantom, closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.identification import io
 from phantom_pin.identification.excitation import continuous_effort
-from phantom_pin.identification.overlays import friction_overlay
 
 DESCRIPTION = describe()
 EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
@@ -149,20 +148,9 @@ def test_excite_writes_whole_periods_and_consistent_columns(tmp_path, capsys):
     derivative = np.gradient(dtheta, t, axis=0)[1:-1]
     np.testing.assert_allclose(ddtheta[1:-1], derivative, rtol=0, atol=2e-3 * np.abs(ddtheta).max())
     friction = CONFIG.actuation.friction
-    expected = (closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + friction.viscous * dtheta
-                + friction.coulomb * np.sign(dtheta))
+    expected = (closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + np.asarray(friction.viscous) * dtheta
+                + np.asarray(friction.coulomb) * np.sign(dtheta))
     np.testing.assert_allclose(tau, expected, rtol=0, atol=1e-12 * np.abs(expected).max() + 1e-15)
-
-
-def test_one_friction_value_is_written_only_when_the_joints_agree():
-    """friction_overlay: the inverse-variance mean when every joint lies within max(3 sigma,
-    20 % of the mean) of it, else None. Joint 3 here lies 0.27 from the mean of 1.033: 27 of its
-    sigmas, and 26 % of the mean, so no common value."""
-    mean = friction_overlay(np.array([1.0, 1.01, 0.99]), np.array([0.01, 0.01, 0.01]))
-    assert mean == pytest.approx(1.0, abs=1e-12)
-    assert friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.01])) is None
-    # within 3 sigma though 26 % apart: one value
-    assert friction_overlay(np.array([1.0, 1.0, 1.3]), np.array([0.005, 0.005, 0.1])) is not None
 
 
 @pytest.mark.parametrize("option, message", [
@@ -231,8 +219,9 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     assert np.abs(identified.mass_matrix(theta) - mass).max() < 5e-3 * np.abs(mass).max()
     assert np.abs(identified.gravity(theta) - gravity).max() < 5e-3 * np.abs(gravity).max()
     law = CONFIG.actuation.friction
-    assert keys["actuation.friction.viscous"] == pytest.approx(law.viscous, rel=1e-2)
-    assert keys["actuation.friction.coulomb"] == pytest.approx(law.coulomb, rel=1e-2)
+    for j in range(3):      # each joint's own law, written per joint
+        assert keys[f"actuation.friction.viscous.joint{j + 1}"] == pytest.approx(law.viscous[j], rel=1e-2)
+        assert keys[f"actuation.friction.coulomb.joint{j + 1}"] == pytest.approx(law.coulomb[j], rel=1e-2)
     code, _, err = run(capsys, "simulate", "--trajectory", traj, "--duration", "3")
     assert code == 2 and "--duration: --trajectory sets it" in err
     # the overlay carries its model and lengths: another model refuses it (before, the CAD

@@ -129,9 +129,12 @@ def test_identified_urdf_predicts_held_out_torques(identified):
 
 
 def test_friction_is_identified_and_written(identified):
+    """Each joint's own friction is written (overlays.overlay), each within 10 % (viscous) and
+    5 % (Coulomb) of the device's."""
     keys = read_overrides(identified / "id.yaml")
-    assert keys["actuation.friction.viscous"] == pytest.approx(VISCOUS, rel=0.1)
-    assert keys["actuation.friction.coulomb"] == pytest.approx(COULOMB, rel=0.05)
+    for j in (1, 2, 3):
+        assert keys[f"actuation.friction.viscous.joint{j}"] == pytest.approx(VISCOUS, rel=0.1)
+        assert keys[f"actuation.friction.coulomb.joint{j}"] == pytest.approx(COULOMB, rel=0.05)
 
 
 def test_written_constants_are_the_true_ones(identified, tmp_path):

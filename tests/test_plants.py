@@ -12,7 +12,7 @@ from phantom_pin.device.mujoco_plant import simulate_mujoco
 DEVICE = Device(describe())
 GRAVITY = DEVICE.phantom.gravity
 START = np.array([0.0, 0.3, 0.4])                  # rad
-COULOMB = DEVICE.config.actuation.friction.coulomb  # N m, the breakaway torque
+COULOMB = np.array(DEVICE.config.actuation.friction.coulomb)   # N m, each joint's breakaway torque
 
 
 def both(theta0, duration, controller):
@@ -26,7 +26,7 @@ def test_below_the_breakaway_torque_the_arm_holds_in_both(share):
     gravity-compensated: simulate sticks exactly (0 rad), MuJoCo's soft frictionloss (solref 2
     timesteps) creeps 1.5e-4 rad at half the torque (its default 0.02 s: 1.5e-3); both well under
     1e-3 rad in 1 s."""
-    ours, mujoco = both(START, 1.0, lambda t, q, v: GRAVITY(q) + [share * COULOMB, 0.0, 0.0])
+    ours, mujoco = both(START, 1.0, lambda t, q, v: GRAVITY(q) + [share * COULOMB[0], 0.0, 0.0])
     assert np.abs(ours.theta - START).max() == 0.0
     assert np.abs(mujoco.theta[-1] - START).max() < (2e-4 if share == 0.5 else 1e-3)
 
@@ -34,7 +34,7 @@ def test_below_the_breakaway_torque_the_arm_holds_in_both(share):
 def test_above_the_breakaway_torque_both_move_alike():
     """Twice the Coulomb torque: joint 1 runs into its stop in both (1.249 rad in 1 s, within
     2.0e-4 rad of each other)."""
-    ours, mujoco = both(START, 1.0, lambda t, q, v: GRAVITY(q) + [2 * COULOMB, 0.0, 0.0])
+    ours, mujoco = both(START, 1.0, lambda t, q, v: GRAVITY(q) + [2 * COULOMB[0], 0.0, 0.0])
     assert ours.theta[-1, 0] - START[0] > 1.0
     assert np.abs(ours.theta[-1] - mujoco.theta[-1]).max() < 5e-4              # measured 2.0e-4
 

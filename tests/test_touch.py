@@ -227,13 +227,13 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
         return float(np.sqrt(((tau - truth_tau) ** 2).mean()) / np.sqrt((truth_tau ** 2).mean()))
     before, after = error(closed_form.inverse_dynamics(theta, dtheta, ddtheta, estimate.report) + stylus), \
         error(identified.inverse_dynamics(theta, dtheta, ddtheta))
+    law = identified.config.actuation.friction      # per joint, the overlay's
     print(f"held-out: estimate {before:.4f}, identified {after:.4f}; friction "
-          f"{identified.config.actuation.friction.viscous / VISCOUS - 1:+.3f}, "
-          f"{identified.config.actuation.friction.coulomb / COULOMB - 1:+.3f}")
+          f"{np.array(law.viscous) / VISCOUS - 1}, {np.array(law.coulomb) / COULOMB - 1}")
     # the estimate misses by 5.5 % (the stylus, the same on both, carries much of the torque)
     assert before > 0.04 and after < 0.01, (before, after)
-    assert identified.config.actuation.friction.viscous == pytest.approx(VISCOUS, rel=0.05)
-    assert identified.config.actuation.friction.coulomb == pytest.approx(COULOMB, rel=0.05)
+    assert law.viscous == pytest.approx((VISCOUS,) * 3, rel=0.05)
+    assert law.coulomb == pytest.approx((COULOMB,) * 3, rel=0.05)
 
 
 def test_the_command_line_serves_the_touch(capsys, tmp_path):

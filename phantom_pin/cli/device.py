@@ -219,8 +219,11 @@ def info(phantom: Phantom) -> tuple[dict, list[str]]:
         + f"; theta2 - theta3 <= {stops.coupled.theta2_minus_theta3_max * deg:.1f}, theta3 - theta2 <= "
           f"{stops.coupled.theta3_minus_theta2_max * deg:.1f}; K {stops.stiffness:g} N m/rad, "
           f"B {stops.damping:g} N m s/rad",
-        "friction": f"friction: viscous {friction.viscous:g} N m s/rad + coulomb {friction.coulomb:g} N m * "
-                    "sign(dtheta) in motion; at rest a joint sticks below the Coulomb torque",
+        "friction": (f"friction: viscous {friction.viscous[0]:g} N m s/rad + coulomb {friction.coulomb[0]:g} N m * "
+                     "sign(dtheta) in motion; at rest a joint sticks below the Coulomb torque") if friction.uniform else
+                    (f"friction per joint: viscous [{vector(f'{x:g}' for x in friction.viscous)}] N m s/rad + coulomb "
+                     f"[{vector(f'{x:g}' for x in friction.coulomb)}] N m * sign(dtheta) in motion; at rest a joint "
+                     "sticks below its Coulomb torque"),
     }
     if motor is None:
         # what the model lacks, said instead of invented (its sources say why)

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import cast
 
-from phantom_pin.config.files import OPTIONAL
+from phantom_pin.config.files import OPTIONAL, PER_JOINT
 from phantom_pin.config.reader import TIMESTEP_RANGE, Reader
 from phantom_pin.config.types import (
     BODIES,
@@ -85,7 +85,8 @@ def _actuation(r: Reader) -> Actuation:
     def act(*keys: str, **kind: bool) -> float:
         return r.number(arg, *keys, **kind)
 
-    friction = Friction(act("friction", "viscous", non_negative=True), act("friction", "coulomb", non_negative=True))
+    viscous, coulomb = (vector3(r.per_joint(arg, *keys, joints=JOINTS, non_negative=True)) for keys in PER_JOINT[arg])
+    friction = Friction(viscous, coulomb)   # PER_JOINT's keys: friction.viscous, friction.coulomb
     saturation = r.text(arg, "saturation")
     if saturation not in SATURATIONS:
         raise r.error(arg, f"saturation must be {' or '.join(SATURATIONS)}, got {saturation!r}")

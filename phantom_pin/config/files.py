@@ -14,6 +14,7 @@ from typing import cast
 
 import yaml
 
+from phantom_pin.config.types import JOINTS
 from phantom_pin.exceptions import ParameterFileError
 
 #: The parameter files of a configuration folder, by the xacro argument that names them.
@@ -29,6 +30,10 @@ FILES = {
 #: The files a configuration may leave out (read as an empty mapping): a model without a
 #: public stylus gimbal has no gimbal.yaml.
 OPTIONAL = ("gimbal_file",)
+#: The keys that hold a number per joint, by file: each is one number (the same on every joint)
+#: or a mapping {joint1, joint2, joint3} of numbers (config.reader.Reader.per_joint), and an
+#: override may set one joint of it (apply_overrides).
+PER_JOINT = {"actuation_file": (("friction", "viscous"), ("friction", "coulomb"))}
 
 
 class _Loader(yaml.SafeLoader):
@@ -78,14 +83,17 @@ def read_documents(folder: Path) -> dict[str, dict]:
 
 
 def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) -> dict[str, dict]:
-    """A copy of ``documents`` with ``overrides`` applied.
+    """A copy of ``documents`` with ``overrides`` applied, in order.
 
     Override keys are dotted paths into the files ("l1", "segment_a.mass", "joint2.upper"),
     optionally qualified by the file's stem ("actuation.motor.rotor_inertia"); an
     unqualified key must exist in exactly one file. Each must name a number, and each
     value must be a finite number in the units of that file (SI, radians); an item of a
-    list is named by its index ("links.forearm_link.com.2"). ParameterFileError naming
-    the key otherwise.
+    list is named by its index ("links.forearm_link.com.2"). A per-joint key (PER_JOINT:
+    actuation.yaml's friction.viscous and friction.coulomb) takes one joint's value
+    ("actuation.friction.viscous.joint2"; a file's single number is first expanded to the
+    same value on every joint), or without a joint sets every joint to the value, whether the
+    file holds one number or a mapping. ParameterFileError naming the key otherwise.
     """
     documents = copy.deepcopy(documents)
     stems = {Path(name).stem: arg for arg, name in FILES.items()}
@@ -103,11 +111,15 @@ def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) ->
                                      f"qualify it, e.g. {Path(names[0]).stem}.{key}")
         name = FILES[holders[0]]
         node: object = documents[holders[0]]
+        per_joint = PER_JOINT.get(holders[0], ())
+        if tuple(parts[:-1]) in per_joint:      # one joint of a per-joint key
+            _expand(node, parts, key, name)
         for part in parts[:-1]:
             node = _child(node, part)
         if _child(node, parts[-1]) is None and parts[0] not in documents[holders[0]]:
             raise ParameterFileError(f"{key}: {name} has no key {parts[0]!r}")
-        if not is_number(_child(node, parts[-1])):
+        whole = tuple(parts) in per_joint and isinstance(_child(node, parts[-1]), dict)   # every joint at once
+        if not is_number(_child(node, parts[-1])) and not whole:
             raise ParameterFileError(f"{key}: not a number in {name}, cannot override it")
         if not is_number(value) or not math.isfinite(cast(float, value)):
             raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
@@ -116,6 +128,23 @@ def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) ->
         else:
             cast(dict, node)[parts[-1]] = float(cast(float, value))
     return documents
+
+
+def _expand(document: object, parts: list[str], key: object, name: str) -> None:
+    """``parts`` (a per-joint key and a joint) checked, the key's number in ``document`` replaced
+    by the same number on every joint (a mapping is left as it is)."""
+    joint = parts[-1]
+    if joint not in JOINTS:
+        raise ParameterFileError(f"{key}: {'.'.join(parts[:-1])} is per joint: name {', '.join(JOINTS)} "
+                                 f"after it, not {joint!r}")
+    node = document
+    for part in parts[:-2]:
+        node = _child(node, part)
+    held = _child(node, parts[-2])
+    if is_number(held):
+        cast(dict, node)[parts[-2]] = {j: held for j in JOINTS}
+    elif not isinstance(held, dict):
+        raise ParameterFileError(f"{key}: {name} has no number or mapping of joints at {'.'.join(parts[:-1])}")
 
 
 def _child(node: object, part: str) -> object:

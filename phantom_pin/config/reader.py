@@ -56,6 +56,24 @@ class Reader:
             raise self.error(arg, f"{name} must not be negative, got {value!r}")
         return value
 
+    def per_joint(self, arg: str, *keys: str, joints: tuple[str, ...], non_negative: bool = False) -> tuple:
+        """A per-joint number (files.PER_JOINT): one number, the same on every joint, or a mapping
+        with exactly ``joints`` as keys, each a number checked as ``number`` does; the values
+        in the order of ``joints``, each keeping its type."""
+        node = self.node(arg, *keys)
+        name = ".".join(keys)
+        if is_number(node):
+            value = self.number(arg, *keys, non_negative=non_negative)
+            return tuple(value for _ in joints)
+        if not isinstance(node, dict):
+            raise self.error(arg, f"{name} must be a finite number (the same on every joint) or a mapping "
+                                  f"{{{', '.join(joints)}}} of them, got {node!r}")
+        extra = [str(key) for key in node if key not in joints]
+        if extra:
+            raise self.error(arg, f"{name}.{extra[0]} is not a joint: {name} is one number or a mapping of "
+                                  f"{', '.join(joints)}")
+        return tuple(self.number(arg, *keys, joint, non_negative=non_negative) for joint in joints)
+
     def vector(self, arg: str, *keys: str, length: int) -> tuple:
         value = self.node(arg, *keys)
         if not (isinstance(value, list) and len(value) == length

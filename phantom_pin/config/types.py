@@ -10,13 +10,13 @@ the identification) takes it, through a Description, and reads nothing again.
 from __future__ import annotations
 
 import dataclasses
-import math
 import types
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
+from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.inertial import Inertial, vector3
 from phantom_pin.report.parameters import ReportParameters, Unprinted
 
@@ -76,25 +76,47 @@ class Encoder:
 
 @dataclasses.dataclass(frozen=True)
 class Friction:
-    """Joint friction, the same on each joint: Coulomb friction with stiction, and viscous.
+    """Joint friction, each joint its own law: Coulomb friction with stiction, and viscous.
 
-    In motion, tau_f = viscous * dtheta + coulomb * sign(dtheta) (N m s/rad, N m), opposing
-    it. At rest a joint sticks: its friction is whatever torque holds it, up to ``coulomb``
-    (the breakaway torque equals the sliding one: no Stribeck effect, which nothing public
-    measured on a PHANToM and MuJoCo's frictionloss cannot express). phantom_pin.simulate
-    integrates the stick phase exactly (no creep); the MJCF gives MuJoCo's frictionloss the
-    same level (its soft constraint creeps slowly: config/mjcf.yaml's friction solref)."""
+    ``viscous`` (N m s/rad) and ``coulomb`` (N m): one coefficient per joint, joint1..joint3
+    (actuation.yaml gives each as one number, the same on every joint, or as a mapping
+    {joint1, joint2, joint3}). In motion, joint i's friction is tau_f,i = viscous[i] * dtheta_i
+    + coulomb[i] * sign(dtheta_i), opposing it. At rest a joint sticks: its friction is
+    whatever torque holds it, up to its ``coulomb`` (the breakaway torque equals the sliding
+    one: no Stribeck effect, which nothing public measured on a PHANToM and MuJoCo's
+    frictionloss cannot express). phantom_pin.simulate integrates the stick phase exactly (no
+    creep); the URDF's <dynamics damping friction> and the MJCF's damping and frictionloss give
+    each joint its own law (MuJoCo's soft constraint creeps slowly: config/mjcf.yaml's friction
+    solref)."""
 
-    viscous: float
-    coulomb: float
+    viscous: tuple[float, float, float]
+    coulomb: tuple[float, float, float]
 
-    def torque(self, dtheta: np.ndarray | float) -> np.ndarray | float:
-        """The sliding law viscous * dtheta + coulomb * sign(dtheta) (N m) at rates dtheta (rad/s,
-        an array or one float); 0 at rest, where the torque that holds a joint depends on the
-        load (simulate decides it). The identification's friction columns are its two terms."""
-        if isinstance(dtheta, float):
-            return self.viscous * dtheta + (math.copysign(self.coulomb, dtheta) if dtheta else 0.0)
-        return self.viscous * dtheta + self.coulomb * np.sign(dtheta)
+    @property
+    def uniform(self) -> bool:
+        """Whether every joint has the same law (actuation.yaml could say it with one number each)."""
+        return len(set(self.viscous)) == 1 and len(set(self.coulomb)) == 1
+
+    def joint(self, index: int) -> tuple[float, float]:
+        """(viscous N m s/rad, Coulomb N m) of joint ``index`` (0, 1, 2 for joint1..joint3)."""
+        return self.viscous[index], self.coulomb[index]
+
+    def unit_coulomb(self) -> Friction:
+        """This law with no viscous term and a unit Coulomb torque on every joint: its ``torque``
+        is the direction term, the identification's Coulomb columns."""
+        return dataclasses.replace(self, viscous=(0.0, 0.0, 0.0), coulomb=(1.0, 1.0, 1.0))
+
+    def torque(self, dtheta: np.ndarray) -> np.ndarray:
+        """The sliding law (N m) at rates dtheta (rad/s, (3,) or (..., 3), joint1..joint3 along the
+        last axis): viscous[i] * dtheta_i + coulomb[i] * sign(dtheta_i) per joint; 0 at rest, where
+        the torque that holds a joint depends on the load (simulate decides it). The identification's
+        friction columns are its two terms. ValueError (InvalidInputError) naming dtheta for
+        another shape; one joint's law: ``joint``."""
+        rates = np.asarray(dtheta, dtype=float)
+        if rates.shape[-1:] != (3,):
+            raise InvalidInputError(f"expected rates of shape (3,) or (N, 3) (rad/s), got shape {rates.shape}",
+                                    argument="dtheta")
+        return np.asarray(self.viscous) * rates + np.asarray(self.coulomb) * np.sign(rates)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -68,7 +68,8 @@ def _xacro_inputs(config: Config, folder: Path) -> dict[str, str]:
         "actuation_file": {
             "transmission_ratio": None if a.ratios is None else dict(zip(JOINTS, a.ratios)),
             "motor": None if a.motor is None else dataclasses.asdict(a.motor),
-            "friction": dataclasses.asdict(a.friction),
+            "friction": {"viscous": dict(zip(JOINTS, a.friction.viscous)),     # per joint, as effort
+                         "coulomb": dict(zip(JOINTS, a.friction.coulomb))},
             "joint_torque_limit": dict(zip(JOINTS, a.effort)),
             "joint_velocity_limit": dict(zip(JOINTS, a.velocity))},
         "joint_limits_file": {**{j: {"lower": lo, "upper": hi} for j, lo, hi in zip(JOINTS, lim.lower, lim.upper)},

@@ -149,11 +149,11 @@ class Device:
     def friction(self, dtheta: object) -> np.ndarray:
         """Sliding friction torque (N m) of each joint at rates dtheta (rad/s): (..., 3).
 
-        tau_f = viscous * dtheta + coulomb * sign(dtheta), with the sign of dtheta: it opposes
-        motion, M ddtheta + C dtheta + N + tau_f = tau. At rest (dtheta = 0) it returns 0: a
-        joint at rest sticks, held by whatever torque that takes up to ``coulomb`` (the
-        breakaway torque), which depends on the load; phantom_pin.simulate integrates that
-        (config.Friction).
+        tau_f,i = viscous[i] * dtheta_i + coulomb[i] * sign(dtheta_i), each joint i its own law
+        (N m s/rad, N m), with the sign of dtheta: it opposes motion, M ddtheta + C dtheta + N +
+        tau_f = tau. At rest (dtheta = 0) it returns 0: a joint at rest sticks, held by whatever
+        torque that takes up to its ``coulomb`` (the breakaway torque), which depends on the
+        load; phantom_pin.simulate integrates that (config.Friction).
         """
         v, _ = as_states(dtheta, "dtheta")
         return np.asarray(self.config.actuation.friction.torque(v))

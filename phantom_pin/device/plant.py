@@ -66,13 +66,14 @@ def contact_substeps(device: Device, theta0: np.ndarray, period: float, friction
     the smallest eigenvalue of M(theta0), as M varies by about 15 % across the stops): the
     stops' natural frequency OMEGA = sqrt(3 K / m) (a joint may touch its own stop and the
     coupled one, stiffness matrix eigenvalue up to 3 K) and the damping rate RATE = (3 B +
-    viscous) / m. The Coulomb friction adds no stiffness: its stick phase is a mode of
-    the integration, not a steep force. At most 2 * MAX_STEPS (simulate refuses that many).
+    viscous) / m, with the largest joint's viscous coefficient. The Coulomb friction adds no
+    stiffness: its stick phase is a mode of the integration, not a steep force. At most
+    2 * MAX_STEPS (simulate refuses that many).
     """
     stops, law = device.config.limits.stops, device.config.actuation.friction
     inertia = 0.5 * float(np.linalg.eigvalsh(device.phantom.mass_matrix(theta0)).min())
     stiffness = 3 * stops.stiffness if hard_stops else 0.0
-    damping = (3 * stops.damping if hard_stops else 0.0) + (law.viscous if friction else 0.0)
+    damping = (3 * stops.damping if hard_stops else 0.0) + (max(law.viscous) if friction else 0.0)
     need = max(period * math.sqrt(stiffness / inertia) / OSCILLATION_SCALE,
                period * damping / inertia / DAMPING_SCALE)
     need = min(need, 2.0 * MAX_STEPS)           # beyond the bound anyway (and no ceil of inf)
@@ -86,8 +87,8 @@ class Plant:
     M(theta) ddtheta + C dtheta + N(theta) = tau - tau_friction + tau_stops, with M including the
     rotors' reflected inertia (Pinocchio's crba and nonLinearEffects on the Phantom's mimic
     model: Phantom.forward_dynamics without its per-call checks), ``friction``
-    (config.Friction: viscous and Coulomb in motion; a joint at rest sticks while the torque
-    that holds it is below the Coulomb torque, an exact mode of the integration) and
+    (config.Friction, each joint its own law: viscous and Coulomb in motion; a joint at rest sticks
+    while the torque that holds it is below its Coulomb torque, an exact mode of the integration) and
     ``hard_stops`` (Device.stop_torque); ``saturation`` the clip of commands: True for
     actuation.yaml's policy, "continuous" or "peak", False for none (Device.saturation_torque).
     ``contact_step`` (s): the longest RK4 step while a stop is engaged (contact_substeps).
@@ -110,9 +111,10 @@ class Plant:
         self.bounds = list(zip(lower.tolist(), upper.tolist(), strict=True))     # rad, per stop coordinate
         self._flat_bounds = tuple(x for pair in self.bounds for x in pair)    # one unpacking per _margins
         self._stop_force = cast(StopForce, stops.force)                  # a float of floats
-        self._coulomb = actuation.friction.coulomb
-        #: (viscous N m s/rad, Coulomb N m), None without friction: one attribute lookup per evaluation
-        self._law = (actuation.friction.viscous, self._coulomb) if friction else None
+        law = actuation.friction
+        self._coulomb = law.coulomb         # N m per joint, the breakaway torques
+        #: (viscous1..3 N m s/rad, Coulomb1..3 N m), None without friction: one attribute lookup per evaluation
+        self._law = (*law.viscous, *law.coulomb) if friction else None
         model = device.phantom.model
         # Pinocchio's model, data and inputs (filled in place), one tuple: one attribute lookup per evaluation
         self._pinocchio = (model, model.createData(), np.zeros(3), np.zeros(3))
@@ -170,11 +172,11 @@ class Plant:
         t0, t1, t2 = tau
         law = self._law
         if law is not None:
-            viscous, coulomb = law
+            d0, d1, d2, f0, f1, f2 = law        # viscous (damping) and Coulomb per joint
             m0, m1, m2 = mode
-            t0 -= viscous * v0 + coulomb * m0
-            t1 -= viscous * v1 + coulomb * m1
-            t2 -= viscous * v2 + coulomb * m2
+            t0 -= d0 * v0 + f0 * m0
+            t1 -= d1 * v1 + f1 * m1
+            t2 -= d2 * v2 + f2 * m2
         if contact is not None:
             stop_force = self._stop_force
             s0, s1, s2, s3 = contact
@@ -240,8 +242,9 @@ class Plant:
 
     def _mode(self, q: List3, v: List3, tau: List3, contact: Contact) -> Mode:
         """The friction mode at a state: a moving joint slides; a joint at rest sticks if the
-        torque that holds it is within the Coulomb torque, else it breaks away in the direction
-        the net torque pushes it (released one at a time, the most overloaded first)."""
+        torque that holds it is within its Coulomb torque, else it breaks away in the direction
+        the net torque pushes it (released one at a time, the most overloaded first: the largest
+        holding torque beyond its joint's Coulomb torque)."""
         if not self.friction:
             return (1, 1, 1)
         v0, v1, v2 = v
@@ -251,8 +254,9 @@ class Plant:
         while 0 in mode:
             holding = self._held_torque(q, v, tau, (mode[0], mode[1], mode[2]), contact)
             stuck = [i for i in range(3) if mode[i] == 0]
-            worst = max(range(len(stuck)), key=lambda k: abs(holding[k]))
-            if abs(holding[worst]) < self._coulomb:        # at the Coulomb torque it breaks away
+            coulomb = self._coulomb
+            worst = max(range(len(stuck)), key=lambda k: abs(holding[k]) - coulomb[stuck[k]])
+            if abs(holding[worst]) < coulomb[stuck[worst]]:        # at the Coulomb torque it breaks away
                 break
             mode[stuck[worst]] = -1 if holding[worst] > 0 else 1
         return (mode[0], mode[1], mode[2])
@@ -261,13 +265,13 @@ class Plant:
                 margins: List3 | None = None) -> List3:
         """The event functions at a state, positive while the step's start's mode and contact hold:
         per joint the friction mode's slack (a sliding joint's rate along its direction, rad/s; a
-        stuck joint's Coulomb torque less the torque that holds it, N m; none without friction),
+        stuck joint's own Coulomb torque less the torque that holds it, N m; none without friction),
         then per stop coordinate its margin (rad) times ``stop_signs`` (+1 free, -1 engaged).
         ``margins``: _margins(q) if known."""
         if self.friction:
             coulomb = self._coulomb
             holding = iter(self._held_torque(q, v, tau, mode, contact) if not all(mode) else ())
-            slack = [x * m if m else coulomb - abs(next(holding)) for x, m in zip(v, mode)]  # noqa: B905
+            slack = [x * m if m else c - abs(next(holding)) for x, m, c in zip(v, mode, coulomb)]  # noqa: B905
         else:
             slack = []
         stop_part = self._margins(q) if margins is None else margins

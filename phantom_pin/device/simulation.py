@@ -35,9 +35,9 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     Plant (device.plant.Plant): M(theta) ddtheta + C dtheta + N(theta) = tau_motor -
     tau_friction + tau_stops, with M including the rotors' reflected inertia (Pinocchio's crba and nonLinearEffects
     on the Phantom's mimic model, the computation of Phantom.forward_dynamics),
-    ``friction`` config.Friction (viscous and Coulomb in motion; a joint at rest sticks while
-    the torque that holds it is below the Coulomb torque: an exact mode of the integration, no
-    creep), ``hard_stops`` Device.stop_torque, and ``saturation``: tau_motor = the command
+    ``friction`` config.Friction (each joint its own viscous and Coulomb friction in motion; a
+    joint at rest sticks while the torque that holds it is below its Coulomb torque: an exact
+    mode of the integration, no creep), ``hard_stops`` Device.stop_torque, and ``saturation``: tau_motor = the command
     clipped to +-Device.saturation_torque (True: actuation.yaml's policy, "continuous" by
     default; "continuous" or "peak" to choose; False: no clipping), as the MJCF's ctrlrange.
     Between samples: fixed-step RK4, one step per period (at most MAX_STEP) away from the stops
@@ -147,7 +147,8 @@ def _steps(device: Device, theta0: np.ndarray, duration: float, rate: float, sam
             + f"), more than {MAX_STEPS:.0e} (about 4 minutes)"
             + ("" if fixed or substeps <= MAX_STEPS else
                f": the device's stops (B {device.config.limits.stops.damping:g} N m s/rad) and viscous friction "
-               f"({device.config.actuation.friction.viscous:g} N m s/rad) are too stiff to simulate at any rate"),
+               f"(up to {max(device.config.actuation.friction.viscous):g} N m s/rad) are too stiff to simulate at any "
+               "rate"),
             argument="substeps" if fixed else "device" if substeps > MAX_STEPS else "duration")
     return (substeps if fixed else free), substeps
 

@@ -92,12 +92,12 @@ def regressor(theta: np.ndarray, dtheta: np.ndarray, ddtheta: np.ndarray,
     law = description.config.actuation.friction
     eye = np.eye(3)
     viscous = dtheta[..., :, None] * eye
-    coulomb = np.asarray(dataclasses.replace(law, viscous=0.0, coulomb=1.0).torque(dtheta))[..., :, None] * eye
+    coulomb = law.unit_coulomb().torque(dtheta)[..., :, None] * eye
     return np.concatenate([np.stack(columns, axis=-1), viscous, coulomb], axis=-1)
 
 
 def nominal(description: Description) -> np.ndarray:
-    """beta of a configuration: its report constants and its friction (the same on each joint)."""
+    """beta of a configuration: its report constants and its friction (viscous1..3, coulomb1..3)."""
     law = description.config.actuation.friction
     return np.concatenate([report_constants(parameterization.report_vector(description.config), description),
-                           [law.viscous] * 3, [law.coulomb] * 3])
+                           law.viscous, law.coulomb])

@@ -343,8 +343,8 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay
     dt = 1.0 / rate
     dtheta = np.gradient(theta, dt, axis=0)
     ddtheta = np.gradient(dtheta, dt, axis=0)
-    unit = dataclasses.replace(law, viscous=0.0, coulomb=1.0)
-    columns = scipy.signal.sosfiltfilt(sos, np.concatenate([dtheta, unit.torque(dtheta)], axis=1), axis=0)
+    columns = scipy.signal.sosfiltfilt(sos, np.concatenate([dtheta, law.unit_coulomb().torque(dtheta)], axis=1),
+                                       axis=0)
     edge = int(np.ceil(EDGE * rate))
     step = max(1, int(rate / (5 * cutoff)))
     keep = slice(edge, len(log.t) - edge, step)

@@ -1,5 +1,5 @@
-"""A Fit (estimation.estimate) as a --params overlay: the keys of the identified bodies, the
-friction where the joints agree, and what the fit is only valid with (its model and lengths),
+"""A Fit (estimation.estimate) as a --params overlay: the keys of the identified bodies, each
+joint's friction, and what the fit is only valid with (its model and lengths),
 written as a YAML file with the fit in comments (docs/identification.md, step 9)."""
 
 from __future__ import annotations
@@ -15,22 +15,13 @@ from phantom_pin.exceptions import InvalidInputError, ParameterFileError, Phanto
 from phantom_pin.identification.estimation import Fit
 
 
-def friction_overlay(values: np.ndarray, sigma: np.ndarray, spread: float = 0.2) -> float | None:
-    """One value for all three joints (inverse-variance mean) if each joint's estimate lies
-    within max(3 sigma, ``spread`` x mean) of it, else None: actuation.yaml holds one friction
-    law for every joint."""
-    weights = 1.0 / np.asarray(sigma) ** 2
-    mean = float((weights * values).sum() / weights.sum())
-    ok = np.abs(values - mean) <= np.maximum(3 * np.asarray(sigma), spread * abs(mean))
-    return mean if ok.all() else None
-
-
 def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
     """The --params keys of an identification (estimation.Fit) on a model with the overrides
     ``given`` (those of the bodies it identified dropped: the segments and links), and the
-    comment lines that explain its friction: one value per law, the joints' inverse-variance
-    mean of the physical (never negative) values, written only if they agree
-    (friction_overlay).
+    comment lines that explain its friction. Friction is written per joint, always
+    (``actuation.friction.viscous.joint1`` .. ``actuation.friction.coulomb.joint3``, N m s/rad
+    and N m): the physical projection's values (fit.x, never negative; the friction keys of
+    ``given`` are dropped); the comments list each joint's estimate +- its standard deviation.
 
     With the ``config`` identified on, the keys carry what the fit is only valid with: its
     lengths l1, l2, l3 (m) and, for a named model, ``model`` (its name), which
@@ -47,26 +38,38 @@ def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -
         if config.name in MODELS:
             keys[MODEL_KEY] = config.name
         keys.update(dataclasses.asdict(config.kinematics))
-    keys.update({key: value for key, value in (given or {}).items() if section(key) not in bodies})
+    keys.update({key: value for key, value in (given or {}).items()
+                 if section(key) not in bodies and not _friction_key(key)})
     keys.update(fit.overrides)
     notes = []
+    keys.update(friction_keys(fit))
     values, sigma = fit.friction
     for kind, part in (("viscous", slice(0, 3)), ("coulomb", slice(3, 6))):
-        common = friction_overlay(fit.x[-6:][part], sigma[part])   # the projection's: >= 0
-        listed = ", ".join(f"{v:.4g} +- {s:.2g}" for v, s in zip(values[part], sigma[part]))
-        if common is None:
-            notes.append(f"friction.{kind} per joint: {listed} (the joints differ: not written; "
-                         "actuation.yaml holds one value for all joints)")
-        else:
-            keys[f"actuation.friction.{kind}"] = common
-            notes.append(f"friction.{kind} per joint: {listed}; written {common:.4g}, the inverse-variance mean "
-                         "of the physical values (0 or more)")
+        listed = ", ".join(f"joint{j} {v:.4g} +- {s:.2g}" for j, v, s in zip((1, 2, 3), values[part], sigma[part]))
+        notes.append(f"friction.{kind} estimated per joint: {listed}; written per joint, the physical values "
+                     "(0 or more)")
     if config is not None:  # the overlay must give a physical URDF (description.physical.check_urdf)
         try:
             describe(config.folder, overrides=keys)
         except PhantomPinError as error:
             raise ParameterFileError(f"identified parameters not physically valid: {error}") from None
     return keys, notes
+
+
+#: The overlay's friction keys in fit.x[-6:]'s order: viscous1..3 (N m s/rad), coulomb1..3 (N m).
+FRICTION_KEYS = tuple(f"actuation.friction.{kind}.joint{j}" for kind in ("viscous", "coulomb") for j in (1, 2, 3))
+
+
+def friction_keys(fit: Fit) -> dict[str, float]:
+    """Each joint's friction of ``fit`` as --params keys (FRICTION_KEYS): the physical
+    projection's values, fit.x[-6:] (never negative)."""
+    return {key: float(value) for key, value in zip(FRICTION_KEYS, fit.x[-6:], strict=True)}
+
+
+def _friction_key(key: object) -> bool:
+    """Whether an override key names actuation.yaml's friction (any of its forms)."""
+    parts = str(key).split(".")
+    return parts[1 if parts[0] == "actuation" else 0:][:1] == ["friction"]
 
 
 def write_overlay(path: Path | str, fit: Fit, source: str, keys: dict[str, object], notes: list[str]) -> None:

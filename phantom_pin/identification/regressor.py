@@ -17,8 +17,6 @@ and is projected: Y = G^T Y_tree. Gravity is the model's (base_link -z).
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pinocchio as pin
 
@@ -51,7 +49,7 @@ class Regressor:
         self.tree = self.coupling.tree
         self._data = self.tree.createData()
         #: the Coulomb column: the friction law with unit Coulomb and no viscous term
-        self._coulomb = dataclasses.replace(phantom.config.actuation.friction, viscous=0.0, coulomb=1.0).torque
+        self._coulomb = phantom.config.actuation.friction.unit_coulomb().torque
         self.bodies = body_names(self.tree)
         self.n_inertial = 10 * len(self.bodies)
         self.names = ([f"{b}.{p}" for b in self.bodies for p in INERTIAL_NAMES]

@@ -85,7 +85,7 @@ class Structure:
         self.config = phantom.config
         self.regressor = Regressor(phantom)
         law = self.config.actuation.friction
-        self.friction_prior = np.array([law.viscous] * 3 + [law.coulomb] * 3)
+        self.friction_prior = np.array([*law.viscous, *law.coulomb])    # each joint's own law
 
     @property
     def motor(self) -> bool:
