@@ -32,12 +32,12 @@ rigid body and rotors, viscous + Coulomb friction with stiction, stops, saturati
   computed from the motion); no noise, the true angles;
 - each of: the device's encoder quantization (its counts through the gear; the Touch's are not
   public: n/a), 10 mA of current noise (0.010 A x torque constant x ratio per joint, N m, from
-  the device's motor; the Touch's are not public: n/a), 20 and 120 s, a torque constant 2 %
-  high on joint 2 alone (the plant receives 1.02 x the command, the log holds the command), a
-  1 ms delay (the log's torques one sample late), the default held timing on the instantaneous
-  torques, per-joint friction (FRICTION_FACTORS) with a Stribeck peak (STRIBECK), and all at once
-  (identified with identify's defaults: held timing, delay estimated), also at 120 s and without
-  the torque constant's error.
+  the device's motor; the Touch's are not public: n/a, and left out of "all at once"), 20 and
+  120 s, a torque constant 2 % high on joint 2 alone (the plant receives 1.02 x the command, the
+  log holds the command), a 1 ms delay (the log's torques one sample late), the default held
+  timing on the instantaneous torques, per-joint friction (FRICTION_FACTORS) with a Stribeck
+  peak (STRIBECK), and all at once (identified with identify's defaults: held timing, delay
+  estimated), also at 120 s and without the torque constant's error.
 
 Columns: held-out error of the written model's rigid-body torques (``Phantom(describe(folder,
 overrides=overlay(fit)))``, rotors included, friction not) against the device's own inverse
@@ -340,15 +340,21 @@ class Figures:
         return truncated(self.logs[key], condition.duration)
 
 
-def unavailable(setup: Setup, condition: Condition) -> str | None:
-    """Why ``condition`` cannot be run on ``setup``'s device (its data are not public), or None."""
+def available(setup: Setup, condition: Condition) -> tuple[Condition | None, str]:
+    """``condition`` as far as the device's public data allow it (None where nothing of it is
+    left) and what was left out ("" for nothing): quantization needs its encoder, current noise
+    its motor (the Touch has neither)."""
     actuation = setup.truth.config.actuation
-    missing = []
+    left = {}
     if condition.quantization and actuation.encoder is None:
-        missing.append("no encoder in its configuration (not public): no quantization")
+        left["quantization"] = "no quantization (its encoder is not public)"
     if condition.noise and actuation.motor is None:
-        missing.append("no motor in its configuration (not public): no current noise")
-    return "; ".join(missing) or None
+        left["noise"] = "no current noise (its motor is not public)"
+    if not left:
+        return condition, ""
+    reduced = dataclasses.replace(condition, **{name: False for name in left})
+    nothing = not any(reduced.device_key) and reduced.delay == 0 and reduced.sampled and reduced.timing == "sampled"
+    return (None if nothing else reduced), "; ".join(left.values())
 
 
 def through_openhaptics(log: io.Log, folder: Path) -> Path:
@@ -422,16 +428,18 @@ def rows_of(figures: Figures, kinds: tuple[str, ...], conditions: dict[str, Cond
     prior_row.states_error = float(torque_error(setup.prior, figures.truth, figures.held_out["states"]).max())
     rows = [prior_row]
     longest: dict[tuple, float] = {}             # each simulation as long as its longest condition
-    for condition in conditions.values():
-        longest[condition.device_key] = max(longest.get(condition.device_key, 0.0), condition.duration)
+    for reduced in (available(setup, condition)[0] for condition in conditions.values()):
+        if reduced is not None:
+            longest[reduced.device_key] = max(longest.get(reduced.device_key, 0.0), reduced.duration)
     for kind in kinds:
         for name, condition in conditions.items():
-            row = Row(setup.label, kind, condition.name)
+            reduced, omitted = available(setup, condition)
+            row = Row(setup.label, kind, condition.name + (f" ({omitted})" if omitted and reduced else ""))
             rows.append(row)
-            why = unavailable(setup, condition)
-            if why is not None:
-                row.verdict = f"n/a: {why}"
+            if reduced is None:
+                row.verdict = f"n/a: {omitted}"
                 continue
+            condition = reduced
             base = figures.log(kind, condition, longest[condition.device_key])
             log = late(instantaneous(base) if condition.sampled else base, condition.delay)
             if setup.openhaptics:           # written and read back in OpenHaptics' convention
