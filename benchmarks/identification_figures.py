@@ -39,8 +39,9 @@ rigid body and rotors, viscous + Coulomb friction with stiction, stops, saturati
   the device's motor; the Touch's are not public: n/a, and left out of "all at once"), 20 and
   120 s, a torque constant 2 % high on joint 2 alone (the plant receives 1.02 x the command, the
   log holds the command), a 1 ms delay (the log's torques one sample late), the default held
-  timing on the instantaneous torques, per-joint friction (FRICTION_FACTORS) with a Stribeck
-  peak (STRIBECK), and all at once (identified with identify's defaults: held timing, delay
+  timing on the instantaneous torques, per-joint friction (FRICTION_FACTORS, through
+  actuation.yaml's per-joint keys) with a Stribeck peak (STRIBECK, a torque added to the
+  plant's input), and all at once (identified with identify's defaults: held timing, delay
   estimated), also at 120 s and without the torque constant's error.
 
 Columns: held-out error of the written model's rigid-body torques (``Phantom(describe(folder,
@@ -49,7 +50,8 @@ dynamics, worst joint, % of that joint's torque RMS, on an unseen trajectory (an
 seed 7, at 100 Hz) and on 500 seeded random states inside the stops; the worst joint's friction
 error (%, signed) of the estimate (the projection's physical values, per joint) and of the
 written model, viscous / Coulomb, against the device's per joint; the delay (ms, estimated); the
-estimated torque gain of joint 2 relative to joint 1 (once the fit exposes it); what identify
+estimated torque gain of joint 2 relative to joint 1 +- its standard deviation, and whether
+identify corrected it (the device's is 1.02 under the torque constant's error); what identify
 does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), Fit.timing_warning(),
 each listed under the table); and whether the issue's goal (held-out <= 0.5 %, written friction
 within 10 %) is met. Progress goes to stderr.
@@ -106,7 +108,8 @@ class Setup:
     """A device (``truth``) and the configuration identified on (``prior``, with ``structure``);
     ``openhaptics``: the log goes through OpenHaptics' convention; ``posture`` (rad) and
     ``amplitude`` (rad, of each joint's sum of sines) of the lab's log; ``friction``, the
-    device's configured law (N m s/rad, N m), the same on every joint."""
+    device's configured law (N m s/rad, N m), the same on every joint; ``uneven``: the device
+    with each joint's own friction (FRICTION_FACTORS, through the per-joint friction keys)."""
 
     name: str
     label: str
@@ -117,35 +120,44 @@ class Setup:
     posture: tuple[float, float, float]
     amplitude: float
     friction: Friction
+    uneven: Description
 
 
-def moved(model: str, factors: dict[str, float], viscous: float, coulomb: float) -> Description:
-    """The model's report parameters times ``factors`` (by report symbol) and its friction
-    (N m s/rad, N m), as a device (every link checked physical by describe)."""
+def devices(model: str, keys: dict[str, float], viscous: float, coulomb: float) -> tuple[Description, Description]:
+    """The device: ``model`` with the --params ``keys`` and a friction law the same on every joint
+    (N m s/rad, N m); and the same device with each joint's own friction, FRICTION_FACTORS times
+    that law, through actuation.yaml's per-joint keys (actuation.friction.viscous.joint2, ...)."""
+    even = {"actuation.friction.viscous": viscous, "actuation.friction.coulomb": coulomb}
+    per_joint = {f"actuation.friction.{kind}.joint{j + 1}": float(value * factor[j])
+                 for kind, value, factor in (("viscous", viscous, FRICTION_FACTORS[0]),
+                                             ("coulomb", coulomb, FRICTION_FACTORS[1])) for j in range(3)}
+    return describe(model, overrides={**keys, **even}), describe(model, overrides={**keys, **per_joint})
+
+
+def moved(model: str, factors: dict[str, float]) -> dict[str, float]:
+    """The --params keys of ``model``'s report parameters times ``factors`` (by report symbol)."""
     config = describe(model).config
     x = pz.report_vector(config) * np.array([factors.get(symbol, 1.0) for symbol in pz.SYMBOLS])
-    return describe(model, overrides={**pz.overrides(x, config), "actuation.friction.viscous": viscous,
-                                      "actuation.friction.coulomb": coulomb})
+    return pz.overrides(x, config)
 
 
 def setups() -> dict[str, Callable[[], Setup]]:
     """The setups by name, each built on demand (module doc)."""
     def cad() -> Setup:
-        truth = describe("premium_1_5_cad", overrides={"actuation.friction.viscous": 6e-4,
-                                                       "actuation.friction.coulomb": 0.012})
+        truth, uneven = devices("premium_1_5_cad", {}, 6e-4, 0.012)
         lengths = dataclasses.asdict(truth.config.kinematics)        # the lab measured its lengths
         return Setup("cad", "CAD Premium 1.5 (general)", truth, Phantom(describe("premium_1_5", overrides=lengths)),
-                     "general", False, (0.0, 0.3, 0.45), 0.4, truth.config.actuation.friction)
+                     "general", False, (0.0, 0.3, 0.45), 0.4, truth.config.actuation.friction, uneven)
 
     def report() -> Setup:
-        truth = moved("premium_1_5", MOVED, 8e-4, 0.015)
+        truth, uneven = devices("premium_1_5", moved("premium_1_5", MOVED), 8e-4, 0.015)
         return Setup("report", "report-structured, 10-30 % off (report)", truth, Phantom(describe("premium_1_5")),
-                     "report", False, (0.0, 0.3, 0.45), 0.4, truth.config.actuation.friction)
+                     "report", False, (0.0, 0.3, 0.45), 0.4, truth.config.actuation.friction, uneven)
 
     def touch() -> Setup:
-        truth = moved("touch", MOVED_TOUCH, 8e-4, 0.015)
+        truth, uneven = devices("touch", moved("touch", MOVED_TOUCH), 8e-4, 0.015)
         return Setup("touch", "Touch, 10-30 % off (general, OpenHaptics)", truth, Phantom(describe("touch")),
-                     "general", True, (0.0, 0.75, 0.55), 0.3, truth.config.actuation.friction)
+                     "general", True, (0.0, 0.75, 0.55), 0.3, truth.config.actuation.friction, uneven)
     return {"cad": cad, "report": report, "touch": touch}
 
 
@@ -209,26 +221,14 @@ def sum_of_sines(duration: float, posture: np.ndarray, amplitude: float, seed: i
             -a * (omega**2 * np.sin(phase)).sum(-1))
 
 
-def per_joint_friction(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
-    """The device's viscous (N m s/rad) and Coulomb (N m) coefficient per joint in the per-joint
-    friction condition."""
-    return setup.friction.viscous * FRICTION_FACTORS[0], setup.friction.coulomb * FRICTION_FACTORS[1]
-
-
-def disturbance(setup: Setup) -> Callable[[float, np.ndarray, np.ndarray], np.ndarray]:
-    """The torque (N m) added to the plant's input in the per-joint friction condition, at the true
-    rate v (rad/s): each joint's friction above the configured law, and the Stribeck excess."""
-    viscous, coulomb = per_joint_friction(setup)
-    # TODO(friction): once actuation.friction takes per-joint values (actuation.friction.viscous.joint2,
-    # ...), give the device viscous/coulomb through its overrides (Setup.truth) and keep only the
-    # Stribeck excess here.
-    extra_viscous, extra_coulomb = viscous - setup.friction.viscous, coulomb - setup.friction.coulomb
+def stribeck(law: Friction) -> Callable[[float, np.ndarray, np.ndarray], np.ndarray]:
+    """The torque (N m) added to the plant's input in the per-joint friction condition at the true
+    rate v (rad/s): the Stribeck excess above each joint's Coulomb level (STRIBECK), opposing v."""
     excess, speed = STRIBECK
+    coulomb = np.asarray(law.coulomb, float)
 
     def torque(time: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
-        sign = np.sign(dtheta)
-        stribeck = excess * coulomb * sign * np.exp(-((dtheta / speed) ** 2))
-        return -(extra_viscous * dtheta + extra_coulomb * sign) - stribeck
+        return -excess * coulomb * np.sign(dtheta) * np.exp(-((dtheta / speed) ** 2))
     return torque
 
 
@@ -266,11 +266,6 @@ def torque_error(model: Phantom, truth: Phantom, states: tuple[np.ndarray, ...])
     return np.sqrt(((model.inverse_dynamics(*states) - true) ** 2).mean(axis=0) / (true**2).mean(axis=0))
 
 
-def per_joint(value: object) -> np.ndarray:
-    """A friction coefficient of a configuration as three values (one for all joints, or three)."""
-    return np.broadcast_to(np.asarray(value, float), (3,)).copy()
-
-
 def worst(relative: np.ndarray) -> float:
     """The entry of largest magnitude (signed)."""
     return float(relative[np.argmax(np.abs(relative))])
@@ -304,6 +299,7 @@ class Figures:
     def __init__(self, setup: Setup, iterations: int, restarts: int) -> None:
         self.setup, self.iterations, self.restarts = setup, iterations, restarts
         self.device, self.truth = Device(setup.truth), Phantom(setup.truth)
+        self.uneven = Device(setup.uneven)           # the same rigid body, each joint's own friction
         self.logs: dict[tuple, io.Log] = {}
         held_out = optimise(setup.prior, iterations=5, restarts=1, seed=7).trajectory(np.arange(500) / 100.0)
         self.held_out = {"trajectory": held_out, "states": random_states(setup.prior.config.limits, 500, 7)}
@@ -336,11 +332,12 @@ class Figures:
             duration = max(longest, condition.duration)
             progress(f"{self.setup.name}, {kind}: simulating {duration:g} s ({condition.name})")
             t, theta, dtheta, tau = self.trajectory(kind, duration)
+            device = self.uneven if condition.friction else self.device
             self.logs[key] = simulation.track(
-                self.device, t, theta, dtheta, tau, quantization=condition.quantization, seed=1,
-                torque_noise=current_noise(self.device) if condition.noise else 0.0,
+                device, t, theta, dtheta, tau, quantization=condition.quantization, seed=1,
+                torque_noise=current_noise(device) if condition.noise else 0.0,
                 gains=(1.0, 1.02, 1.0) if condition.gain else 1.0,
-                disturbance=disturbance(self.setup) if condition.friction else None)
+                disturbance=stribeck(device.config.actuation.friction) if condition.friction else None)
         return truncated(self.logs[key], condition.duration)
 
 
@@ -383,22 +380,18 @@ def judge(figures: Figures, fit: Fit, row: Row, condition: Condition) -> None:
     model = Phantom(written)
     row.trajectory_error = float(torque_error(model, figures.truth, figures.held_out["trajectory"]).max())
     row.states_error = float(torque_error(model, figures.truth, figures.held_out["states"]).max())
-    viscous, coulomb = per_joint_friction(setup) if condition.friction else \
-        (per_joint(setup.friction.viscous), per_joint(setup.friction.coulomb))
+    truth = (setup.uneven if condition.friction else setup.truth).config.actuation.friction
+    viscous, coulomb = np.asarray(truth.viscous), np.asarray(truth.coulomb)
     estimated = fit.x[-6:]                         # the projection's physical values, per joint
     row.estimated_friction = (worst(estimated[:3] / viscous - 1), worst(estimated[3:] / coulomb - 1))
-    # TODO(friction): per_joint() reads one value or three; check the attribute names once the overlay
-    # writes per-joint friction (actuation.friction.viscous.joint1..3).
-    law = written.config.actuation.friction
-    row.written_friction = (worst(per_joint(law.viscous) / viscous - 1), worst(per_joint(law.coulomb) / coulomb - 1))
+    law = written.config.actuation.friction        # the overlay's, each joint's own
+    row.written_friction = (worst(np.asarray(law.viscous) / viscous - 1), worst(np.asarray(law.coulomb) / coulomb - 1))
     row.delay = 1e3 * fit.delay
-    # TODO(gains): the fit's relative torque gains (joint 1's is 1) and their standard deviations; the
-    # device's joint 2 receives 1.02 x the command in the torque-constant conditions, so the log's
-    # torques read 1/1.02 of the applied (say which the fit reports, and add its error to the goal).
-    gains, sigma = getattr(fit, "gains", None), getattr(fit, "gains_sigma", None)
-    if gains is not None:
-        row.gain = f"{gains[1]:.4f}" + ("" if sigma is None else f" ± {sigma[1]:.2g}")
-    warnings = [*fit.prediction.warnings(), *([fit.timing_warning()] if fit.timing_warning() else [])]
+    # joint 2's gain (the device's joint 2 receives 1.02 x the command in the torque-constant
+    # conditions: the log's torques times 1.02 are the applied ones, the gain to find)
+    values, sigma = fit.gains_estimated
+    row.gain = f"{values[1]:.4f} ± {sigma[1]:.1g}" + (" (corrected)" if fit.gains[1] != 1 else "")
+    warnings = [*fit.prediction.warnings(), *(w for w in (fit.timing_warning(), fit.gain_warning()) if w)]
     if fit.problems:
         row.verdict, row.messages = "refused", fit.problems + tuple(warnings)
     elif warnings:

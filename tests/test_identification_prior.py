@@ -259,3 +259,20 @@ def test_the_log_alones_covariance_is_infinite_where_it_sees_nothing():
     singular = v.T @ np.diag([0.0, 4.0, 100.0]) @ v
     variance = np.diag(estimation.inverse_information(singular))
     assert np.isinf(variance[:2]).all() and variance[2] == pytest.approx(0.01, rel=1e-12)
+
+
+def test_a_prior_without_friction_lets_the_log_give_it(lab):
+    """A configuration with no friction as the prior (viscous and Coulomb 0 on every joint: once a
+    crash, "51 is not in list", the coefficients dropped from the base parameters): the wide log
+    gives each joint's friction within 8 % (viscous) and 1 % (Coulomb) of the device's own
+    (VISCOUS, COULOMB: what the plant applied), and the rigid body as well as with the shipped
+    prior (held-out states within 0.1 % of the torque RMS of the shipped prior's fit)."""
+    fits, truth, held, logs = lab
+    frictionless = Phantom(describe(overrides={"actuation.friction.viscous": 0.0, "actuation.friction.coulomb": 0.0}))
+    fit = estimation.estimate(logs["wide"], frictionless)
+    values = fit.x[-6:]
+    print("friction from a frictionless prior:", values)
+    np.testing.assert_allclose(values[:3], VISCOUS, rtol=0.08)
+    np.testing.assert_allclose(values[3:], COULOMB, rtol=0.01)
+    states = held["states"]
+    assert np.abs(error(fit.written, truth, states) - error(fits["wide"].written, truth, states)).max() < 1e-3

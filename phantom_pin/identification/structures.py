@@ -65,6 +65,12 @@ class Structured:
                 rigid @ self.offset)
 
 
+#: A friction coefficient's typical size where the model has none, as a share of the joint's
+#: torque limit (N m, and N m s/rad per rad/s): 1 %, near the shipped models' Coulomb friction
+#: (0.01 N m against 0.33-0.38 N m) and far above what a joint's noise hides.
+FRICTION_FLOOR = 0.01
+
+
 class Structure:
     """Common part: the regressor of the Phantom, friction columns and the overlay's friction."""
 
@@ -86,6 +92,11 @@ class Structure:
         self.regressor = Regressor(phantom)
         law = self.config.actuation.friction
         self.friction_prior = np.array([*law.viscous, *law.coulomb])    # each joint's own law
+        # the friction coefficients' typical size: the model's, or where it is 0 (a model without
+        # friction) FRICTION_FLOOR of the joint's torque limit (N m; per rad/s for viscous): a
+        # zero size would drop the coefficient from the base parameters and the prior
+        floor = FRICTION_FLOOR * np.tile(np.asarray(self.config.actuation.effort, dtype=float), 2)
+        self.friction_scale = np.where(self.friction_prior > 0, self.friction_prior, floor)
 
     @property
     def motor(self) -> bool:
@@ -104,7 +115,9 @@ class Structure:
         rotor = [self.rotor] if self.rotor is not None else []
         positive = (rotor if self.motor else []) + list(range(n - 6, n))
         fixed = [] if self.motor or self.rotor is None else rotor
-        return physical.nearest(target - self.offset, weights, self.matrix, self.prior, self.scale, bodies,
+        start = self.prior.copy()      # strictly inside: a model without friction has it on the boundary
+        start[n - 6:] = np.maximum(start[n - 6:], 1e-3 * self.friction_scale)
+        return physical.nearest(target - self.offset, weights, self.matrix, start, self.scale, bodies,
                                 positive, self.consistent, fixed, prior_weight)
 
     def friction_ok(self, x: np.ndarray) -> bool:
@@ -159,7 +172,7 @@ class General(Structure):
         self.prior = np.concatenate([*(self.bodies[name].dynamic_parameters() for name in BODIES),
                                      [config.actuation.rotor[0]] if self.motor else [], self.friction_prior])
         self.scale = np.concatenate([*(_body_scale(self.bodies[name]) for name in BODIES),
-                                     [config.actuation.rotor[0]] if self.motor else [], self.friction_prior])
+                                     [config.actuation.rotor[0]] if self.motor else [], self.friction_scale])
         base = cached(description, ("general base", prefix),   # the base of Y A: combinations of x only
                       lambda: base_parameters(regressor.stacked(*sample(regressor)) @ a, self.names, self.scale))
         order = np.argsort(base.independent)            # pivots in x's order: friction last
@@ -233,7 +246,7 @@ class Report(Structure):
         self.units = constants.UNITS
         x0 = parameterization.report_vector(self.config)
         self.prior = np.concatenate([x0, self.friction_prior])
-        self.scale = np.concatenate([np.where(x0 != 0, np.abs(x0), 1.0), self.friction_prior])
+        self.scale = np.concatenate([np.where(x0 != 0, np.abs(x0), 1.0), self.friction_scale])
         self._pseudo = np.linalg.pinv(c)
         s = self.structured
         self.affine = np.hstack([s.affine, np.zeros((len(s.affine), 6))])
