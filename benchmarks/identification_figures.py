@@ -42,7 +42,8 @@ rigid body and rotors, viscous + Coulomb friction with stiction, stops, saturati
   timing on the instantaneous torques, per-joint friction (FRICTION_FACTORS, through
   actuation.yaml's per-joint keys) with a Stribeck peak (STRIBECK, a torque added to the
   plant's input), and all at once (identified with identify's defaults: held timing, delay
-  estimated), also at 120 s and without the torque constant's error.
+  estimated), also at 120 s, without the torque constant's error, and the friction and all at
+  once with ``--min-speed 0.05`` (the equations near rest left out: a Stribeck peak).
 
 Columns: held-out error of the written model's rigid-body torques (``Phantom(describe(folder,
 overrides=overlay(fit)))``, rotors included, friction not) against the device's own inverse
@@ -79,6 +80,7 @@ from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation
 from phantom_pin.identification import parameterization as pz
+from phantom_pin.identification.estimation import MIN_SPEED
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
 #: The report-structured devices: each report parameter (parameterization.SYMBOLS) times its
@@ -166,7 +168,7 @@ class Condition:
     """How the device is run and identified: the device's ``quantization``, ``noise`` (10 mA),
     ``gain`` (joint 2's torque constant 2 % high), ``friction`` (per joint, Stribeck); the log's
     ``duration`` (s), ``sampled`` (instantaneous torques, else the held commands), ``delay``
-    (samples late); identify's ``timing``."""
+    (samples late); identify's ``timing`` and ``min_speed`` (rad/s, --min-speed)."""
 
     name: str
     quantization: bool = False
@@ -177,6 +179,7 @@ class Condition:
     sampled: bool = True
     delay: int = 0
     timing: str = "sampled"
+    min_speed: float = MIN_SPEED
 
     @property
     def device_key(self) -> tuple[bool, bool, bool, bool]:
@@ -196,7 +199,10 @@ CONDITIONS = {
     "delay": Condition("1 ms delay (torques one sample late)", delay=1),
     "held": Condition("default --torque-timing held on instantaneous torques", timing="held"),
     "friction": Condition("per-joint friction, 1.5x Stribeck peak", friction=True),
+    "friction_slow": Condition("per-joint friction, 1.5x Stribeck peak, --min-speed 0.05", friction=True,
+                               min_speed=0.05),
     "all": Condition("all at once (identify's defaults: held, delay estimated)", **EVERYTHING),
+    "all_slow": Condition("all at once, --min-speed 0.05", min_speed=0.05, **EVERYTHING),
     "all_long": Condition(f"all at once, {LONG:g} s", duration=LONG, **EVERYTHING),
     "all_but_gain": Condition("all at once but the torque constant", **{**EVERYTHING, "gain": False}),
 }
@@ -442,7 +448,8 @@ def rows_of(figures: Figures, kinds: tuple[str, ...], conditions: dict[str, Cond
             if setup.openhaptics:           # written and read back in OpenHaptics' convention
                 log = io.read_log(through_openhaptics(log, folder), "openhaptics")
             started = time.perf_counter()
-            fit = estimate(log, setup.prior, structure=setup.structure, timing=condition.timing, delay=None)
+            fit = estimate(log, setup.prior, structure=setup.structure, timing=condition.timing, delay=None,
+                           min_speed=condition.min_speed)
             judge(figures, fit, row, condition)
             progress(f"{setup.name}, {kind}, {condition.name}: {row.verdict}, held-out "
                      f"{100 * row.trajectory_error:.3f} / {100 * row.states_error:.3f} % "

@@ -313,3 +313,15 @@ def test_the_identification_starts_from_each_joints_law(overridden):
     for structure in (General(phantom), Report(phantom)):
         assert structure.friction_prior.tolist() == list(VISCOUS + COULOMB)
     assert constants.nominal(overridden)[-6:].tolist() == list(VISCOUS + COULOMB)
+
+
+@pytest.mark.parametrize("viscous", [0.001, (1e-3, 1e-3), (1e-3, 1e-3, -1e-3), ("a", 1e-3, 1e-3),
+                                     (1e-3, 1e-3, float("nan")), (True, 1e-3, 1e-3), None])
+def test_a_friction_built_in_code_is_checked_like_the_file(viscous):
+    """Friction(viscous, coulomb) in code: three finite coefficients >= 0 each, as actuation.yaml's
+    reader demands; anything else (the old single number too) raises InvalidInputError naming it."""
+    with pytest.raises(InvalidInputError, match="viscous: expected three finite numbers >= 0"):
+        Friction(viscous, (0.01, 0.01, 0.01))
+    with pytest.raises(InvalidInputError, match="coulomb: expected three finite numbers >= 0"):
+        Friction((0.0, 0.0, 0.0), viscous)
+    assert Friction([1, 2, 3], np.array([4.0, 5.0, 6.0])) == Friction((1.0, 2.0, 3.0), (4.0, 5.0, 6.0))

@@ -15,7 +15,7 @@ from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import estimation, io
+from phantom_pin.identification import estimation, io, simulation
 from test_identification_end_to_end import COULOMB, VISCOUS, truth_overrides
 from test_identification_prior import PRIOR, error, lab_log, sum_of_sines
 
@@ -95,7 +95,8 @@ def test_the_timing_that_fits_better_is_recognised(device, held_log):
         right, wrong = (estimation.estimate(log, PRIOR, timing=timing) for timing in (kind, other))
         residual = right.timing_residual
         print(kind, residual, residual[other] / residual[kind])
-        assert min(residual, key=residual.get) == kind and residual == wrong.timing_residual
+        # each fit reads both timings in joint 1's torque scale with its own gains: the same within 1 %
+        assert min(residual, key=residual.get) == kind and residual == pytest.approx(wrong.timing_residual, rel=0.01)
         assert right.timing_warning() is None
         assert wrong.timing_warning().startswith(f"--torque-timing {other} fits the log worse than {kind} ")
         assert f"torque timing: {kind} fits the log better with the given 0 ms delay" in right.timing_lines()[1]
@@ -133,3 +134,35 @@ def test_identify_reports_the_delay_and_refuses_a_bad_one(held_log, tmp_path, ca
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith("phantom-pin: error: --delay: "), err
         assert not (tmp_path / "bad.yaml").exists()
+
+
+def stribeck(time, theta, dtheta):
+    """A Stribeck peak the model's friction law lacks: 0.5 x the device's Coulomb level opposing
+    the rate, decaying over 0.05 rad/s (N m; added to the plant's input by track)."""
+    return -0.5 * COULOMB * np.sign(dtheta) * np.exp(-((dtheta / 0.05) ** 2))
+
+
+def test_min_speed_leaves_out_a_stribeck_peak(device):
+    """The device with a Stribeck peak after breakaway (``stribeck``), a lab's 30 s sum of sines:
+    fitting the equations near rest (the default 0.01 rad/s) biases viscous friction by more
+    than 15 % (measured -63 % on joint 2) and the rigid body by more than 1 % on 500 states
+    (5.0 %); leaving out rates below 0.05 rad/s (min_speed) brings every joint's viscous and
+    Coulomb friction within 5 % and 1 % of the device's (2.2 %, 0.1 %) and the rigid body within
+    0.5 % (0.38 %). Bad values are refused naming ``min_speed``."""
+    dev, truth = device
+    t, theta, dtheta, ddtheta = sum_of_sines(30, 0.4, 1)
+    tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + CONFIG.actuation.friction.torque(dtheta)
+    log = simulation.track(dev, t, theta, dtheta, tau, seed=1, disturbance=stribeck)
+    states = random_states(CONFIG.limits, 500, 7)
+    errors = {}
+    for speed in (estimation.MIN_SPEED, 0.05):
+        fit = estimation.estimate(log, PRIOR, min_speed=speed)
+        errors[speed] = (fit.x[-6:] / TRUE_FRICTION - 1, error(fit.written, truth, states))
+        print(f"min_speed {speed}: friction errors {errors[speed][0]}, held-out {errors[speed][1]}")
+    assert np.abs(errors[estimation.MIN_SPEED][0][:3]).max() > 0.15 and errors[estimation.MIN_SPEED][1].max() > 0.01
+    assert np.abs(errors[0.05][0][:3]).max() < 0.05 and np.abs(errors[0.05][0][3:]).max() < 0.01
+    assert errors[0.05][1].max() < 5e-3
+    for value in (0.0, -0.05, float("nan"), "fast", True):
+        with pytest.raises(InvalidInputError) as caught:
+            estimation.estimate(log, PRIOR, min_speed=value)
+        assert caught.value.argument == "min_speed"

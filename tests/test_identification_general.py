@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from helpers import CONFIG
-from phantom_pin import Device, describe
+from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.identification import io, simulation
+from phantom_pin.identification import estimation, io, simulation
 from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, uncarve
 
 #: Per body: factor on mass and inertia, centre of mass offset (m), products xy, xz, yz (kg m^2).
@@ -160,7 +160,9 @@ BAD_LOGS = {
     "angles scaled by 1e300": (lambda r: _bad(r, theta=1e300 * r.log.theta), "rad beyond the stops, more than a turn"),
     "torques scaled by 1e300": (lambda r: _bad(r, tau=1e300 * r.log.tau), "N m, more than 1000 N m: not joint torques"),
     "a 10 Hz log": (lambda r: _bad(r, step=100), "cutoff: 20 Hz needs a log at 400 Hz or faster (this one: 10 Hz"),
-    "tau2 in another unit": (lambda r: _bad(r, tau=r.log.tau * [1, 10, 1]), "tau2 fit the model 0.1"),
+    "tau2 in another unit": (lambda r: _bad(r, tau=r.log.tau * [1, 10, 1]), "tau2: the logged torques are 9."),
+    "tau3 2.5 times the others": (lambda r: _bad(r, tau=r.log.tau * [1, 1, 2.5]),
+                                  "tau3 is 2.5 times joint 1's torque scale (gain 0.4"),
 }
 
 
@@ -202,12 +204,17 @@ def test_a_joints_torque_gain_is_found_corrected_and_reported(run, case, tmp_pat
     io.write_log(tmp_path / "log.csv", run.log.t, run.log.theta, run.log.tau * factor)
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml")
     assert code == 0, err
-    found, clean = gains(out), gains(run.general)
-    print(case, "gains:", found.tolist(), "true log's:", clean.tolist())
-    np.testing.assert_allclose(found[:, 0] / clean[:, 0], 1 / factor[1:], rtol=2e-4)
+    found = gains(out)                 # as applied (corrected) or estimated (kept at 1)
+    scaled_fit, clean_fit = (estimation.estimate(io.Log(run.log.t, run.log.theta, run.log.tau * f), Phantom(),
+                                                 delay=None) for f in (factor, np.ones(3)))
+    ratio = scaled_fit.gains_estimated[0] / clean_fit.gains_estimated[0]
+    print(case, "gains:", found.tolist(), "estimated over the true log's:", ratio)
+    np.testing.assert_allclose(ratio[1:], 1 / factor[1:], rtol=2e-4)
     assert (np.abs(found[:, 0] - 1 / factor[1:]) < 4 * found[:, 1]).all() and (found[:, 1] < 5e-3).all()
     scaled = [j for j in (1, 2) if factor[j] != 1]
-    assert "tau" + ", tau".join(str(j + 1) for j in scaled) + " are " in out
+    for j in scaled:    # the log's scale against joint 1's (1 / the gain), to the 4 digits printed
+        shown = float(re.search(rf"tau{j + 1} is (\S+) times", out).group(1))
+        assert abs(shown - factor[j]) < 4 * found[j - 1, 1] + 1e-4, (shown, factor[j])
     assert "torque constant in your driver by" in out
     if len(scaled) == 2:
         ratios = [float(v) for v in re.findall(r"(\S+) instead of the model's 11.6", out)]

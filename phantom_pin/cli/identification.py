@@ -78,13 +78,17 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
     identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread",
-                                                                 "delay": "--delay"})
+                                                                 "delay": "--delay", "min_speed": "--min-speed"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "
                                "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
+    identify.add_argument("--min-speed", type=float, default=estimation.MIN_SPEED, metavar="RAD_PER_S",
+                          help="fit a joint's torques only where its rate stays above this over the filter's span "
+                               f"(default {estimation.MIN_SPEED:g} rad/s: near rest a joint sticks); 0.05 for a "
+                               "friction with a Stribeck peak after breakaway (docs/identification.md, step 4)")
     identify.add_argument("--fixed-gains", action="store_true",
                           help="take the log's torques as they are (default: estimate each joint's torque gain "
                                "relative to joint 1, correct the model for it and report it)")
@@ -182,7 +186,7 @@ def identify_command(args: argparse.Namespace) -> int:
     try:
         fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
                                   timing=args.torque_timing, prior_spread=args.prior_spread, delay=delay,
-                                  gains=not args.fixed_gains)
+                                  gains=not args.fixed_gains, min_speed=args.min_speed)
     finally:
         bar.close()
     if fit.problems and not args.accept:

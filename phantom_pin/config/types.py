@@ -92,6 +92,20 @@ class Friction:
     viscous: tuple[float, float, float]
     coulomb: tuple[float, float, float]
 
+    def __post_init__(self) -> None:
+        for name in ("viscous", "coulomb"):     # what the reader checks, for a Friction built in code
+            value = getattr(self, name)
+            try:
+                values = tuple(float(v) for v in value)
+            except (TypeError, ValueError):
+                values = ()
+            if len(values) != 3 or not all(np.isfinite(values)) or min(values) < 0 or \
+                    any(isinstance(v, (bool, str)) for v in value):
+                raise InvalidInputError(f"expected three finite numbers >= 0, joint1..joint3 "
+                                        f"({'N m s/rad' if name == 'viscous' else 'N m'}), got {value!r}",
+                                        argument=name)
+            object.__setattr__(self, name, values)
+
     @property
     def uniform(self) -> bool:
         """Whether every joint has the same law (actuation.yaml could say it with one number each)."""

@@ -24,8 +24,9 @@ physically consistent parameters, and the checks that decide whether they may be
    off on one joint). Every link's parameters appear in several joints' equations (joint 1's
    holds every link), so one joint's scale against the others is in the log; the overall
    scale is not (all torques and all parameters scaled alike fit equally), hence joint 1 as
-   the reference. A gain is corrected where the log shows it differs from 1 (GAIN_EVIDENCE),
-   and beta estimated again with the others at 1.
+   the reference. A gain is corrected where the log shows it differs from 1 (by more than
+   GAIN_NOTED and GAIN_EVIDENCE standard deviations), and beta estimated again with the
+   others at 1.
 3. physical.nearest: the structure's parameters x (structures.py) whose base parameters are
    nearest to beta in the covariance's metric, with every link physical and friction >= 0.
 4. The checks (``Fit.problems``, each one line): a model that predicts the log worse than the
@@ -71,7 +72,8 @@ MAX_SHIFT_SIGMA, SHIFT_SHARE = 10.0, 0.1
 TORQUE_SCALE = (1 / 3, 3.0)
 #: The prior's standard deviation of each joint's torque gain relative to joint 1 (module doc,
 #: step 2): a torque constant or amplifier gain is specified to a few percent, a transmission
-#: ratio misread (11.2 for 11.6) is 3.5 % off; the log decides (a 60 s log: +-0.05 %).
+#: ratio misread (11.2 for 11.6) is 3.5 % off; the log decides (excite's trajectory: +-0.002-0.1 %;
+#: a lab's 60 s sum of sines, which moves joint 1 little: +-0.5 %).
 GAIN_SPREAD = 0.05
 #: A relative gain outside these bounds is no tolerance but a mistake (a unit, another joint's
 #: ratio): refused; a negative one is a flipped amplifier.
@@ -204,36 +206,37 @@ class Fit:
                    if self.delay_estimated else f"; identify with --torque-timing {other}"))
 
     def gain_lines(self) -> list[str]:
-        """The joints' torque gains relative to joint 1, estimated and corrected, one line (none
-        when not estimated)."""
+        """The joints' torque gains relative to joint 1, as estimated (the corrected ones as
+        applied: estimated again with the others at 1) and what became of them, one line."""
         values, sigma = self.gains_estimated
         if not sigma.any():
-            return []
+            return ["torque gains: not estimated (--fixed-gains / gains=False): the log's torques taken as they are"]
         return ["torque gains relative to joint 1 (the log's torques times these are the model's): " + ", ".join(
-            f"joint{j + 1} {values[j]:.6g} +- {sigma[j]:.2g} ("
-            + ("corrected in the written model" if self.gains[j] != 1 else
-               f"within {GAIN_EVIDENCE:g} standard deviations or {100 * GAIN_NOTED:g} % of 1: kept at 1") + ")"
+            f"joint{j + 1} " + (f"{self.gains[j]:.6g} +- {sigma[j]:.2g} (corrected in the written model)"
+                                if self.gains[j] != 1 else f"{values[j]:.6g} +- {sigma[j]:.2g} (within "
+                                f"{GAIN_EVIDENCE:g} standard deviations or {100 * GAIN_NOTED:g} % of 1: kept at 1)")
             for j in (1, 2))]
 
     def gain_warning(self) -> str | None:
-        """One line naming the gains corrected (what to write into the driver), or those kept at 1
+        """One line naming the gains corrected (what to write into the driver) and those kept at 1
         that the estimate puts more than GAIN_NOTED from it (the log cannot tell), else None."""
-        off = [j for j in (1, 2) if self.gains[j] != 1 and GAIN_BOUNDS[0] <= self.gains[j] <= GAIN_BOUNDS[1]]
         values, sigma = self.gains_estimated
-        unsure = [j for j in (1, 2) if self.gains[j] == 1 and abs(values[j] - 1) > GAIN_NOTED]
-        if not off and unsure:
-            return (", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in unsure)
-                    + f": kept at 1, the log cannot show it differs (needs {GAIN_EVIDENCE:g} standard deviations); "
-                    "a log that moves joint 1 more (phantom-pin excite) would tell")
-        if not off:
-            return None
-        hint = "" if self.ratios is None else " (or were they converted with transmission ratio " + ", ".join(
-            f"{self.ratios[j] / self.gains[j]:.4g} instead of the model's {self.ratios[j]:.4g}" for j in off) + "?)"
-        return (", ".join(f"tau{j + 1}" for j in off) + " are " + ", ".join(f"{self.gains[j]:.4g}" for j in off)
-                + " times joint 1's torque scale: corrected in the written model; multiply "
-                + ", ".join(f"joint {j + 1}'s" for j in off) + " torque constant in your driver by "
-                + ", ".join(f"{self.gains[j]:.4g}" for j in off)
-                + f" so that its commands are the model's torques{hint}")
+        off = [j for j in (1, 2) if self.gains[j] != 1 and GAIN_BOUNDS[0] <= self.gains[j] <= GAIN_BOUNDS[1]]
+        unsure = [j for j in (1, 2) if self.gains[j] == 1 and sigma[j] > 0 and abs(values[j] - 1) > GAIN_NOTED]
+        parts = []
+        if off:
+            hint = "" if self.ratios is None else " (or were they converted with transmission ratio " + ", ".join(
+                f"{self.ratios[j] / self.gains[j]:.4g} instead of the model's {self.ratios[j]:.4g}" for j in off) + "?)"
+            parts.append(" and ".join(f"tau{j + 1} is {1 / self.gains[j]:.4g} times" for j in off)
+                         + " joint 1's torque scale (gain " + ", ".join(f"{self.gains[j]:.4g}" for j in off)
+                         + "): corrected in the written model; multiply " + " and ".join(
+                             f"joint {j + 1}'s torque constant in your driver by {self.gains[j]:.4g}" for j in off)
+                         + f" so that its commands are the model's torques{hint}")
+        if unsure:
+            parts.append(", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in unsure)
+                         + f": kept at 1, the log cannot show it differs (needs {GAIN_EVIDENCE:g} standard "
+                         "deviations); a log that moves joint 1 more (phantom-pin excite) would tell")
+        return "; ".join(parts) or None
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:
@@ -257,8 +260,16 @@ class Fit:
 
 
 #: A joint's equation is fitted only where its rate stays above MIN_SPEED (rad/s) over the
-#: filter's span (1 / cutoff) either side: near rest a joint may stick, and its friction is then
-#: whatever holds it, not the sliding law the regressor's columns describe.
+#: filter's span (1 / cutoff) either side (``estimate(min_speed=)``, ``--min-speed``): near rest
+#: a joint may stick, and its friction is then whatever holds it, not the sliding law the
+#: regressor's columns describe. Where a joint's friction has a Stribeck peak just after
+#: breakaway, a higher bound leaves it out: measured on a lab's 60 s sum of sines
+#: (benchmarks/identification_figures.py, CAD device, a 1.5x peak decaying over 0.05 rad/s) at
+#: 0.01 rad/s 0.82 / 0.76 % held-out, viscous friction 34 % low; at 0.05 rad/s 0.20 / 0.30 %, 3.6 %
+#: low; at 0.1 rad/s 0.11 / 0.06 %, 2.2 % low. Not the default: on the tests' 1 %-noise lab logs
+#: 0.05 rad/s made a narrow log's joint 1 worse (5.9 -> 7.1 % on states) and the predicted
+#: uncertainty of a wide one optimistic (0.15 % predicted, 0.66 % shown), the samples it drops
+#: having carried the noise's share of the residual.
 MIN_SPEED = 0.01
 #: How a log's torques relate to its times: "held", commands each applied from its sample to the
 #: next (a servo loop's zero-order hold: the default), or "sampled", the torque at that instant
@@ -323,7 +334,8 @@ def _estimate_lag(samples: Samples, tau0: np.ndarray, weighted: Callable[[np.nda
     return float(grid[k] + np.clip(step, -1.0, 1.0) * GRID_STEP)
 
 
-def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay: float = 0.0) -> Samples:
+def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay: float = 0.0,
+             min_speed: float = MIN_SPEED) -> Samples:
     """The log filtered at ``cutoff`` (Hz), with the friction columns of ``law`` (Friction.torque
     with unit coefficients), edges cut, decimated (module doc, step 1); ``timing`` (TIMINGS);
     ``delay`` (s): the torques were logged that long after the positions they belong to, so
@@ -352,7 +364,7 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay
     keep = slice(edge, len(log.t) - edge, step)
     friction = friction_block(columns[keep])
     span = max(1, int(round(rate / cutoff)))
-    slow = scipy.ndimage.maximum_filter1d((np.abs(dtheta) < MIN_SPEED).astype(np.uint8), 2 * span + 1, axis=0)
+    slow = scipy.ndimage.maximum_filter1d((np.abs(dtheta) < min_speed).astype(np.uint8), 2 * span + 1, axis=0)
     index = np.arange(len(log.t))[keep]
     tau = tau[keep] if delay == 0 else lagged(smooth, rate, index, HOLD[timing] / rate - delay)
     return Samples(theta[keep], dtheta[keep], ddtheta[keep], tau, friction, ~slow[keep].astype(bool),
@@ -436,7 +448,7 @@ MAX_TORQUE = 1e3
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",  # noqa: C901 (checks, then stages)
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
              timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
-             gains: bool = True) -> Fit:
+             gains: bool = True, min_speed: float = MIN_SPEED) -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
     the prior, its friction law the friction columns): the base parameters of ``structure``
     ("general": the rigid body in full; "report": the report's structure, for a model in the
@@ -456,7 +468,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     Both timings are also fitted (at zero delay when it is estimated, else at the given one):
     ``Fit.timing_residual``, ``Fit.timing_lines``, ``Fit.timing_warning``. ``gains``: estimate each
     joint's torque gain relative to joint 1 (module doc, step 2; ``Fit.gains``), or take the
-    log's torques as they are (False).
+    log's torques as they are (False). ``min_speed`` (rad/s): a joint's equation is fitted where
+    its rate stays above it over the filter's span (MIN_SPEED).
     ``progress(share)`` is called as stages end."""
     def stage(share: float) -> None:
         if progress is not None:
@@ -466,7 +479,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise InvalidInputError(f"expected a phantom_pin.identification.Log (read_log), got {log!r}", argument="log")
     if not isinstance(phantom, Phantom):
         raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
-    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)):
+    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight), ("min_speed", min_speed)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
             raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
     spread = priors.spread_argument(prior_spread)
@@ -501,7 +514,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         raise LogError(f"{', '.join(constant)}: constant torque{'s' if len(constant) > 1 else ''} over the whole "
                        "log: nothing to identify (the log must hold the torques commanded during the motion)")
     model = STRUCTURES[structure](phantom)
-    samples = filtered(log, cutoff, phantom.config.actuation.friction, timing, 0.0 if delay is None else delay)
+    samples = filtered(log, cutoff, phantom.config.actuation.friction, timing, 0.0 if delay is None else delay,
+                       min_speed)
     stage(0.1)
     if len(samples.theta) < 50:
         raise LogError(f"too short: {len(samples.theta)} samples after filtering at {cutoff:g} Hz and cutting "
@@ -511,16 +525,14 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     moving = samples.moving                  # the equations fitted: joints clear of rest
     if (moving.sum(axis=0) < 50).any():
         still = ", ".join(str(j + 1) for j in np.flatnonzero(moving.sum(axis=0) < 50))
-        raise LogError(f"too little motion: joint(s) {still} move faster than {MIN_SPEED} rad/s in fewer than 50 "
-                       f"samples filtered at {cutoff:g} Hz; log an excitation trajectory (phantom-pin excite), or "
-                       "filter less")
+        raise LogError(f"too little motion: joint(s) {still} move faster than {min_speed:g} rad/s in fewer than 50 "
+                       f"samples filtered at {cutoff:g} Hz; log an excitation trajectory (phantom-pin excite), "
+                       "filter less, or lower --min-speed")
     smooth, index = samples.filtered_tau, samples.index
     assert smooth is not None and index is not None
     weighted = _criterion(phi, moving, _rms(smooth[index] - tau0, moving))    # the same for any timing
     estimated = delay is None
     at = delay = 0.0 if delay is None else delay
-    timing_residual = {name: weighted(lagged(smooth, samples.rate, index, HOLD[name] / samples.rate - at) - tau0)
-                       for name in TIMINGS}
     phi = phi * moving[..., None]
     stacked = phi.reshape(-1, phi.shape[-1])
     norms = np.linalg.norm(stacked, axis=0)
@@ -539,6 +551,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
         solved = _solve_gains(phi, samples.tau, tau0, moving, prior, (1, 2) if gains else ())
         estimated_gains = solved[-1]
         guess = estimated_gains[0]
+    timing_residual = {name: weighted(lagged(smooth * guess, samples.rate, index, HOLD[name] / samples.rate - at)
+                                      - tau0) for name in TIMINGS}     # the torques in joint 1's scale
     if gains:            # correct only the gains the log shows to differ from 1 (module doc, step 2)
         shown = tuple(j for j in (1, 2) if abs(estimated_gains[0][j] - 1) >
                       max(GAIN_NOTED, GAIN_EVIDENCE * estimated_gains[1][j]))
@@ -641,12 +655,19 @@ def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: L
                         f"(at most {100 * MAX_RESIDUAL_SHARE:.0f} %): the torques do not follow the motion; check "
                         "that theta and tau are the same samples, in rad and N m")
     prior = phi @ (model.matrix @ model.prior + model.offset)
-    size = float((y * prior).sum() / (prior * prior).sum())
-    scaled = TORQUE_SCALE[0] <= size <= TORQUE_SCALE[1]
-    if not scaled:
+    sizes = (y * prior).sum(axis=0) / np.maximum((prior * prior).sum(axis=0), 1e-300)    # per joint
+    wrong = [j for j in range(3) if not TORQUE_SCALE[0] <= sizes[j] <= TORQUE_SCALE[1]]
+    if len(wrong) == 3:
+        size = float((y * prior).sum() / (prior * prior).sum())
         problems.append(f"tau: the logged torques are {size:.3g} times the model's prediction along the motion"
                         + ("; are their signs flipped (amplifier polarity)?" if size < 0 else
                            "; are they in another unit (N m at the joint, not mN m or motor torques)?"))
+    follows = share.max() <= MAX_RESIDUAL_SHARE        # else the torques' sizes say nothing per joint
+    for j in wrong if len(wrong) < 3 and follows else ():
+        problems.insert(0, f"tau{j + 1}: the logged torques are {sizes[j]:.3g} times the model's prediction along "
+                        "the motion" + (f": tau{j + 1}'s sign is flipped (amplifier polarity)?" if sizes[j] < 0 else
+                                        "; in another unit, or converted with another joint's transmission ratio? The "
+                                        "log must hold joint torques (N m at the joint: motor torque x ratio)"))
     values, sigma = fit.friction
     negative = [name for name, v, s in zip(model.names[-6:], values, sigma) if v < -3 * s]
     if negative:
@@ -663,17 +684,13 @@ def _problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: L
                         f"{fit.beta[k]:.4g} to {fit.written[k]:.4g} {fit.units[k]} ({moved[k] / fit.sigma[k]:.3g} "
                         f"standard deviations{', a flipped sign' if flipped else ''}): the estimate is not of a "
                         "physical arm; check torque signs, units and transmission ratios")
-    flipped = [j for j in (1, 2) if fit.gains[j] < 0 and scaled]     # the whole log's scale first
-    odd = [j for j in (1, 2) if not GAIN_BOUNDS[0] <= fit.gains[j] <= GAIN_BOUNDS[1] and j not in flipped and scaled]
-    if flipped:
-        problems.insert(0, ", ".join(f"tau{j + 1}" for j in flipped) + " fit" + ("s" if len(flipped) == 1 else "")
-                        + " the model only as " + ", ".join(f"{fit.gains[j]:.3g}" for j in flipped)
-                        + " times joint 1's torque scale: " + ", ".join(f"tau{j + 1}" for j in flipped)
-                        + "'s sign is flipped (amplifier polarity)")
-    if odd:
-        problems.insert(0, ", ".join(f"tau{j + 1}" for j in odd) + " fit the model "
-                        + ", ".join(f"{fit.gains[j]:.3g}" for j in odd) + " times joint 1's torque scale (outside "
-                        f"{GAIN_BOUNDS[0]:g}-{GAIN_BOUNDS[1]:g}: no tolerance of a drive): were they converted with "
-                        "another joint's transmission ratio or unit? The log must hold joint torques (N m at the "
-                        "joint: motor torque x ratio)")
+    for j in (1, 2) if len(wrong) < 3 and follows else ():    # the gains of joints whose size is plausible
+        if j in wrong or GAIN_BOUNDS[0] <= fit.gains[j] <= GAIN_BOUNDS[1]:
+            continue
+        problems.insert(0, f"tau{j + 1} is {1 / fit.gains[j]:.3g} times joint 1's torque scale (gain "
+                        f"{fit.gains[j]:.3g}" + (f"): tau{j + 1}'s sign is flipped (amplifier polarity)" if
+                                                 fit.gains[j] < 0 else
+                                                 f", outside {GAIN_BOUNDS[0]:g}-{GAIN_BOUNDS[1]:g}: no drive's "
+                                                 "tolerance): converted with another joint's transmission ratio or "
+                                                 "unit? The log must hold joint torques (N m at the joint)"))
     return problems
