@@ -541,28 +541,36 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
                                                  spread if np.isfinite(spread) else 1.0)
     p = phi.shape[-1]
     prior = (beta0, spread_covariance) if np.isfinite(spread) else None
-    guess = np.ones(3)
-    for _ in range(2 if estimated and gains else 1):   # the delay again with the gains: a joint's scale moves it
-        if estimated:
-            delay = _estimate_lag(dataclasses.replace(samples, filtered_tau=smooth * guess), tau0, weighted,
-                                  HOLD[timing])
-            samples = dataclasses.replace(samples, tau=lagged(smooth, samples.rate, index,
-                                                              HOLD[timing] / samples.rate - delay))
-        solved = _solve_gains(phi, samples.tau, tau0, moving, prior, (1, 2) if gains else ())
-        estimated_gains = solved[-1]
-        guess = estimated_gains[0]
-    timing_residual = {name: weighted(lagged(smooth * guess, samples.rate, index, HOLD[name] / samples.rate - at)
-                                      - tau0) for name in TIMINGS}     # the torques in joint 1's scale
+
+    def lag(scale: np.ndarray) -> tuple[float, Samples]:
+        """The delay estimated on the torques times ``scale`` (joint 1's scale), and the samples at it."""
+        found = _estimate_lag(dataclasses.replace(samples, filtered_tau=smooth * scale), tau0, weighted, HOLD[timing])
+        return found, dataclasses.replace(samples, tau=lagged(smooth, samples.rate, index,
+                                                             HOLD[timing] / samples.rate - found))
+
+    if estimated:
+        delay, samples = lag(np.ones(3))
+    solved = _solve_gains(phi, samples.tau, tau0, moving, prior, (1, 2) if gains else ())
+    estimated_gains = solved[-1]
     if gains:            # correct only the gains the log shows to differ from 1 (module doc, step 2)
         shown = tuple(j for j in (1, 2) if abs(estimated_gains[0][j] - 1) >
                       max(GAIN_NOTED, GAIN_EVIDENCE * estimated_gains[1][j]))
-        solved = solved if shown == (1, 2) else _solve_gains(phi, samples.tau, tau0, moving, prior, shown)
+        if estimated and shown:          # the delay again with the gains corrected: a joint's scale moves it
+            scale = np.ones(3)
+            scale[list(shown)] = estimated_gains[0][list(shown)]
+            delay, samples = lag(scale)
+            solved = _solve_gains(phi, samples.tau, tau0, moving, prior, (1, 2))
+            estimated_gains = solved[-1]
+        if shown != (1, 2):
+            solved = _solve_gains(phi, samples.tau, tau0, moving, prior, shown)
     beta, covariance, information, log_beta, log_rms, (gain, _) = solved
     log_sigma = np.sqrt(np.diag(inverse_information(information)))[:p]
     if information.shape[0] > p:      # beta's marginal: its covariance block, the information's Schur complement
         information = information[:p, :p] - information[:p, p:] @ np.linalg.solve(information[p:, p:],
                                                                                  information[p:, :p])
     covariance, log_beta = covariance[:p, :p], log_beta[:p]
+    timing_residual = {name: weighted(lagged(smooth * gain, samples.rate, index, HOLD[name] / samples.rate - at)
+                                      - tau0) for name in TIMINGS}     # in joint 1's scale, the gains applied
     logged = (samples.tau - tau0) * moving
     samples = dataclasses.replace(samples, tau=samples.tau * gain)     # in joint 1's torque scale
     y = (samples.tau - tau0) * moving
