@@ -610,7 +610,8 @@ def _solve_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.
     (beta, covariance, information (of beta and the free inverse gains), the log alone's beta
     and residual RMS per joint in joint 1's scale (N m), (gains (3,), standard deviations (3,)))."""
     p, scale = phi.shape[-1], np.ones(3)
-    beta = _fit(phi, (tau - tau0) * moving, moving, prior)[0]       # the gains at 1: where to start
+    # where to start: the gains at 1 (with none free, the loop's one pass is that fit: not done twice)
+    beta = _fit(phi, (tau - tau0) * moving, moving, prior)[0] if free else np.zeros(p)
     if prior is not None:
         prior = (np.concatenate([prior[0], np.zeros(len(free))]),
                  scipy.linalg.block_diag(prior[1], GAIN_SPREAD**2 * np.eye(len(free))))

@@ -24,7 +24,8 @@ with standard deviation SPREAD (30 %) of its typical size ``scale`` (structures:
 m r and m r^2 with m its mass and r its radius of gyration about the link origin, so that a
 product of inertia or an off-axis first moment is allowed 30 % of the body's size, not 30 % of
 a value that may be zero; the rotor inertia and each friction coefficient, 30 % of the model's
-value). 30 %: a model of the same design built by another lab differs by this much (the CAD
+value, or of structures.FRICTION_FLOOR of the joint's torque limit where the model has none).
+30 %: a model of the same design built by another lab differs by this much (the CAD
 masses against the report's: 8-25 % per link, docs/cad.md; friction laws between devices of one
 model: 20-40 %), and a prior tighter than the truth's distance would bias the excited
 directions, a looser one only lets the log decide a little more.
