@@ -65,7 +65,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     period = 1.0 / rate
     plant = Plant(device, friction=friction, hard_stops=hard_stops, saturation=saturation,
                   contact_step=period / substeps)
-    sense = _Encoders(device, theta, velocity, rate) if quantization else None
+    sense = Encoders(device, theta, velocity, rate) if quantization else None
     q, v = theta.tolist(), velocity.tolist()          # the state, Python floats
     # the samples, flat buffers of doubles (appending costs less than a NumPy row assignment)
     out_theta, out_dtheta, commanded, applied = (array.array("d") for _ in range(4))
@@ -153,7 +153,7 @@ def _steps(device: Device, theta0: np.ndarray, duration: float, rate: float, sam
     return (substeps if fixed else free), substeps
 
 
-class _Encoders:
+class Encoders:
     """What the controller sees with quantization: theta (rad) rounded to encoder counts
     (Device.encoder_counts) and the backward difference of those quantized angles over one
     period (rad/s; at t = 0 against theta0 - dtheta0 / rate), as fresh arrays."""

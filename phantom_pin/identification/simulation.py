@@ -19,7 +19,7 @@ import numpy as np
 
 from phantom_pin.device.controllers import tracking
 from phantom_pin.device.device import Device
-from phantom_pin.device.simulation import _Encoders, simulate
+from phantom_pin.device.simulation import Encoders, simulate
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log
 
@@ -81,7 +81,7 @@ def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, 
     rate = (len(t) - 1) / (t[-1] - t[0])
     # what the controller sees: simulate's own encoder model (the true state stays the plant's,
     # for the disturbance)
-    sense = _Encoders(device, theta[0], dtheta[0], rate) if quantization else None
+    sense = Encoders(device, theta[0], dtheta[0], rate) if quantization else None
 
     def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         k = min(int(round(time * rate)), len(t) - 1)
