@@ -36,20 +36,25 @@ publishers reliable, depth 100.
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import math
-from collections.abc import Mapping, Sequence
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from phantom_pin import drivers
-from phantom_pin.config.types import GIMBAL_JOINTS, JOINTS
-from phantom_pin.dynamics.coupling import Coupling
+from phantom_pin.config.types import GIMBAL_JOINTS, JOINTS, Friction
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.exceptions import InvalidInputError, MissingDataError
+from phantom_pin.forces import Frames, Renderer, Vector
+from phantom_pin.profiles import Profile, Qos
 
 #: The topics, by role: the input and the five outputs (module doc), relative names.
-TOPICS = {"joint_states": "joint_states", "gravity_torque": "gravity_torque",
+TOPICS = {"joint_states": "joint_states", "wrench": "wrench", "gravity_torque": "gravity_torque",
           "gravity_torque_openhaptics": "gravity_torque_openhaptics", "tip_pose": "tip_pose",
           "stylus_pose": "stylus_pose", "model_joint_states": "model_joint_states"}
 #: OpenHaptics' names of its three joints (its reference guide: "Turet Left +, Thigh Up +, Shin Up +").
@@ -61,6 +66,8 @@ BEYOND = 2 * math.pi
 #: is of no use to a servo loop); the publishers' depth (reliable) is DEPTH_OUT.
 DEPTH = 10
 DEPTH_OUT = 100
+#: The largest user force the node takes, per axis (N): far above any haptic device's.
+MAX_USER_FORCE = 100.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,6 +83,63 @@ class Output:
     stylus: np.ndarray | None
     model_names: tuple[str, ...]
     model_positions: np.ndarray
+
+
+class DriverBridge:
+    """The force path's computation, without ROS: a driver's joint_states (its profile's names,
+    each with the description's prefix, exactly once; its conventions) to theta and g, a user's
+    WrenchStamped to frame s, and the force the driver must send (forces.Renderer).
+    InvalidInputError naming the field of a message that must be dropped."""
+
+    def __init__(self, phantom: Phantom, profile: Profile, compensate: Sequence[str] = ("gravity",),
+                 max_force: float = math.inf, friction: Friction | None = None) -> None:
+        self.phantom, self.profile = phantom, profile
+        self.renderer = Renderer(phantom, profile, compensate, max_force, friction)
+        self.frames = Frames(phantom)
+        prefix = phantom.description.prefix
+        self.names = tuple(prefix + n for n in profile.joint_states.names)
+        stops = phantom.config.limits.stops
+        self.gimbal = phantom.config.gimbal
+        self.lower = np.array([*stops.lower, *(self.gimbal.lower if self.gimbal else ())]) - BEYOND
+        self.upper = np.array([*stops.upper, *(self.gimbal.upper if self.gimbal else ())]) + BEYOND
+
+    def state(self, names: Sequence[str], positions: Sequence[float]) -> tuple[np.ndarray, np.ndarray | None]:
+        """(theta, g) (rad) of one joint_states message; g None for a model without a gimbal."""
+        given = list(names)
+        if len(positions) != len(given):
+            raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
+        wanted = self.names if self.gimbal is not None else self.names[:3]
+        wrong = [n for n in wanted if given.count(n) != 1]
+        if wrong:
+            raise InvalidInputError(f"must hold each of {', '.join(wanted)} once; {', '.join(wrong)} not, in {given}",
+                                    argument="name")
+        values = [float(positions[given.index(n)]) for n in wanted]
+        if not math.isfinite(sum(values)):
+            raise InvalidInputError("not finite (NaN or inf)", argument="position")
+        theta = self.profile.arm_from_state(values[:3])
+        gimbal = None if self.gimbal is None else self.profile.gimbal_from_state(values[3:])
+        state = self.frames.state(theta, gimbal)
+        outside = [i for i in range(len(state)) if not self.lower[i] <= state[i] <= self.upper[i]]
+        if outside:
+            raise InvalidInputError(f"{wanted[outside[0]]} = {values[outside[0]]:.4g} rad is more than a turn "
+                                    "beyond its stop", argument="position")
+        return theta, gimbal
+
+    def wrench(self, frame: str, force: Sequence[float]) -> tuple[str, tuple[float, float, float]]:
+        """A user's WrenchStamped's frame_id and force (N), checked: a frame of the model's URDF
+        ("" is base_link) and finite values of at most MAX_USER_FORCE N."""
+        values = tuple(float(v) for v in force)
+        if len(values) != 3 or not all(math.isfinite(v) and abs(v) <= MAX_USER_FORCE for v in values):
+            raise InvalidInputError(f"expected three finite values of at most {MAX_USER_FORCE:g} N, got {values}",
+                                    argument="force")
+        if frame not in ("", self.frames.prefix + "base_link") and frame not in self.frames.names:
+            raise InvalidInputError(f"{frame!r} is not a frame of the model", argument="frame_id")
+        return frame, (values[0], values[1], values[2])
+
+    def user_force(self, frame: str, force: Sequence[float], theta: np.ndarray,
+                   gimbal: np.ndarray | None) -> np.ndarray:
+        """The user's force (N, given in ``frame``, checked by ``wrench``) in frame s at (theta, g)."""
+        return self.frames.rotation(frame, theta, gimbal) @ np.asarray(force, dtype=float)
 
 
 class Bridge:
@@ -98,13 +162,9 @@ class Bridge:
         stops = config.limits.stops
         self.lower = np.array([*stops.lower, *(self.gimbal.lower if self.gimbal else ())]) - BEYOND
         self.upper = np.array([*stops.upper, *(self.gimbal.upper if self.gimbal else ())]) + BEYOND
-        description = phantom.description
-        self.full = Coupling(description.urdf)  # every joint of the URDF, the gimbal free
+        self.frames = Frames(phantom)   # every joint of the URDF, the gimbal free; frame s in base_link
+        self.full, self.base_from_s = self.frames.full, self.frames.base_from_s
         self.model_names = tuple(self.full.tree.names[1:])
-        # base_link <- frame s: poses of Phantom (frame s) to base_link (REP-103)
-        data = phantom.model.createData()
-        pin.framesForwardKinematics(phantom.model, data, pin.neutral(phantom.model))
-        self.base_from_s = data.oMf[phantom.model.getFrameId(prefix + "report_s")].homogeneous.copy()
 
     def _values(self, names: Sequence[str], positions: Sequence[float]) -> tuple[dict[str, float], bool]:
         """The input by name, and whether it uses the drivers' names (else the model's)."""
@@ -155,11 +215,44 @@ def _pose(message, pose: np.ndarray, stamp, frame: str) -> None:
     o.x, o.y, o.z, o.w = float(q.x), float(q.y), float(q.z), float(q.w)
 
 
-def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: str = "phantom_pin"):
+def message_type(name: str) -> type:
+    """The Python class of a ROS message type ``pkg/msg/Name``; MissingDataError naming
+    ``driver`` where its package is not installed (omni_msgs: build it in the driver's workspace)."""
+    package, _, kind = name.split("/")
+    try:
+        return getattr(importlib.import_module(f"{package}.msg"), kind)
+    except (ImportError, AttributeError):
+        raise MissingDataError(f"the driver's message type {name} is not installed here (omni_msgs is not on "
+                               "PyPI: source the driver's ROS 2 workspace, or run the relay of docs/drivers.md)",
+                               argument="driver") from None
+
+
+def _qos(qos: Qos):
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    return QoSProfile(depth=qos.depth, reliability=ReliabilityPolicy.RELIABLE if qos.reliability == "reliable"
+                      else ReliabilityPolicy.BEST_EFFORT)
+
+
+def fill_force(message, profile: Profile, force: Vector, stamp=None) -> None:
+    """Write the driver's three numbers (N, its frame) into its force ``message`` (and ``stamp``
+    into its header where the type has one)."""
+    vector = message
+    for part in (profile.force.field or "").split("."):
+        vector = getattr(vector, part) if part else vector
+    vector.x, vector.y, vector.z = (float(v) for v in force)
+    if profile.force.header and stamp is not None:
+        message.header.stamp = stamp
+
+
+def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: str = "phantom_pin",
+              driver: DriverBridge | None = None):
     """The rclpy node (rclpy.init must have run): subscribes TOPICS["joint_states"] (renamed by
     ``topics``) and publishes the module doc's outputs per message; names with the prefix of
-    the Phantom's description."""
-    from geometry_msgs.msg import PoseStamped
+    the Phantom's description. With a ``driver``: subscribes its profile's joint states
+    instead, the user's force on ``wrench`` (geometry_msgs/WrenchStamped), and publishes the
+    profile's force command first, then the outputs above on the model's joint names."""
+    from geometry_msgs.msg import PoseStamped, WrenchStamped
     from rclpy.node import Node
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
@@ -167,14 +260,23 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
     bridge = Bridge(phantom)
     prefix = bridge.prefix
     names = {**TOPICS, **(topics or {})}
+    if driver is not None and "joint_states" not in (topics or {}):
+        names["joint_states"] = driver.profile.joint_states.topic
     unknown = sorted(set(names) - set(TOPICS))
     if unknown:
         raise InvalidInputError(f"unknown topic roles {unknown} (known: {', '.join(TOPICS)})", argument="topics")
-    base = prefix + "base_link"
+    model_names = [*bridge.model_arm, *(bridge.model_gimbal if bridge.gimbal is not None else ())]
+    force_type: Any = None if driver is None else message_type(driver.profile.force.type)
 
     class GravityNode(Node):
         def __init__(self) -> None:
             super().__init__(name)
+            if driver is not None:  # first: the force command, the servo loop's path
+                self.force: Any = self.create_publisher(force_type, driver.profile.force.topic,
+                                                   _qos(driver.profile.force.qos))
+                self.create_subscription(WrenchStamped, names["wrench"], self.on_wrench,
+                                         QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT))
+                self.user: tuple[str, tuple[float, float, float]] = ("", (0.0, 0.0, 0.0))
             reliable = QoSProfile(depth=DEPTH_OUT, reliability=ReliabilityPolicy.RELIABLE)
             self.outputs = {role: self.create_publisher(kind, names[role], reliable) for role, kind in (
                 ("gravity_torque", JointState), ("gravity_torque_openhaptics", JointState),
@@ -183,45 +285,110 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
             self.create_subscription(JointState, names["joint_states"], self.on_joint_states,
                                      QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT))
             self.dropped = 0
+            self.warned: set[str] = set()
+
+        def warn_once(self, key: str, text: str) -> None:
+            if key not in self.warned:
+                self.warned.add(key)
+                self.get_logger().warning(text)
+
+        def on_wrench(self, message) -> None:
+            force, torque = message.wrench.force, message.wrench.torque
+            try:
+                self.user = driver.wrench(  # type: ignore[union-attr]  # only with a driver
+                    message.header.frame_id, (force.x, force.y, force.z))
+            except InvalidInputError as error:
+                self.get_logger().warning(f"dropped a wrench message: {error}", throttle_duration_sec=1.0)
+                return
+            if torque.x or torque.y or torque.z:
+                self.warn_once("torque", "wrench: its torque part is ignored (the arm has three motors: a force "
+                                         "at the gimbal centre only)")
 
         def on_joint_states(self, message) -> None:
+            stamp = message.header.stamp
             try:
-                out = bridge(message.name, message.position)
+                if driver is None:
+                    out = bridge(message.name, message.position)
+                else:
+                    theta, gimbal = driver.state(message.name, message.position)
+                    self.send_force(theta, gimbal, stamp)
+                    out = bridge(model_names, [*theta, *(gimbal if gimbal is not None else ())])
             except InvalidInputError as error:
                 self.dropped += 1
                 self.get_logger().warning(f"dropped a joint_states message: {error}", throttle_duration_sec=1.0)
                 return
-            stamp = message.header.stamp
-            effort = JointState()
-            effort.header.stamp, effort.header.frame_id = stamp, message.header.frame_id
-            effort.name, effort.effort = list(out.names), [float(v) for v in out.effort]
-            self.outputs["gravity_torque"].publish(effort)
-            hd = JointState()
-            hd.header.stamp = stamp
-            hd.name, hd.effort = [prefix + n for n in OPENHAPTICS_NAMES], [float(v) for v in out.openhaptics]
-            self.outputs["gravity_torque_openhaptics"].publish(hd)
-            tip = PoseStamped()
-            _pose(tip, out.tip, stamp, base)
-            self.outputs["tip_pose"].publish(tip)
-            if out.stylus is not None:
-                stylus = PoseStamped()
-                _pose(stylus, out.stylus, stamp, base)
-                self.outputs["stylus_pose"].publish(stylus)
-            full = JointState()
-            full.header.stamp = stamp
-            full.name, full.position = list(out.model_names), [float(v) for v in out.model_positions]
-            self.outputs["model_joint_states"].publish(full)
+            self.publish_outputs(out, stamp, message.header.frame_id)
+
+        def send_force(self, theta: np.ndarray, gimbal: np.ndarray | None, stamp) -> None:
+            _send_force(self, driver, force_type, theta, gimbal, stamp)  # type: ignore[arg-type]
+
+        def publish_outputs(self, out: Output, stamp, frame_id: str) -> None:
+            _publish_outputs(self.outputs, out, stamp, frame_id, prefix)
 
     return GravityNode()
 
 
-def spin(phantom: Phantom, topics: Mapping[str, str] | None = None) -> int:
-    """Run the node until SIGINT or SIGTERM; 0 on a clean stop. The executor spins in a thread;
-    the signals set a flag that the main thread reads every 0.1 s, then shuts the executor down
-    (rclpy's own handlers are not installed: with them, a SIGTERM now and then left the node
-    spinning in CI)."""
+def _send_force(node, driver: DriverBridge, force_type: type, theta: np.ndarray, gimbal: np.ndarray | None,
+                stamp) -> None:
+    """Publish the driver's force command for one state (rad), its header stamped ``stamp``;
+    throttled warnings where it was clamped or damped near a singularity."""
+    frame, values = node.user
+    user = driver.user_force(frame, values, theta, gimbal)
+    seconds = stamp.sec + 1e-9 * stamp.nanosec
+    rendered = driver.renderer(theta, gimbal, user, seconds if seconds > 0 else time.time())
+    command = force_type()
+    fill_force(command, driver.profile, rendered.message, stamp)
+    node.force.publish(command)
+    if rendered.scale < 1.0:
+        node.get_logger().warning(f"force clamped to {np.linalg.norm(rendered.openhaptics):.3g} N (x "
+                                  f"{rendered.scale:.3g}: the driver's clamp, the motors or --max-force)",
+                                  throttle_duration_sec=1.0)
+    if rendered.singular:
+        node.get_logger().warning(f"near a singularity (smallest singular value of J {rendered.sigma_min:.2e} "
+                                  "m/rad): damped inverse", throttle_duration_sec=1.0)
+
+
+def _publish_outputs(outputs: dict, out: Output, stamp, frame_id: str, prefix: str) -> None:
+    """Publish today's outputs of one message (the module doc)."""
+    from geometry_msgs.msg import PoseStamped
+    from sensor_msgs.msg import JointState
+
+    base = prefix + "base_link"
+    effort = JointState()
+    effort.header.stamp, effort.header.frame_id = stamp, frame_id
+    effort.name, effort.effort = list(out.names), [float(v) for v in out.effort]
+    outputs["gravity_torque"].publish(effort)
+    hd = JointState()
+    hd.header.stamp = stamp
+    hd.name, hd.effort = [prefix + n for n in OPENHAPTICS_NAMES], [float(v) for v in out.openhaptics]
+    outputs["gravity_torque_openhaptics"].publish(hd)
+    tip = PoseStamped()
+    _pose(tip, out.tip, stamp, base)
+    outputs["tip_pose"].publish(tip)
+    if out.stylus is not None:
+        stylus = PoseStamped()
+        _pose(stylus, out.stylus, stamp, base)
+        outputs["stylus_pose"].publish(stylus)
+    full = JointState()
+    full.header.stamp = stamp
+    full.name, full.position = list(out.model_names), [float(v) for v in out.model_positions]
+    outputs["model_joint_states"].publish(full)
+
+
+def spin(phantom: Phantom, topics: Mapping[str, str] | None = None, driver: DriverBridge | None = None) -> int:
+    """Run the node (make_node) until SIGINT or SIGTERM; 0 on a clean stop."""
+    return run(lambda: make_node(phantom, topics, driver=driver),
+               f"phantom_pin {phantom.config.name}: joint_states -> "
+               f"{driver.profile.force.topic + ', ' if driver is not None else ''}gravity, poses")
+
+
+def run(make: Callable[[], Any], ready: str, loop: Callable[[Any, threading.Event], None] | None = None) -> int:
+    """Run the node ``make()`` builds until SIGINT or SIGTERM, logging ``ready`` once it spins;
+    0 on a clean stop. A worker thread spins the executor, or runs ``loop(executor, stop)``
+    (which must return once ``stop`` is set); the signals set ``stop``, which the main thread
+    reads every 0.1 s, then shuts the executor down (rclpy's own handlers are not installed:
+    with them, a SIGTERM now and then left the node spinning in CI)."""
     import signal
-    import threading
 
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
@@ -231,16 +398,18 @@ def spin(phantom: Phantom, topics: Mapping[str, str] | None = None) -> int:
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     try:
-        node = make_node(phantom, topics)
-        node.get_logger().info(f"phantom_pin {phantom.config.name}: {TOPICS['joint_states']} -> gravity, poses")
+        node = make()
         executor = SingleThreadedExecutor()
         executor.add_node(node)
-        worker = threading.Thread(target=executor.spin, name="phantom_pin executor", daemon=True)
+        target = executor.spin if loop is None else (lambda: loop(executor, stop))
+        worker = threading.Thread(target=target, name="phantom_pin executor", daemon=True)
         worker.start()
+        node.get_logger().info(ready)
         try:
             while not stop.wait(0.1) and worker.is_alive():
                 pass
         finally:
+            stop.set()
             executor.shutdown(timeout_sec=5.0)
             worker.join(timeout=5.0)
             node.destroy_node()

@@ -1,0 +1,220 @@
+"""The public ROS drivers of the Touch / Omni, as data: one profile per driver.
+
+Each profile (robots/phantom_description/config/drivers/NAME.yaml, every fact with the driver's
+source file and line at a stated commit) says what the driver publishes as joint states and how
+it takes a force: the topic, the message type and its quality of service, the frame of the
+force vector (a matrix A from the message's three numbers to OpenHaptics' HD_CURRENT_FORCE:
+F_OH = A F_msg), the clamp and damping the driver applies itself, and its rate.
+
+OpenHaptics' frame (OH) has the axes of the report's frame s (x to the user's right, y up, z
+towards the user; phantom_pin.drivers), so a force in OH is a force in frame s (N). Every
+public driver takes a Cartesian force in newtons and sends it with hdSetDoublev(
+HD_CURRENT_FORCE); OpenHaptics renders it at the gimbal centre (the tool frame t, ``tip``):
+the joint torques are J_p(theta)^T F, J_p the tip's position Jacobian in frame s
+(Device.tip_jacobian). See docs/drivers.md.
+
+Joint states: ``published = sign * a`` for OpenHaptics' raw arm angles a
+(HD_CURRENT_JOINT_ANGLES, rad), the elbow ``relative`` (sign3 * (a3 - a2)) or ``absolute``
+(sign3 * a3); the gimbal ``published = sign * g + offset`` (HD_CURRENT_GIMBAL_ANGLES, rad).
+The report's theta is (-a1, a2, a3) (phantom_pin.drivers).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from functools import cache
+
+import numpy as np
+import yaml
+
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError
+from phantom_pin.paths import DESCRIPTION_DIR
+
+#: Where the profiles live: one YAML file per driver, named after its repository.
+PROFILES_DIR = DESCRIPTION_DIR / "config" / "drivers"
+#: OpenHaptics' angle i = _SIGN[i] * theta_i (phantom_pin.drivers).
+_SIGN = (-1.0, 1.0, 1.0)
+#: The force message types a driver takes (the fields read; omni_msgs is built in a ROS workspace).
+FORCE_TYPES = ("geometry_msgs/msg/Vector3", "geometry_msgs/msg/Wrench", "geometry_msgs/msg/WrenchStamped",
+               "omni_msgs/msg/OmniFeedback")
+
+
+@dataclasses.dataclass(frozen=True)
+class Qos:
+    """A topic's quality of service: ``reliability`` ("reliable" or "best_effort"), ``depth``."""
+
+    reliability: str
+    depth: int
+
+
+@dataclasses.dataclass(frozen=True)
+class JointStates:
+    """What a driver publishes as sensor_msgs/JointState: ``topic``, ``names`` (the six, in
+    order: three of the arm, three of the gimbal), ``arm_signs`` and ``elbow`` ("relative" or
+    "absolute") of the arm's angles, ``gimbal_signs`` and ``gimbal_offsets`` (rad), ``effort_unit``
+    ("mN m" where it publishes OpenHaptics' joint torques, else None), ``qos``, ``rate`` (Hz)."""
+
+    topic: str
+    names: tuple[str, ...]
+    arm_signs: tuple[float, float, float]
+    elbow: str
+    gimbal_signs: tuple[float, float, float]
+    gimbal_offsets: tuple[float, float, float]
+    effort_unit: str | None
+    qos: Qos
+    rate: float
+
+
+@dataclasses.dataclass(frozen=True)
+class ForceCommand:
+    """How a driver takes a force: ``topic``, ``type`` (FORCE_TYPES), ``field`` (the Vector3
+    read: "force", "wrench.force", or None for a Vector3 itself), ``header`` (whether the type
+    has one), ``to_openhaptics`` (A, 3x3 signed permutation: F_OH = A F_msg), ``qos``,
+    ``clamp`` (N, the largest norm it sends; inf for none), ``damping`` (N s/m, F_OH -= damping *
+    v_OH each servo tick), ``spring`` (N/m towards the start-up position, each axis; 0 for none),
+    ``hold`` ("held": the last command every servo tick; "one_tick": only the tick after each
+    message), ``nan_to_zero`` (whether it zeroes non-finite components)."""
+
+    topic: str
+    type: str
+    field: str | None
+    header: bool
+    to_openhaptics: np.ndarray
+    qos: Qos
+    clamp: float
+    damping: float
+    spring: float
+    hold: str
+    nan_to_zero: bool
+
+
+@dataclasses.dataclass(frozen=True)
+class Profile:
+    """One driver: ``name``, ``description``, ``joint_states``, ``force``, ``sources`` (the
+    repositories read: owner/name@commit)."""
+
+    name: str
+    description: str
+    joint_states: JointStates
+    force: ForceCommand
+    sources: tuple[str, ...]
+
+    # -- joint states ------------------------------------------------------------------
+    def arm_from_state(self, published: Sequence[float]) -> np.ndarray:
+        """The report's theta (rad) of the driver's three published arm angles (rad)."""
+        s = self.joint_states.arm_signs
+        a1, a2, a3 = (p / si for p, si in zip(published, s))
+        if self.joint_states.elbow == "relative":
+            a3 += a2
+        return np.array([_SIGN[0] * a1, a2, a3])
+
+    def state_from_arm(self, theta: Sequence[float]) -> np.ndarray:
+        """The driver's three published arm angles (rad) of the report's theta (rad)."""
+        a1, a2, a3 = _SIGN[0] * theta[0], theta[1], theta[2]
+        if self.joint_states.elbow == "relative":
+            a3 -= a2
+        return np.array([a1, a2, a3]) * np.array(self.joint_states.arm_signs)
+
+    def gimbal_from_state(self, published: Sequence[float]) -> np.ndarray:
+        """OpenHaptics' raw gimbal angles (rad) of the driver's three published ones (rad)."""
+        return (np.asarray(published, dtype=float) - self.joint_states.gimbal_offsets) / self.joint_states.gimbal_signs
+
+    def state_from_gimbal(self, gimbal: Sequence[float]) -> np.ndarray:
+        """The driver's three published gimbal angles (rad) of OpenHaptics' raw ones (rad)."""
+        return np.asarray(gimbal, dtype=float) * self.joint_states.gimbal_signs + self.joint_states.gimbal_offsets
+
+    # -- forces ------------------------------------------------------------------------
+    def message_from_openhaptics(self, force: np.ndarray) -> np.ndarray:
+        """The message's three numbers (N) that make the driver send ``force`` (N, OH frame)."""
+        return self.force.to_openhaptics.T @ force
+
+    def openhaptics_from_message(self, force: np.ndarray) -> np.ndarray:
+        """HD_CURRENT_FORCE's direction and size (N, OH) of the message's three numbers (N),
+        before the driver's own clamp, damping and spring."""
+        return self.force.to_openhaptics @ force
+
+
+def names() -> tuple[str, ...]:
+    """The profiles' names, sorted."""
+    return tuple(sorted(path.stem for path in PROFILES_DIR.glob("*.yaml")))
+
+
+def _qos(node: dict, where: str) -> Qos:
+    reliability, depth = node.get("reliability"), node.get("depth")
+    if reliability not in ("reliable", "best_effort") or not isinstance(depth, int) or depth < 1:
+        raise ParameterFileError(f"{where}: expected reliability reliable|best_effort and depth >= 1, got {node}")
+    return Qos(reliability, depth)
+
+
+def _three(values: object, where: str) -> tuple[float, float, float]:
+    if not isinstance(values, list) or len(values) != 3 or not all(
+            isinstance(v, (int, float)) and math.isfinite(v) for v in values):
+        raise ParameterFileError(f"{where}: expected three finite numbers, got {values!r}")
+    return float(values[0]), float(values[1]), float(values[2])
+
+
+def _joint_states(node: dict, where: str) -> JointStates:
+    arm, gimbal = node["arm"], node["gimbal"]
+    if arm.get("elbow") not in ("relative", "absolute"):
+        raise ParameterFileError(f"{where}.arm.elbow: expected relative or absolute, got {arm.get('elbow')!r}")
+    signs = _three(arm["signs"], f"{where}.arm.signs") + _three(gimbal["signs"], f"{where}.gimbal.signs")
+    if any(s not in (-1.0, 1.0) for s in signs):
+        raise ParameterFileError(f"{where}: every sign must be 1 or -1, got {signs}")
+    names_ = node["names"]
+    if not isinstance(names_, list) or len(names_) != 6 or len(set(names_)) != 6:
+        raise ParameterFileError(f"{where}.names: expected six distinct joint names, got {names_!r}")
+    unit = node["effort"].get("unit")
+    if unit not in (None, "mN m"):
+        raise ParameterFileError(f"{where}.effort.unit: expected null or 'mN m', got {unit!r}")
+    rate = node["rate"]
+    if not isinstance(rate, (int, float)) or not rate > 0:
+        raise ParameterFileError(f"{where}.rate: expected a rate in Hz, got {rate!r}")
+    return JointStates(str(node["topic"]), tuple(map(str, names_)), signs[:3], arm["elbow"], signs[3:],
+                       _three(gimbal["offsets"], f"{where}.gimbal.offsets"), unit,
+                       _qos(node["qos"], f"{where}.qos"), float(rate))
+
+
+def _force(node: dict, where: str) -> ForceCommand:
+    if node["type"] not in FORCE_TYPES:
+        raise ParameterFileError(f"{where}.type: expected one of {', '.join(FORCE_TYPES)}, got {node['type']!r}")
+    matrix = np.array(node["to_openhaptics"], dtype=float)
+    if matrix.shape != (3, 3) or not np.array_equal(matrix @ matrix.T, np.eye(3)) or not set(
+            np.abs(matrix).ravel()) <= {0.0, 1.0} or round(np.linalg.det(matrix)) != 1:
+        raise ParameterFileError(f"{where}.to_openhaptics: expected a rotation that permutes and signs axes, "
+                                 f"got {node['to_openhaptics']}")
+    clamp = node["clamp"]
+    limit = math.inf if clamp["kind"] == "none" else float(clamp["value"])
+    if clamp["kind"] not in ("none", "norm") or not limit > 0:
+        raise ParameterFileError(f"{where}.clamp: expected kind none or norm with a value > 0 N, got {clamp}")
+    damping = float((node.get("damping") or {}).get("value", 0.0))
+    spring = float((node.get("impedance_spring") or {}).get("value", 0.0))
+    if not (damping >= 0 and spring >= 0 and math.isfinite(damping + spring)):
+        raise ParameterFileError(f"{where}: damping and spring must be finite and >= 0, got {damping}, {spring}")
+    if node["hold"] not in ("held", "one_tick"):
+        raise ParameterFileError(f"{where}.hold: expected held or one_tick, got {node['hold']!r}")
+    field = node["field"]
+    expected = {"geometry_msgs/msg/Vector3": None, "geometry_msgs/msg/Wrench": "force",
+                "geometry_msgs/msg/WrenchStamped": "wrench.force", "omni_msgs/msg/OmniFeedback": "force"}
+    if field != expected[node["type"]] or bool(node["header"]) != node["type"].endswith("Stamped"):
+        raise ParameterFileError(f"{where}: field {field!r} / header {node['header']!r} do not fit {node['type']}")
+    return ForceCommand(str(node["topic"]), node["type"], field, bool(node["header"]), matrix,
+                        _qos(node["qos"], f"{where}.qos"), limit, damping, spring, node["hold"],
+                        node["nan_to_zero"] is True)
+
+
+@cache
+def load(name: str) -> Profile:
+    """The profile ``name`` (names()); InvalidInputError naming ``driver`` for an unknown one,
+    ParameterFileError for a file that does not hold a profile."""
+    if not isinstance(name, str) or name not in names():
+        raise InvalidInputError(f"unknown driver profile {name!r} (known: {', '.join(names())})", argument="driver")
+    path = PROFILES_DIR / f"{name}.yaml"
+    node = yaml.safe_load(path.read_text(encoding="utf-8"))
+    try:
+        return Profile(node["name"], node["description"], _joint_states(node["joint_states"], f"{path}: joint_states"),
+                       _force(node["force"], f"{path}: force"),
+                       tuple(f"{r['repo']}@{str(r['commit'])[:7]}" for r in node["repositories"]))
+    except (KeyError, TypeError) as error:
+        raise ParameterFileError(f"{path}: not a driver profile ({error!r} missing or malformed)") from None

@@ -1,0 +1,174 @@
+"""A simulated driver: the device's own plant under a public driver's force command, in real
+time over ROS 2, so that users (and the tests) develop against a driver without hardware.
+
+``DriverSimulation`` is the computation without ROS: each servo tick (1 ms) it turns the last
+force command into the force OpenHaptics renders, as the profile's driver does (its frame A,
+its damping and start-up spring, its NaN handling, its norm clamp, the command held or applied
+for one tick: phantom_pin.profiles), applies J_p(theta)^T F at the gimbal centre to the plant
+(Device's gravity, friction, stops and saturation; device.plant), and gives the joint states in
+the driver's conventions. No hand holds the stylus, except that ``hold`` keeps it at theta0 for
+its first seconds, as a user's hand would until a node started alongside connects.
+
+``make_node`` and ``spin`` put it on ROS 2: the profile's joint-state topic at its rate and
+quality of service (positions, rad, in its conventions; efforts, where the driver publishes
+OpenHaptics' joint torques, the motors' J_p^T F in mN m on OpenHaptics' angles), and its force
+topic in its message type.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Sequence
+
+import numpy as np
+
+from phantom_pin import drivers
+from phantom_pin.device.device import Device
+from phantom_pin.device.plant import MAX_STEP, Plant, contact_substeps
+from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.profiles import Profile
+from phantom_pin.ros2 import _qos, message_type, run
+
+#: The servo loop's period (s): OpenHaptics' 1 kHz.
+PERIOD = 1e-3
+#: The most servo ticks one pass of the real-time loop catches up (a machine too busy to keep
+#: up drops the rest: the simulated time then lags the clock, said once in the log).
+CATCH_UP = 20
+
+
+class DriverSimulation:
+    """The device under a driver (module doc). ``device``: its Device (its Phantom's gimbal
+    locked at the angles the stylus is held at); ``profile``; ``theta0`` (rad, inside the
+    stops); ``hold`` (s, >= 0). ``tick()`` advances one servo period; ``command(numbers)``
+    takes a force message's three numbers (N, the driver's frame)."""
+
+    def __init__(self, device: Device, profile: Profile, theta0: Sequence[float], hold: float = 0.0) -> None:
+        theta = np.array(theta0, dtype=float)
+        if theta.shape != (3,) or not np.isfinite(theta).all() or not device.within_limits(theta):
+            raise InvalidInputError(f"expected three angles (rad) inside the stops, got {theta0!r}", argument="theta0")
+        if isinstance(hold, bool) or not isinstance(hold, (int, float)) or not 0 <= hold < math.inf:
+            raise InvalidInputError(f"expected a time >= 0 s, got {hold!r}", argument="hold")
+        self.device, self.profile, self.hold = device, profile, float(hold)
+        self.steps = max(1, math.ceil(PERIOD / MAX_STEP * (1 - 1e-12)))
+        substeps = max(self.steps, contact_substeps(device, theta, PERIOD, True, True))
+        self.plant = Plant(device, friction=True, hard_stops=True, saturation=True, contact_step=PERIOD / substeps)
+        self.q, self.v = theta.tolist(), [0.0, 0.0, 0.0]
+        self.x0 = device.phantom.forward_kinematics(theta)[:3, 3]     # m, frame s: the spring's target
+        self.time = 0.0                                                 # s, simulated
+        self.message: np.ndarray | None = None                          # the last command's numbers
+        self.fresh = False
+        self.applied = np.zeros(3)                                      # N m, J^T F of the last tick
+
+    def command(self, numbers: Sequence[float]) -> None:
+        """A force message's three numbers (N, the driver's frame), as the driver receives them."""
+        self.message = np.array([float(v) for v in numbers])
+        self.fresh = True
+
+    def force(self, jacobian: np.ndarray) -> np.ndarray:
+        """HD_CURRENT_FORCE this tick (N, OH = frame s), as the profile's driver computes it."""
+        spec = self.profile.force
+        if self.message is None or (spec.hold == "one_tick" and not self.fresh):
+            force = np.zeros(3)
+        else:
+            force = spec.to_openhaptics @ self.message
+        if spec.damping:
+            force = force - spec.damping * (jacobian @ np.array(self.v))
+        if spec.spring:
+            force = force + spec.spring * (self.x0 - self.device.phantom.forward_kinematics(np.array(self.q))[:3, 3])
+        if spec.nan_to_zero:
+            force = np.where(np.isfinite(force), force, 0.0)
+        elif not np.isfinite(force).all():
+            force = np.zeros(3)   # what the hardware does with NaN is not public: no force
+        norm = float(np.linalg.norm(force))
+        return force * (spec.clamp / norm) if norm > spec.clamp else force
+
+    def tick(self) -> None:
+        """One servo period: the driver's force as joint torques on the plant (after ``hold``)."""
+        theta = np.array(self.q)
+        jacobian = self.device.tip_jacobian(theta)
+        self.applied = jacobian.T @ self.force(jacobian)
+        self.fresh = False
+        if self.time >= self.hold:
+            self.q, self.v = self.plant.hold(self.q, self.v, self.applied.tolist(), PERIOD, self.steps)
+        self.time += PERIOD
+
+    def joint_state(self, gimbal: Sequence[float]) -> tuple[list[str], list[float], list[float]]:
+        """(names, positions (rad), efforts) of the driver's joint_states: the arm and the stylus
+        gimbal (raw angles ``gimbal``, rad) in its conventions; efforts in mN m where it publishes
+        OpenHaptics' joint torques (the motors' J^T F, the gimbal's 0), else empty."""
+        positions = [*self.profile.state_from_arm(self.q), *self.profile.state_from_gimbal(gimbal)]
+        efforts: list[float] = []
+        if self.profile.joint_states.effort_unit == "mN m":
+            efforts = [*drivers.openhaptics_torque_from_tau(self.applied).tolist(), 0.0, 0.0, 0.0]
+        return list(self.profile.joint_states.names), [float(p) for p in positions], efforts
+
+
+def make_node(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str = "", name: str = "sim_driver"):
+    """The rclpy node of a DriverSimulation (rclpy.init must have run): the profile's force topic
+    in, its joint states out (``loop`` runs it in real time)."""
+    from rclpy.node import Node
+    from sensor_msgs.msg import JointState
+
+    profile = simulation.profile
+    force_type = message_type(profile.force.type)
+    field = profile.force.field
+
+    class SimulatedDriverNode(Node):
+        def __init__(self) -> None:
+            super().__init__(name)
+            self.states = self.create_publisher(JointState, profile.joint_states.topic, _qos(profile.joint_states.qos))
+            self.create_subscription(force_type, profile.force.topic, self.on_force, _qos(profile.force.qos))
+
+        def on_force(self, message) -> None:
+            vector = message
+            for part in (field or "").split("."):
+                vector = getattr(vector, part) if part else vector
+            simulation.command((vector.x, vector.y, vector.z))
+
+        def publish_state(self) -> None:
+            names, positions, efforts = simulation.joint_state(gimbal)
+            message = JointState()
+            message.header.stamp = self.get_clock().now().to_msg()
+            message.name, message.position, message.effort = [prefix + n for n in names], positions, efforts
+            self.states.publish(message)
+
+    return SimulatedDriverNode()
+
+
+def loop(simulation: DriverSimulation, node, executor, stop: threading.Event) -> None:
+    """Real time: the servo ticks due by the clock, the joint states at the profile's rate, and
+    the executor's callbacks (force commands) between them, until ``stop``."""
+    rate_period = 1.0 / simulation.profile.joint_states.rate
+    start, ticks, published, lagging = time.monotonic(), 0, 0, False
+    while not stop.is_set():
+        due = int((time.monotonic() - start) / PERIOD)
+        if due - ticks > CATCH_UP:
+            if not lagging:
+                node.get_logger().warning(f"the machine is too busy for real time: dropped {due - ticks - CATCH_UP} "
+                                          "servo ticks (the simulated time lags the clock)")
+                lagging = True
+            start += (due - ticks - CATCH_UP) * PERIOD
+            due = ticks + CATCH_UP
+        while ticks < due:
+            simulation.tick()
+            ticks += 1
+            if ticks * PERIOD >= published * rate_period:
+                node.publish_state()
+                published += 1
+        executor.spin_once(timeout_sec=max(0.0, start + (ticks + 1) * PERIOD - time.monotonic()))
+
+
+def spin(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str = "") -> int:
+    """Run the simulated driver until SIGINT or SIGTERM; 0 on a clean stop."""
+    nodes: list = []
+
+    def make():
+        nodes.append(make_node(simulation, gimbal, prefix))
+        return nodes[0]
+
+    profile = simulation.profile
+    return run(make, f"sim-driver {profile.name}: {profile.force.topic} -> {profile.joint_states.topic} at "
+                     f"{profile.joint_states.rate:g} Hz", lambda executor, stop: loop(simulation, nodes[0], executor,
+                                                                                     stop))

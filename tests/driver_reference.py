@@ -1,0 +1,122 @@
+"""Independent reference for the drivers: each public driver's own formulas, transcribed from
+its source lines (not from our profiles), and the Touch's tip Jacobian and gravity from
+Ubitrack's kinematics (complex-step derivatives), the report's closed form and the gimbal's
+reference load. Nothing here reads phantom_pin's profiles or forces."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import yaml
+
+from gimbal_reference import L1, L2, derivative, gimbal_gravity, openhaptics, ubitrack
+from helpers import CONFIG_DIR
+
+TOUCH = CONFIG_DIR.parent / "touch"
+LIMITS = yaml.safe_load((TOUCH / "joint_limits.yaml").read_text())["stops"]
+RANGES = yaml.safe_load((TOUCH / "gimbal.yaml").read_text())["joints"]
+PI = math.pi
+
+
+# -- from each driver's message to HD_CURRENT_FORCE (N, OpenHaptics' frame), its own formula ------
+def geomagic_touch_ros2(message) -> np.ndarray:
+    """IvoD1998/Geomagic_Touch_ROS2@cd0cdba omni_common/src/omni_state.cpp 320-325 (the stylus
+    at rest: the damping of 189-191 is 0): hdSetDoublev(HD_CURRENT_FORCE, (f.x, f.z, -f.y))."""
+    f = message.force
+    return np.array([f.x, f.z, -f.y])
+
+
+def sawsensablephantom(message) -> np.ndarray:
+    """jhu-saw/sawSensablePhantom@7ddd575 mtsSensableHD.cpp 327-356: the wrench's force as it is
+    (OpenHaptics' axes; viscosity 0 by default), its norm clamped to m_max_force = 2 N (71)."""
+    f = message.wrench.force
+    force = np.array([f.x, f.y, f.z])
+    norm = np.linalg.norm(force)
+    return force * (2.0 / norm) if norm > 2.0 else force
+
+
+def phantom_touch_ros2(message) -> np.ndarray:
+    """kinisi-robotics/phantom_touch_ros2@2bf5b20 hd++.cpp 138-145: the Vector3 as it is."""
+    return np.array([message.x, message.y, message.z])
+
+
+def touch_ros2_control(message) -> np.ndarray:
+    """CalaW/touch_ros2_control@e1e181e device_transforms.hpp 19-44 and touch_driver_node.cpp
+    176-199, 231-252 (at its start-up position, at rest: spring and damper 0): F_OH = (F_R.y,
+    F_R.z, F_R.x); non-finite components 0; the norm clamped to max_force, 8 N by default (278)."""
+    f = message.wrench.force
+    force = np.array([f.y, f.z, f.x])
+    force = np.where(np.isfinite(force), force, 0.0)
+    norm = np.linalg.norm(force)
+    return force * (8.0 / norm) if norm > 8.0 else force
+
+
+def geomagic_touch_x_ros2(message) -> np.ndarray:
+    """RViMLab/geomagic_touch_x_ros2@57da5c9 device.cpp 42-65: the Wrench's force as it is."""
+    f = message.force
+    return np.array([f.x, f.y, f.z])
+
+
+FORCE = {"geomagic_touch_ros2": geomagic_touch_ros2, "sawsensablephantom": sawsensablephantom,
+         "phantom_touch_ros2": phantom_touch_ros2, "touch_ros2_control": touch_ros2_control,
+         "geomagic_touch_x_ros2": geomagic_touch_x_ros2}
+
+
+# -- each driver's joint_states of OpenHaptics' raw angles a (arm) and g (gimbal), rad ------------
+def published(profile: str, a: np.ndarray, g: np.ndarray) -> tuple[list[str], list[float]]:
+    """(names, positions) as each driver publishes them (sources in the comments)."""
+    six = ["waist", "shoulder", "elbow", "yaw", "pitch", "roll"]
+    if profile == "geomagic_touch_ros2":   # omni_state.cpp 222-239, 286-288, 343-347
+        return six, [-a[0], a[1], a[2] - a[1], -g[0] + PI, -g[1] - 3 * PI / 4, -g[2] - PI]
+    if profile == "sawsensablephantom":    # mtsSensableHD.cpp 417-423 (q[0] = -q[0]; q[2] -= q[1]); gimbal raw
+        return six, [-a[0], a[1], a[2] - a[1], *g]
+    if profile in ("phantom_touch_ros2", "touch_ros2_control"):   # hd++.cpp 257-268; device_transforms.hpp 77-87
+        return six, [a[0], a[1], a[2] - a[1], *g]
+    if profile == "geomagic_touch_x_ros2":  # geomagic_touch_x_component.cpp 98-105, 157-165: raw, absolute
+        return [f"joint_angle_{k}" for k in (1, 2, 3)] + [f"gimbal_angle_{k}" for k in (1, 2, 3)], [*a, *g]
+    raise KeyError(profile)
+
+
+# -- the Touch: the tip's position Jacobian in frame s and the gravity torques ------------------------
+def tip_jacobian(theta: np.ndarray) -> np.ndarray:
+    """d(gimbal centre in frame s)/d(theta) (m/rad): complex steps of Ubitrack's position of
+    OpenHaptics' angles (-theta1, theta2, theta3)."""
+    def position(t):
+        return ubitrack(np.array([-t[0], t[1], t[2], 0, 0, 0], dtype=complex))[0]
+    return np.column_stack([derivative(position, np.asarray(theta, dtype=float), k) for k in range(3)])
+
+
+def gravity(theta: np.ndarray, gimbal: np.ndarray, report) -> np.ndarray:
+    """The Touch's gravity torques (N m): the report's closed form with the Touch's numbers and
+    the gimbal's links at the given angles (gimbal_reference)."""
+    from phantom_pin import closed_form
+
+    return closed_form.gravity(theta, report) + gimbal_gravity(theta, gimbal)
+
+
+def stylus_rotation(theta: np.ndarray, gimbal: np.ndarray) -> np.ndarray:
+    """The stylus frame's rotation in frame s (Ubitrack's m[0..8])."""
+    return ubitrack(openhaptics(theta, gimbal))[1]
+
+
+#: base_link <- frame s rotation (the macro's frame: the report's x, y, z along base_link's y, z, x).
+BASE_FROM_S = np.array([[0.0, 0, 1], [1, 0, 0], [0, 1, 0]])
+
+
+def states(n: int, seed: int, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` seeded (theta, g) inside the Touch's stops (``margin`` rad inside) and gimbal ranges."""
+    rng = np.random.default_rng(seed)
+    joints = ("joint1", "joint2", "joint3")
+    lower = np.array([LIMITS[j]["lower"] for j in joints]) + margin
+    upper = np.array([LIMITS[j]["upper"] for j in joints]) - margin
+    theta = rng.uniform(lower, upper, (20 * n, 3))
+    keep = ((theta[:, 1] - theta[:, 2] <= LIMITS["theta2_minus_theta3_max"] - margin)
+            & (theta[:, 2] - theta[:, 1] <= LIMITS["theta3_minus_theta2_max"] - margin))
+    theta = theta[keep][:n]
+    names = ("joint4", "joint5", "joint6")
+    g = rng.uniform([RANGES[j]["lower"] for j in names], [RANGES[j]["upper"] for j in names], (n, 3))
+    return theta, g
+
+
+__all__ = ["FORCE", "L1", "L2", "BASE_FROM_S", "published", "tip_jacobian", "gravity", "stylus_rotation", "states"]

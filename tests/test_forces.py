@@ -1,0 +1,173 @@
+"""The force path without ROS (phantom_pin.forces, profiles, ros2.DriverBridge): each driver's
+joint_states read as the driver writes them (its source lines, driver_reference), the force it
+is sent taken back to OpenHaptics' frame by its own formula, and J^T F compared with the Touch's
+gravity from the report's closed form and the gimbal's reference load (J from complex steps of
+Ubitrack's kinematics): 1e-9 N m."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import driver_reference as ref
+from phantom_pin import InvalidInputError, Phantom, profiles
+from phantom_pin.forces import SINGULAR, Renderer
+from phantom_pin.ros2 import DriverBridge, fill_force
+
+PROFILES = profiles.names()
+
+
+@pytest.fixture(scope="module")
+def touch() -> Phantom:
+    return Phantom("touch")
+
+
+def message(profile: profiles.Profile) -> SimpleNamespace:
+    """An empty force message of the profile's type, as attributes (the ROS classes' layout)."""
+    vector = SimpleNamespace(x=0.0, y=0.0, z=0.0)
+    kind = profile.force.type.rsplit("/", 1)[1]
+    if kind == "Vector3":
+        return vector
+    if kind == "WrenchStamped":
+        return SimpleNamespace(header=SimpleNamespace(stamp=None), wrench=SimpleNamespace(force=vector))
+    return SimpleNamespace(force=vector)
+
+
+def test_every_driver_of_drivers_md_has_a_profile_with_its_sources():
+    assert set(PROFILES) == set(ref.FORCE)
+    for name in PROFILES:
+        profile = profiles.load(name)
+        assert profile.name == name and profile.sources and all("@" in s for s in profile.sources)
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_the_drivers_joint_states_give_theta_and_the_raw_gimbal(touch, name):
+    """Each driver's published angles (its formulas) back to theta = (-a1, a2, a3) and g: 1e-12."""
+    bridge = DriverBridge(touch, profiles.load(name))
+    theta, g = ref.states(50, seed=11)
+    for t, gg in zip(theta, g):
+        a = np.array([-t[0], t[1], t[2]])
+        names, positions = ref.published(name, a, gg)
+        shuffled = [*names[::-1], "other"]
+        values = dict(zip(names, positions))
+        got_theta, got_g = bridge.state(shuffled, [values.get(n, 9.0) for n in shuffled])
+        assert np.abs(got_theta - t).max() < 1e-12 and np.abs(got_g - gg).max() < 1e-12
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_the_force_sent_holds_gravity_plus_the_users_force(touch, name):
+    """F in the driver's message, taken back by the driver's own formula: J^T F = G(theta, g) +
+    J^T F_user (1e-9 N m), F_user 0.3 N given in base_link and in the stylus frame; where the
+    driver's clamp acts, |F| is the clamp and F keeps its direction."""
+    profile = profiles.load(name)
+    bridge = DriverBridge(touch, profile)
+    report = touch.config.report
+    theta, g = ref.states(40, seed=12)
+    user = np.array([0.1, -0.2, 0.3]) * 0.5
+    clamped = 0
+    for t, gg in zip(theta, g):
+        for frame, f_s in (("base_link", ref.BASE_FROM_S.T @ user), ("stylus", ref.stylus_rotation(t, gg) @ user)):
+            rendered = bridge.renderer(t, gg, bridge.user_force(frame, user, t, gg))
+            sent = message(profile)
+            fill_force(sent, profile, rendered.message)
+            force = ref.FORCE[name](sent)
+            jacobian = ref.tip_jacobian(t)
+            want = ref.gravity(t, gg, report) + jacobian.T @ f_s
+            if rendered.scale == 1.0:
+                assert np.abs(jacobian.T @ force - want).max() < 1e-9
+            else:  # the driver's clamp: the size it allows, the direction of the unclamped force
+                clamped += 1
+                assert np.linalg.norm(force) == pytest.approx(profile.force.clamp, rel=1e-12)
+                unclamped = np.linalg.solve(jacobian.T, want)
+                assert np.abs(force / np.linalg.norm(force) - unclamped / np.linalg.norm(unclamped)).max() < 1e-9
+    if profile.force.clamp == np.inf:
+        assert clamped == 0
+
+
+def test_the_clamp_is_the_lowest_of_the_drivers_max_force_and_the_motors(touch):
+    """A 50 N user force: saw's 2 N, --max-force 1 N, and the motors' saturation torques
+    (config/touch/actuation.yaml: 0.8801, 0.4401, 0.4401 N m) each bound it; never exceeded."""
+    limits = np.array([0.8801, 0.4401, 0.4401])
+    theta, g = ref.states(30, seed=13)
+    for name, max_force, cap in (("sawsensablephantom", np.inf, 2.0), ("touch_ros2_control", 1.0, 1.0),
+                                 ("geomagic_touch_x_ros2", np.inf, np.inf)):
+        renderer = Renderer(touch, profiles.load(name), max_force=max_force)
+        for t, gg in zip(theta, g):
+            rendered = renderer(t, gg, (50.0, -20.0, 10.0))
+            torques = ref.tip_jacobian(t).T @ rendered.openhaptics
+            assert rendered.scale < 1 and np.all(np.abs(torques) <= limits * (1 + 1e-12))
+            assert np.linalg.norm(rendered.openhaptics) <= cap * (1 + 1e-12)
+            assert np.isclose(np.linalg.norm(rendered.openhaptics), cap, rtol=1e-12) or \
+                np.isclose(np.abs(torques / limits).max(), 1.0, rtol=1e-12)
+
+
+def test_near_the_singularity_the_inverse_is_damped_and_the_force_finite(touch):
+    """The tip on joint 1's axis (x = z = 0 in frame s: l1 cos(theta2) + l2 sin(theta3) = 0):
+    J loses joint 1's column; the force stays finite, bounded by |G| / (2 SINGULAR) at most."""
+    renderer = Renderer(touch, profiles.load("geomagic_touch_x_ros2"))
+    theta3 = -np.arcsin(np.cos(1.2))            # l1 = l2
+    theta = np.array([0.3, 1.2, theta3])
+    rendered = renderer(theta, None, (0.0, 0.0, 0.0))
+    assert rendered.singular and rendered.sigma_min < 1e-12 and np.isfinite(rendered.openhaptics).all()
+    assert np.linalg.norm(rendered.openhaptics) <= np.linalg.norm(touch.gravity(theta)) / (2 * SINGULAR)
+    far = renderer(np.array([0.3, 0.5, 0.6]), None)
+    assert not far.singular and far.sigma_min > SINGULAR
+
+
+def test_friction_compensation_adds_the_law_at_the_filtered_rate(touch):
+    """A joint path at a constant rate (rad/s), sampled at 1 kHz: after 0.5 s the filtered rate is
+    the true one (the first-order filter's error e^-63) and J^T F = G + viscous w + Coulomb sign(w)
+    (config/touch/actuation.yaml: 5e-4 N m s/rad, 0.01 N m) within 1e-9 N m; at rest no Coulomb term."""
+    renderer = Renderer(touch, profiles.load("geomagic_touch_x_ros2"), compensate=("gravity", "friction"))
+    rate = np.array([0.4, -0.3, 0.2])
+    start = np.array([0.0, 0.4, 0.5])
+    for k in range(501):
+        t = start + rate * k * 1e-3
+        rendered = renderer(t, None, (0.0, 0.0, 0.0), time=k * 1e-3)
+    want = ref.gravity(t, np.zeros(3), touch.config.report) + 5e-4 * rate + 0.01 * np.sign(rate)
+    assert np.abs(ref.tip_jacobian(t).T @ rendered.openhaptics - want).max() < 1e-9
+    still = Renderer(touch, profiles.load("geomagic_touch_x_ros2"), compensate=("gravity", "friction"))
+    for k in range(3):
+        rendered = still(start, None, time=k * 1e-3)
+    assert np.abs(ref.tip_jacobian(start).T @ rendered.openhaptics
+                  - ref.gravity(start, np.zeros(3), touch.config.report)).max() < 1e-9
+
+
+@pytest.mark.parametrize("call, argument", [
+    (lambda r: r([0.1, np.nan, 0.2]), "theta"),
+    (lambda r: r([0.1, 0.2, 0.3], [0, np.inf, 0]), "gimbal"),
+    (lambda r: r([0.1, 0.2, 0.3], None, (1e300, 0, 0)), "user"),
+    (lambda r: r([0.1, 0.2]), "theta"),
+])
+def test_bad_states_are_refused_naming_the_argument(touch, call, argument):
+    renderer = Renderer(touch, profiles.load("sawsensablephantom"))
+    with pytest.raises(InvalidInputError) as error:
+        call(renderer)
+    assert error.value.argument == argument
+
+
+def test_bad_options_and_messages_are_refused_naming_them(touch):
+    profile = profiles.load("sawsensablephantom")
+    for kwargs, argument in (({"compensate": ("inertia",)}, "compensate"), ({"compensate": "gravity"}, "compensate"),
+                             ({"max_force": 0.0}, "max_force"), ({"max_force": float("nan")}, "max_force")):
+        with pytest.raises(InvalidInputError) as error:
+            Renderer(touch, profile, **kwargs)
+        assert error.value.argument == argument
+    with pytest.raises(InvalidInputError) as error:
+        profiles.load("omni_firewire")
+    assert error.value.argument == "driver"
+    bridge = DriverBridge(touch, profile)
+    names = ["waist", "shoulder", "elbow", "yaw", "pitch", "roll"]
+    for frame, force, argument in (("nowhere", (0, 0, 1), "frame_id"), ("", (0, np.nan, 0), "force"),
+                                   ("stylus", (1e9, 0, 0), "force")):
+        with pytest.raises(InvalidInputError) as error:
+            bridge.wrench(frame, force)
+        assert error.value.argument == argument
+    for given, positions, argument in ((names + ["waist"], [0.1] * 7, "name"), (names[:5], [0.1] * 5, "name"),
+                                       (names, [0.1] * 5, "position"), (names, [0.1, np.nan, 0, 0, 0, 0], "position"),
+                                       (names, [9.0, 0.2, 0.1, 0, 0, 0], "position")):
+        with pytest.raises(InvalidInputError) as error:
+            bridge.state(given, positions)
+        assert error.value.argument == argument
