@@ -66,6 +66,9 @@ BEYOND = 2 * math.pi
 #: is of no use to a servo loop); the publishers' depth (reliable) is DEPTH_OUT.
 DEPTH = 10
 DEPTH_OUT = 100
+#: With a driver, the gravity torques, poses and model joint states follow at most this rate (Hz):
+#: enough for RViz and a logger, and the servo path (the force) is answered first and alone.
+OUTPUTS_RATE = 100.0
 #: The largest user force the node takes, per axis (N): far above any haptic device's.
 MAX_USER_FORCE = 100.0
 
@@ -285,12 +288,8 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
             self.create_subscription(JointState, names["joint_states"], self.on_joint_states,
                                      QoSProfile(depth=DEPTH, reliability=ReliabilityPolicy.BEST_EFFORT))
             self.dropped = 0
+            self.next_outputs = 0.0   # s, monotonic: when the driver's path publishes the outputs next
             self.warned: set[str] = set()
-
-        def warn_once(self, key: str, text: str) -> None:
-            if key not in self.warned:
-                self.warned.add(key)
-                self.get_logger().warning(text)
 
         def on_wrench(self, message) -> None:
             force, torque = message.wrench.force, message.wrench.torque
@@ -300,9 +299,10 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
             except InvalidInputError as error:
                 self.get_logger().warning(f"dropped a wrench message: {error}", throttle_duration_sec=1.0)
                 return
-            if torque.x or torque.y or torque.z:
-                self.warn_once("torque", "wrench: its torque part is ignored (the arm has three motors: a force "
-                                         "at the gimbal centre only)")
+            if (torque.x or torque.y or torque.z) and "torque" not in self.warned:
+                self.warned.add("torque")
+                self.get_logger().warning("wrench: its torque part is ignored (the arm has three motors: a force at "
+                                          "the gimbal centre only)")
 
         def on_joint_states(self, message) -> None:
             stamp = message.header.stamp
@@ -312,6 +312,10 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
                 else:
                     theta, gimbal = driver.state(message.name, message.position)
                     self.send_force(theta, gimbal, stamp)
+                    now = time.monotonic()
+                    if now < self.next_outputs:  # the servo path first: the rest at OUTPUTS_RATE
+                        return
+                    self.next_outputs = now + 1.0 / OUTPUTS_RATE
                     out = bridge(model_names, [*theta, *(gimbal if gimbal is not None else ())])
             except InvalidInputError as error:
                 self.dropped += 1

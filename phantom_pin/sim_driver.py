@@ -152,8 +152,11 @@ def loop(simulation: DriverSimulation, node, executor, stop: threading.Event) ->
             start += (due - ticks - CATCH_UP) * PERIOD
             due = ticks + CATCH_UP
         while ticks < due:
+            held = simulation.time < simulation.hold
             simulation.tick()
             ticks += 1
+            if held and simulation.time >= simulation.hold:
+                node.get_logger().info(f"released: the stylus is let go after {simulation.hold:g} s")
             if ticks * PERIOD >= published * rate_period:
                 node.publish_state()
                 published += 1

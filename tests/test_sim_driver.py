@@ -1,0 +1,126 @@
+"""The simulated driver without ROS (phantom_pin.sim_driver.DriverSimulation): the force it
+renders against each driver's own formula (its damping, spring, clamp and hold transcribed from
+its source lines), and, in lockstep with the node's computation (ros2.DriverBridge), the stylus
+floating where it was released, falling without the compensation, and moved by a user's force:
+the displacements measured on the tip of the report's closed-form kinematics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import driver_reference as ref
+from phantom_pin import Device, Phantom, closed_form, profiles
+from phantom_pin.ros2 import DriverBridge, fill_force
+from phantom_pin.sim_driver import DriverSimulation
+from test_forces import message
+
+PROFILES = profiles.names()
+#: Seeded releases where gravity beats static friction (|G| > 0.01 N m on joints 2 and 3).
+RELEASES = [np.array([0.2, 0.6, 0.5]), np.array([-0.3, 0.9, 0.2])]
+
+
+@pytest.fixture(scope="module")
+def device() -> Device:
+    return Device(Phantom("touch"))
+
+
+def tip(device: Device, theta) -> np.ndarray:
+    """The gimbal centre in frame s (m), by the report's closed form (eq. 10)."""
+    return closed_form.forward_kinematics(np.asarray(theta), device.config.report)[:3, 3]
+
+
+def test_the_simulated_drivers_render_as_their_sources_say(device):
+    """One tick's HD_CURRENT_FORCE for a command m, the stylus moving at v: geomagic's A m - 1 N s/m v
+    (0.001 N/(mm/s), omni_state.cpp 189-191, 320-325); CalaW's B^T(m) + 45 N/m (x0 - x) - 2.5 N s/m v
+    (touch_driver_node.cpp 176-199, 271-291), its 8 N clamp; saw's 2 N clamp; kinisi's command for one
+    tick only (hd++.cpp 138-145, phantom_touch_control_node.cpp 197-211)."""
+    theta0 = np.array([0.1, 0.5, 0.6])
+    command = np.array([0.3, -0.2, 0.1])
+    for name in PROFILES:
+        profile = profiles.load(name)
+        simulation = DriverSimulation(device, profile, theta0)
+        simulation.q, simulation.v = [0.12, 0.48, 0.61], [0.5, -0.4, 0.3]
+        jacobian = ref.tip_jacobian(np.array(simulation.q))
+        velocity = jacobian @ np.array(simulation.v)
+        sent = message(profile)
+        fill_force(sent, profile, command)
+        simulation.command(command)
+        want = ref.FORCE[name](sent)
+        if name == "geomagic_touch_ros2":
+            want = want - 1.0 * velocity
+        if name == "touch_ros2_control":
+            x0, x = tip(device, theta0), tip(device, simulation.q)
+            want = ref.FORCE[name](SimpleWrench(np.array([want[2], want[0], want[1]])
+                                                + [45 * (x0 - x)[2], 45 * (x0 - x)[0], 45 * (x0 - x)[1]]
+                                                - 2.5 * np.array([velocity[2], velocity[0], velocity[1]])))
+        assert np.abs(simulation.force(jacobian) - want).max() < 1e-12, name
+        simulation.tick()
+        second = simulation.force(ref.tip_jacobian(np.array(simulation.q)))
+        if name == "phantom_touch_ros2":
+            assert np.abs(second).max() == 0.0   # one tick after its message only
+    big = DriverSimulation(device, profiles.load("sawsensablephantom"), theta0)
+    big.command([30.0, 0.0, 0.0])
+    assert np.linalg.norm(big.force(ref.tip_jacobian(theta0))) == pytest.approx(2.0, rel=1e-12)
+
+
+class SimpleWrench:
+    """A WrenchStamped-shaped holder of a force in CalaW's driver frame R."""
+
+    def __init__(self, force: np.ndarray) -> None:
+        from types import SimpleNamespace
+
+        self.wrench = SimpleNamespace(force=SimpleNamespace(x=force[0], y=force[1], z=force[2]))
+
+
+def run(device: Device, name: str, theta0: np.ndarray, seconds: float, compensate=("gravity",),
+        user: tuple[str, np.ndarray] | None = None) -> np.ndarray:
+    """The driver simulated for ``seconds`` with the node's computation answering each of its
+    joint_states (at the driver's rate; the answer applied from the next tick): the tip (m, frame
+    s) at each tick."""
+    profile = profiles.load(name)
+    simulation = DriverSimulation(device, profile, theta0)
+    bridge = DriverBridge(device.phantom, profile, compensate)
+    every = round(1000 / profile.joint_states.rate)
+    gimbal = np.zeros(3)
+    tips = []
+    for k in range(round(seconds * 1000)):
+        if k % every == 0:
+            names, positions, _ = simulation.joint_state(gimbal)
+            theta, g = bridge.state(names, positions)
+            force = np.zeros(3) if user is None else bridge.user_force(user[0], user[1], theta, g)
+            simulation.command(bridge.renderer(theta, g, force, time=k * 1e-3).message)
+        simulation.tick()
+        tips.append(tip(device, simulation.q))
+    return np.array(tips)
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_the_stylus_floats_where_it_is_released_and_falls_without_compensation(device, name):
+    """Released at rest: within 2 mm of the release for 5 s with the node's compensation; more
+    than 10 mm down (frame s's -y) within 3 s without (gravity beats the static friction there),
+    but for CalaW's driver, whose own 45 N/m spring to its start-up position (touch_driver_node.cpp
+    176-199) holds the stylus 5-10 mm below it: more than 5 mm there."""
+    report = device.config.report
+    for theta0 in RELEASES:
+        g = ref.gravity(theta0, np.zeros(3), report)
+        assert np.all(np.abs(g[1:]) > 0.01)     # beyond the Coulomb torque, 0.01 N m
+        start = tip(device, theta0)
+        held = run(device, name, theta0, 5.0)
+        assert np.linalg.norm(held - start, axis=1).max() < 2e-3
+        fallen = run(device, name, theta0, 3.0, compensate=())
+        assert (start[1] - fallen[:, 1]).max() > (5e-3 if name == "touch_ros2_control" else 10e-3)
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_a_users_force_moves_the_stylus_its_way(device, name):
+    """0.5 N up (base_link +z, frame s's +y) lifts the tip; 0.5 N along the stylus axis (its frame's
+    +z, Ubitrack's rotation) moves it along that axis: more than 1 mm in 0.1 s each (before a
+    stop: the tip's acceleration J M^-1 J^T F has a positive component along F)."""
+    theta0 = RELEASES[0]
+    start = tip(device, theta0)
+    lifted = run(device, name, theta0, 0.1, user=("base_link", np.array([0.0, 0.0, 0.5])))
+    assert lifted[-1, 1] - start[1] > 1e-3
+    axis = ref.stylus_rotation(theta0, np.zeros(3))[:, 2]
+    pushed = run(device, name, theta0, 0.1, user=("stylus", np.array([0.0, 0.0, 0.5])))
+    assert (pushed[-1] - start) @ axis > 1e-3
