@@ -150,8 +150,11 @@ def show_command(args: argparse.Namespace) -> int:
     if args.html is not None:
         output(args, "--html")
     robot = load(description(args))
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit  # the arm's, then a gimbal's
     if args.theta is not None:
-        warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+        warn_limits(args.theta, lower[:3], upper[:3])
+    if args.gimbal is not None and robot.model.nq == 6:
+        warn_limits(args.gimbal, lower[3:], upper[3:], "gimbal")
     with Viewer(robot) as viewer:
         if args.tip_force is not None:
             viewer.set_force(args.tip_force)
@@ -222,4 +225,4 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--html", help="write a self-contained HTML file instead of serving")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     command.add_argument("--open", action="store_true", help="open the live viewer in a browser")
-    command.set_defaults(run=show_command)
+    command.set_defaults(run=show_command, options={"gimbal": "--gimbal"})
