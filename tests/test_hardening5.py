@@ -2,6 +2,9 @@
 something independent of the code under test (the configuration files' own numbers, closed
 forms, a second tool)."""
 
+import json
+import shutil
+
 import numpy as np
 import pytest
 
@@ -41,3 +44,25 @@ def test_show_on_the_touch_checks_the_arm_and_the_gimbal_against_their_own_range
                          "--html", str(tmp_path / "arm.html"))
     assert code == 0 and err.count("\n") == 1, err
     assert "warning: theta" in err and bounds(arm.lower, arm.upper) in err, err
+
+
+def test_a_copy_of_the_touchs_folder_is_the_touch(tmp_path, capsys):
+    """H4: a copy of the Touch's configuration folder given with --config wrote a URDF named
+    phantom_1_5 without the gimbal and an MJCF MuJoCo could not load (exit 0), and every other
+    command failed with "no gimbal joint joint4 to lock". Against the committed files of the
+    named model, and MuJoCo loading the written scene."""
+    mujoco = pytest.importorskip("mujoco")
+    copy = tmp_path / "my_touch"
+    shutil.copytree(config.MODELS["touch"].config, copy)
+    urdf, mjcf, scene = tmp_path / "t.urdf", tmp_path / "t.xml", tmp_path / "scene.xml"
+    assert run(capsys, "--config", str(copy), "urdf", "-o", str(urdf))[0] == 0
+    assert urdf.read_text() == config.MODELS["touch"].urdf.read_text()
+    assert run(capsys, "--config", str(copy), "mjcf", "-o", str(mjcf), "--scene", str(scene))[0] == 0
+    assert mjcf.read_text() == config.MODELS["touch"].mjcf.read_text()
+    assert mujoco.MjModel.from_xml_path(str(scene)).nq == \
+        mujoco.MjModel.from_xml_path(str(config.MODELS["touch"].scene)).nq
+    theta = ["0.1", "0.3", "0.4"]
+    code, out, err = run(capsys, "--config", str(copy), "fk", *theta, "--json")
+    assert code == 0 and err == "", err
+    _, named, _ = run(capsys, "--model", "touch", "fk", *theta, "--json")
+    assert json.loads(out) == json.loads(named)

@@ -13,8 +13,7 @@ import numpy as np
 from phantom_pin import verification
 from phantom_pin.cli import device
 from phantom_pin.cli.common import description, output, overrides, phantom, positive_integer, show, vector, warn_limits
-from phantom_pin.config import DEFAULT, MODELS
-from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml
+from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -128,7 +127,7 @@ def write(args: argparse.Namespace) -> int:
     # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
     robot_file = target.name if scene is None else os.path.relpath(target.resolve(), scene.resolve().parent)
     made = description(args, prefix=args.prefix, robot_file=robot_file)
-    robot = (made.model or MODELS[DEFAULT]).robot_name
+    robot = xacro_model(made.config).robot_name
     if args.kind == "urdf" and args.convention == "driver":
         target.write_text(driver_urdf(made.config.folder if made.model is None else made.config.name,
                                       prefix=args.prefix, overrides=overrides(args)))

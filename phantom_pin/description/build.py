@@ -115,9 +115,14 @@ class Description:
     robot_file: str
 
 
-def _model(config: Config) -> Model:
-    """The named model whose xacros generate ``config`` (the default model's for a folder)."""
-    return configuration.MODELS.get(config.name, configuration.MODELS[configuration.DEFAULT])
+def xacro_model(config: Config) -> Model:
+    """The named model whose xacros generate ``config``: its own, or for a folder of one's own
+    the first named model (the default first) with a stylus gimbal if the folder has one (a copy
+    of the Touch's folder is written with the Touch's xacro, gimbal included)."""
+    if config.name in configuration.MODELS:
+        return configuration.MODELS[config.name]
+    named = sorted(configuration.MODELS.values(), key=lambda m: m.name != configuration.DEFAULT)
+    return next(m for m in named if (m.config / "gimbal.yaml").is_file() == (config.gimbal is not None))
 
 
 def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | None,
@@ -127,7 +132,7 @@ def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | No
     if not isinstance(prefix, str):
         raise InvalidInputError(f"prefix: expected a string, got {prefix!r}")
     config = configuration.read(source, overrides)
-    model = _model(config)
+    model = xacro_model(config)
     arguments = {"prefix": prefix, **({} if convention == "report" else {"convention": convention})}
     with tempfile.TemporaryDirectory() as folder:
         inputs = _xacro_inputs(config, Path(folder))
