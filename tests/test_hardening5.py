@@ -4,6 +4,7 @@ forms, a second tool)."""
 
 import json
 import shutil
+import warnings
 
 import numpy as np
 import pytest
@@ -66,3 +67,30 @@ def test_a_copy_of_the_touchs_folder_is_the_touch(tmp_path, capsys):
     assert code == 0 and err == "", err
     _, named, _ = run(capsys, "--model", "touch", "fk", *theta, "--json")
     assert json.loads(out) == json.loads(named)
+
+
+def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_path, capsys):
+    """M1: `identify --prior-spread 1e300` gave NumPy's overflow warning with source lines, then
+    "array must not contain infs or NaNs", no option named. The bound's reason, against the fit
+    of the log alone (no prior at all): at MAX_SPREAD the prior no longer moves the estimate
+    (relative difference below 1e-9 on a noiseless 10 s log of the model's own torques)."""
+    from phantom_pin.identification import estimation, io, prior
+    from test_identification_prior import CONFIG as PREMIUM
+    from test_identification_prior import PRIOR, sum_of_sines
+
+    t, theta, dtheta, ddtheta = sum_of_sines(10, 0.2, 1)
+    tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + PREMIUM.actuation.friction.torque(dtheta)
+    io.write_log(tmp_path / "log.csv", t, theta, tau)
+    log = io.read_log(tmp_path / "log.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        alone = estimation.estimate(log, PRIOR, prior_spread=float("inf")).beta
+        widest = estimation.estimate(log, PRIOR, prior_spread=prior.MAX_SPREAD).beta
+        assert np.abs(widest - alone).max() < 1e-9 * np.abs(alone).max()
+        for spread in ("1e300", "1e7"):
+            code, out, err = run(capsys, "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"),
+                                 "--prior-spread", spread)
+            assert code == 2 and out == "" and err == (
+                f"phantom-pin: error: --prior-spread: {float(spread)!r} is beyond 1e+06, where the prior no "
+                "longer counts; give inf for no prior\n")
+            assert not (tmp_path / "id.yaml").exists()
