@@ -100,8 +100,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                "report: the report's eight constants (a model in the report's form)")
     identify.add_argument("--prior-spread", type=float, default=prior.SPREAD,
                           help="how far the device may lie from the configuration you pass (the prior), as a "
-                               "relative standard deviation of every physical parameter (default 0.3, at most 1e6); what the log "
-                               "does not excite comes from the prior; inf: the log alone")
+                               "relative standard deviation of every physical parameter (default 0.3, at most 1e6); "
+                               "what the log does not excite comes from the prior; inf: the log alone")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     identify.add_argument("--accept", action="store_true",
                           help="write the result even where the checks refuse it, each check's reason as a warning "
