@@ -8,6 +8,7 @@ import warnings
 
 import numpy as np
 import pytest
+import yaml
 
 from phantom_pin import config
 from phantom_pin.cli import main
@@ -94,3 +95,19 @@ def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_
                 f"phantom-pin: error: --prior-spread: {float(spread)!r} is beyond 1e+06, where the prior no "
                 "longer counts; give inf for no prior\n")
             assert not (tmp_path / "id.yaml").exists()
+
+
+@pytest.mark.parametrize("text, message", [
+    ("l1: 0.2\nl1: 0.3\n", "not valid YAML at line 2, column 1: the key 'l1' is given twice"),
+    ("segment_a:\n  mass: 0.03\n  mass: 0.04\n", "not valid YAML at line 3, column 3: the key 'mass' is given twice"),
+    ("segment_a:\n  mass: 0.03\nsegment_a.mass: 0.04\n", "segment_a.mass is given twice (nested and dotted)"),
+])
+def test_an_overlay_that_gives_one_number_twice_is_refused(tmp_path, capsys, text, message):
+    """M4: an overlay with a duplicate key (`l1: 0.2` then `l1: 0.3`), or one number both nested
+    and dotted, was taken silently (the last won). PyYAML itself reads such a file without a word
+    (the premise); the command refuses it in one line naming --params and the file."""
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text(text)
+    yaml.safe_load(text)  # no error from PyYAML: it keeps the last
+    code, out, err = run(capsys, "--params", str(overlay), "fk", "0", "0", "0")
+    assert (code, out) == (2, "") and err == f"phantom-pin: error: --params: {overlay}: {message}\n", err
