@@ -111,3 +111,31 @@ def test_an_overlay_that_gives_one_number_twice_is_refused(tmp_path, capsys, tex
     yaml.safe_load(text)  # no error from PyYAML: it keeps the last
     code, out, err = run(capsys, "--params", str(overlay), "fk", "0", "0", "0")
     assert (code, out) == (2, "") and err == f"phantom-pin: error: --params: {overlay}: {message}\n", err
+
+
+@pytest.mark.parametrize("command, name, kind", [
+    (["excite"], "t.json", "CSV; name a .csv file"),
+    (["identify", "LOG"], "id.json", "a YAML overlay; name a .yaml or .yml file"),
+])
+def test_excite_and_identify_refuse_an_output_of_another_format(tmp_path, capsys, command, name, kind):
+    """M5: `excite -o t.json` wrote CSV into t.json (and identify YAML into any name)."""
+    (tmp_path / "log.csv").write_text("t,theta1,theta2,theta3,tau1,tau2,tau3\n")
+    target = tmp_path / name
+    argv = [a.replace("LOG", str(tmp_path / "log.csv")) for a in command]
+    code, out, err = run(capsys, *argv, "-o", str(target))
+    assert (code, out) == (2, "") and err == f"phantom-pin: error: --output: {target}: this command writes {kind}\n"
+    assert not target.exists()
+
+
+def test_excite_says_when_it_rounds_the_duration_up_to_whole_periods(tmp_path, capsys):
+    """M5: `excite --duration 3` silently wrote 5 s (one whole period of 5 s). The file's own
+    time column is the length the warning states."""
+    path = tmp_path / "t.csv"
+    code, out, err = run(capsys, "excite", "-o", str(path), "--duration", "3", "--rate", "100",
+                         "--iterations", "2", "--restarts", "1")
+    assert code == 0 and err == ("phantom-pin: warning: --duration 3 s rounded up to 1 whole period(s) of 5 s: 5 s "
+                                 "(the excitation is periodic; --period sets its length)\n")
+    assert np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(5.0, abs=1e-12)
+    code, out, err = run(capsys, "excite", "-o", str(path), "--duration", "10", "--rate", "100", "--force",
+                         "--iterations", "2", "--restarts", "1")
+    assert code == 0 and err == "" and np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(10.0)

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import description, overrides
+from phantom_pin.cli.common import description, overrides, warn
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -45,6 +45,13 @@ def _writable(path: Path) -> None:
         raise PhantomPinError(f"--output: {path} is a folder; name a file")
     if not folder.is_dir() or not os.access(folder, os.W_OK):
         raise PhantomPinError(f"--output: cannot write in {folder}")
+
+
+def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
+    """--output ends with one of ``suffixes``: the command writes ``kind`` only."""
+    if path.suffix.lower() not in suffixes:
+        raise PhantomPinError(f"{path}: this command writes {kind}; name a {' or '.join(suffixes)} file",
+                              argument="--output")
 
 
 def _delay(text: str | None) -> float | None:
@@ -136,6 +143,10 @@ def excite_command(args: argparse.Namespace) -> int:
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1
     _writable(args.output)
+    _suffix(args.output, (".csv",), "CSV")
+    if not math.isclose(periods * args.period, args.duration, rel_tol=1e-9):
+        warn(f"--duration {args.duration:g} s rounded up to {periods} whole period(s) of {args.period:g} s: "
+             f"{periods * args.period:g} s (the excitation is periodic; --period sets its length)")
     made = description(args)
     phantom = Phantom(made)
     times = np.arange(rows) / args.rate
@@ -172,6 +183,7 @@ def identify_command(args: argparse.Namespace) -> int:
     """phantom-pin identify, for the configuration of --model or --config (and the overrides)."""
     _refuse(args.output, args.force)
     _writable(args.output)
+    _suffix(args.output, (".yaml", ".yml"), "a YAML overlay")
     given = overrides(args)
     phantom = Phantom(description(args, given))
     if args.structure == "report" and phantom.config.report is None:
