@@ -228,7 +228,7 @@ def test_overrides_nested_dotted_and_qualified_keys_are_the_same(tmp_path):
     unchanged = dataclasses.replace(
         changed, overridden=False, report=dataclasses.replace(changed.report, Iaxx=shipped_config.report.Iaxx),
         actuation=dataclasses.replace(changed.actuation, motor=shipped_config.actuation.motor),
-        links=shipped_config.links)
+        links=shipped_config.links, sources=shipped_config.sources)  # the motor's says what changed
     assert unchanged == shipped_config  # nothing else changed
 
 

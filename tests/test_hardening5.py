@@ -139,3 +139,29 @@ def test_excite_says_when_it_rounds_the_duration_up_to_whole_periods(tmp_path, c
     code, out, err = run(capsys, "excite", "-o", str(path), "--duration", "10", "--rate", "100", "--force",
                          "--iterations", "2", "--restarts", "1")
     assert code == 0 and err == "" and np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(10.0)
+
+
+def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_path, capsys):
+    """M6: info with an overlay or --set printed the shipped source ("ESTIMATES ... the same for
+    each joint") beside the new numbers. The sources as the files state them (read here with
+    PyYAML): a section an override changed says which numbers are not its source's; the others
+    are unchanged."""
+    folder = config.MODELS["touch"].config
+    stated = {**yaml.safe_load((folder / "actuation.yaml").read_text())["sources"],
+              **yaml.safe_load((folder / "joint_limits.yaml").read_text())["sources"],
+              **yaml.safe_load((folder / "gimbal.yaml").read_text())["sources"]}
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("actuation:\n  friction:\n    viscous:\n      joint2: 0.01\ntip_offset: 0.04\n")
+    code, out, err = run(capsys, "--model", "touch", "info", "--json", "--params", str(overlay),
+                         "--set", "joint_torque_limit.joint1=0.5")
+    assert code == 0 and err == ""
+    data = json.loads(out)["device"]
+    expected = {"friction": "friction.viscous.joint2", "motor": "joint_torque_limit.joint1"}
+    for section in ("stops", "friction", "motor", "encoder", "transmission_ratio"):
+        changed = expected.get(section)
+        assert data[section]["source"] == (stated[section] if changed is None else
+                                           f"OVERRIDDEN here: {changed} (not from the source); the rest: "
+                                           f"{stated[section]}")
+    code, out, _ = run(capsys, "--model", "touch", "info", "--params", str(overlay))
+    assert f"  source: OVERRIDDEN here: tip_offset (not from the source); the rest: {stated['gimbal']}\n" in out
+    assert f"  source: {stated['friction']}\n" not in out
