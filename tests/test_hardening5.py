@@ -5,6 +5,7 @@ forms, a second tool)."""
 import json
 import shutil
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -165,3 +166,13 @@ def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_
     code, out, _ = run(capsys, "--model", "touch", "info", "--params", str(overlay))
     assert f"  source: OVERRIDDEN here: tip_offset (not from the source); the rest: {stated['gimbal']}\n" in out
     assert f"  source: {stated['friction']}\n" not in out
+
+
+def test_the_readme_says_what_ctrl_c_does_to_show_and_ros2():
+    """M7: the README promised one line and 130 on Ctrl-C for every command, while `show`'s live
+    viewer and `ros2` exit 0 on it, their normal stop (tests/test_cli.py's
+    test_show_serves_on_loopback_until_interrupted runs show and sends SIGINT: exit 0)."""
+    readme = " ".join((Path(__file__).parents[1] / "README.md").read_text().split())
+    start = readme.index("Ctrl-C prints one line and exits with 130")
+    sentence = readme[start:readme.index(". ", start)]
+    assert "`show`'s live viewer and the `ros2` node run until Ctrl-C or SIGTERM and then exit 0" in sentence
