@@ -176,3 +176,27 @@ def test_the_readme_says_what_ctrl_c_does_to_show_and_ros2():
     start = readme.index("Ctrl-C prints one line and exits with 130")
     sentence = readme[start:readme.index(". ", start)]
     assert "`show`'s live viewer and the `ros2` node run until Ctrl-C or SIGTERM and then exit 0" in sentence
+
+
+def test_a_length_that_leaves_the_lower_bar_unphysical_is_named(capsys):
+    """M8: `--set l1=0.2` on the Touch was refused blaming segment_c and hinge_pin, not l1. The
+    hinge pin (mass mp) is carved out of the lower bar (mass mc, transverse inertia I about its
+    centre, l1 long) at its end, l1 / 2 from the centre: by the parallel-axis theorem what is
+    left has I - mp mc (l1 / 2)^2 / (mc - mp) about its own centre, and the same axial moment Izz
+    (the pin sits on the axis): a body while twice the first is at least Izz (the triangle
+    inequality), up to the l1 below."""
+    physical = yaml.safe_load((config.MODELS["touch"].config / "physical_parameters.yaml").read_text())
+    mc, inertia, axial, mp = (physical["segment_c"]["mass"], physical["segment_c"]["inertia"]["xx"],
+                              physical["segment_c"]["inertia"]["zz"], physical["hinge_pin"]["mass"])
+    longest = 2 * np.sqrt((inertia - axial / 2) * (mc - mp) / (mp * mc))      # 0.1661 m
+    code, _, err = run(capsys, "--model", "touch", "--set", f"l1={longest * 0.999}", "fk", "0", "0", "0")
+    assert code == 0 and err == "", err
+    l1 = 0.2
+    code, out, err = run(capsys, "--model", "touch", "--set", f"l1={l1}", "fk", "0", "0", "0")
+    left = inertia - mp * mc * (l1 / 2) ** 2 / (mc - mp)
+    assert (code, out) == (2, "") and err.count("\n") == 1 and "link lower_bar_link" in err
+    assert f"principal moments {left:.6g}, {left:.6g}, {axial:.6g} kg m^2)" in err
+    assert err.endswith("(from segment_c.mass, segment_c.inertia, hinge_pin.mass, l1 (the hinge pin's distance; "
+                        "the inertias do not follow it))\n"), err
+    code, _, _ = run(capsys, "--model", "touch", "--set", f"l1={longest * 1.001}", "fk", "0", "0", "0")
+    assert code == 2
