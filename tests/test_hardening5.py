@@ -200,3 +200,18 @@ def test_a_length_that_leaves_the_lower_bar_unphysical_is_named(capsys):
                         "the inertias do not follow it))\n"), err
     code, _, _ = run(capsys, "--model", "touch", "--set", f"l1={longest * 1.001}", "fk", "0", "0", "0")
     assert code == 2
+
+
+@pytest.mark.parametrize("second", ["tau1", "TAU1 [mN m]"])
+def test_a_log_naming_one_column_twice_is_refused(tmp_path, capsys, second):
+    """M9: identify silently used the first of two columns both named tau1 (the second could be
+    the one meant: another unit, a filtered copy)."""
+    t = np.arange(3001) / 1000.0
+    theta = 0.2 * np.sin(np.outer(t, [1.0, 1.3, 1.7]))
+    table = np.column_stack([t, theta, 0.01 * theta, 10 * theta[:, 0]])
+    log = tmp_path / "log.csv"
+    np.savetxt(log, table, delimiter=",", header=f"t,theta1,theta2,theta3,tau1,tau2,tau3,{second}", comments="")
+    code, out, err = run(capsys, "identify", str(log), "-o", str(tmp_path / "id.yaml"))
+    assert (code, out) == (2, "") and err == (f"phantom-pin: error: {log}: the header names tau1 2 times; name each "
+                                              "column once\n"), err
+    assert not (tmp_path / "id.yaml").exists()

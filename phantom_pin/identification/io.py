@@ -110,6 +110,9 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, s
     if missing:
         raise LogError(f"{path}: missing column(s) {', '.join(missing)} (header must name "
                        f"{','.join(columns)}, in any order, case or quotes, with or without units in [])")
+    twice = [c for c in columns if header.count(c) > 1]
+    if twice:
+        raise LogError(f"{path}: the header names {twice[0]} {header.count(twice[0])} times; name each column once")
     rows = []
     for number, line in lines[1:]:
         values = line.split(separator)
