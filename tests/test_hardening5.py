@@ -215,3 +215,25 @@ def test_a_log_naming_one_column_twice_is_refused(tmp_path, capsys, second):
     assert (code, out) == (2, "") and err == (f"phantom-pin: error: {log}: the header names tau1 2 times; name each "
                                               "column once\n"), err
     assert not (tmp_path / "id.yaml").exists()
+
+
+@pytest.mark.parametrize("unbuffered", ["1", None])
+def test_simulate_into_a_pipe_closed_part_way_exits_141(unbuffered):
+    """M12: `simulate | head -c 10` exited 0 with PYTHONUNBUFFERED=1 (as Docker images set it):
+    unbuffered, Python writes the 219 kB once, the reader's exit leaves a short write and no
+    error, and the rest was dropped silently; the README says 141. Read in full, the output is
+    a whole JSON document of duration x rate + 1 samples."""
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"} | (
+        {"PYTHONUNBUFFERED": unbuffered} if unbuffered else {})
+    argv = [sys.executable, "-m", "phantom_pin.cli", "simulate", "--theta0", "0", "0.3", "0.4", "--duration", "1"]
+    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    assert len(process.stdout.read(10)) == 10
+    process.stdout.close()
+    assert process.wait(120) == 141 and process.stderr.read() == b""
+    process.stderr.close()
+    whole = subprocess.run(argv, capture_output=True, env=env, check=True, timeout=120)
+    assert len(whole.stdout) > 2**16 and len(json.loads(whole.stdout)["t"]) == 1001

@@ -132,7 +132,22 @@ def output(args: argparse.Namespace, option: str = "--output") -> Path:
 
 def show(args: argparse.Namespace, data: dict, text: str) -> None:
     """Print ``data`` as JSON with --json, else ``text``."""
-    print(json.dumps(data, indent=2, allow_nan=False) if getattr(args, "json", False) else text)
+    emit((json.dumps(data, indent=2, allow_nan=False) if getattr(args, "json", False) else text) + "\n")
+
+
+def emit(text: str) -> None:
+    """Write ``text`` to standard output in full, or raise BrokenPipeError (main: exit 141).
+    Unbuffered (PYTHONUNBUFFERED, python -u), sys.stdout writes once to the file descriptor, and
+    a reader that closes the pipe part way leaves a short write and no error: the rest is lost
+    silently, and the command exits 0."""
+    buffer = getattr(sys.stdout, "buffer", None)
+    if buffer is None:  # a replaced stdout (a test's capture)
+        sys.stdout.write(text)
+        return
+    sys.stdout.flush()
+    data = memoryview(text.encode(sys.stdout.encoding or "utf-8"))
+    while data:
+        data = data[buffer.write(data) or 0:]
 
 
 def vector(values: Any, spec: str) -> str:

@@ -6,14 +6,13 @@ import argparse
 import dataclasses
 import json
 import math
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import output, phantom, warn
+from phantom_pin.cli.common import emit, output, phantom, warn
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
@@ -170,7 +169,7 @@ def simulate_command(args: argparse.Namespace) -> int:
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
     text = _json(result, settings) if form == "json" else _csv(result)
     if target is None:
-        sys.stdout.write(text)
+        emit(text)
         return 0
     try:
         target.write_text(text)
