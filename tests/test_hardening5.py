@@ -237,3 +237,48 @@ def test_simulate_into_a_pipe_closed_part_way_exits_141(unbuffered):
     process.stderr.close()
     whole = subprocess.run(argv, capture_output=True, env=env, check=True, timeout=120)
     assert len(whole.stdout) > 2**16 and len(json.loads(whole.stdout)["t"]) == 1001
+
+
+def _log(path, units):
+    t = np.arange(3001) / 1000.0
+    theta = 0.2 * np.sin(np.outer(t, [1.0, 1.3, 1.7]))
+    header = "t [s]," + ",".join(f"theta{j} [rad]" for j in (1, 2, 3)) + "," + ",".join(
+        f"tau{j} [{units}]" for j in (1, 2, 3))
+    np.savetxt(path, np.column_stack([t, theta, 10 * theta]), delimiter=",", header=header, comments="")
+
+
+def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(tmp_path, capsys):
+    """M11: a log in mN m, named as such in its header, was refused after 19.5 s of fitting,
+    blaming the motion. Now at once, naming the column and the unit; the units each convention
+    takes are read (the report's N m in any spelling, OpenHaptics' mN m)."""
+    import time
+
+    from phantom_pin.identification import io
+
+    for units, convention in (("N m", "report"), ("Nm", "report"), ("N*m", "report"), ("mN m", "openhaptics")):
+        _log(tmp_path / "ok.csv", units)
+        assert io.read_log(tmp_path / "ok.csv", convention).tau.shape == (3001, 3)
+    _log(tmp_path / "log.csv", "mN m")
+    start = time.monotonic()
+    code, out, err = run(capsys, "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"))
+    assert time.monotonic() - start < 1.0
+    assert (code, out) == (2, "") and err == (
+        f"phantom-pin: error: {tmp_path / 'log.csv'}: tau1 is in mN m (its header), the report convention's torques "
+        "in N m: give the convention of the log (--convention; OpenHaptics': mN m) or convert it\n")
+    assert not (tmp_path / "id.yaml").exists()
+    _log(tmp_path / "log.csv", "N m")
+    with pytest.raises(io.LogError, match="tau1 is in N m .its header., the openhaptics convention's torques in mN m"):
+        io.read_log(tmp_path / "log.csv", "openhaptics")
+
+
+def test_a_poorly_excited_direction_spread_over_many_parameters_is_named_by_its_largest_three():
+    """Found with M11's log (torques 10 times the model's, read as N m): a poorly excited
+    direction with no component above 0.2 of its square crashed identify with an IndexError
+    (prediction._words took the first of none). Unit vector by hand: the three largest."""
+    from phantom_pin.identification import prediction
+
+    vector = np.array([3.0, -3.0, 2.9, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0])
+    vector /= np.linalg.norm(vector)                 # largest square 9 / 58.41 = 0.154
+    names = tuple(f"p{k}" for k in range(len(vector)))
+    a, c = 3 / np.sqrt(58.41), 2.9 / np.sqrt(58.41)
+    assert prediction._words(vector, names) == f"{a:.2f} (p0) - {a:.2f} (p1) + {c:.2f} (p2)"
