@@ -13,6 +13,7 @@ import yaml
 
 from phantom_pin import config
 from phantom_pin.cli import main
+from phantom_pin.exceptions import ParameterFileError
 
 TOUCH = config.read("touch")
 
@@ -282,3 +283,66 @@ def test_a_poorly_excited_direction_spread_over_many_parameters_is_named_by_its_
     names = tuple(f"p{k}" for k in range(len(vector)))
     a, c = 3 / np.sqrt(58.41), 2.9 / np.sqrt(58.41)
     assert prediction._words(vector, names) == f"{a:.2f} (p0) - {a:.2f} (p1) + {c:.2f} (p2)"
+
+
+#: Gimbal angles inside the Touch's ranges, none zero: a sign error in the lock shows here.
+LOCK = (0.3, -0.4, 0.5)
+
+
+def _locked_touch():
+    from phantom_pin import describe
+
+    return describe("touch", overrides={f"locked_at.{i}": v for i, v in enumerate(LOCK)})
+
+
+def test_the_arm_dynamics_hold_the_gimbal_at_a_nonzero_locked_at_as_the_six_joint_model():
+    """Mutation (gimbal): the lock's rotation with its sign flipped passed, every test running at
+    locked_at = 0. Against Pinocchio's six-joint model (joint4..6 free, at q = LOCK), whose arm
+    block of M and arm torques of gravity are the locked arm's, at 50 seeded states inside the
+    stops; 1e-12 relative. The gravity differs by 2 % from the one at 0 (the test can see it)."""
+    import pinocchio as pin
+
+    from phantom_pin import Phantom
+    from phantom_pin.config.sampling import random_states
+    from phantom_pin.dynamics.loader import load
+
+    description = _locked_touch()
+    arm, six = Phantom(description), load(description)
+    theta = random_states(TOUCH.limits, 50, seed=42)[0]
+    for th in theta:
+        q = np.concatenate([th, LOCK])
+        gravity = pin.computeGeneralizedGravity(six.model, six.data, q)[:3]
+        mass = pin.crba(six.model, six.data, q)[:3, :3]
+        np.testing.assert_allclose(arm.gravity(th), gravity, rtol=0, atol=1e-12 * np.abs(gravity).max())
+        np.testing.assert_allclose(arm.mass_matrix(th), mass, rtol=0, atol=1e-12 * np.abs(mass).max())
+    at_zero = pin.computeGeneralizedGravity(six.model, six.data, np.concatenate([theta[0], [0, 0, 0]]))[:3]
+    assert np.abs(at_zero - arm.gravity(theta[0])).max() > 1e-3 * np.abs(at_zero).max()
+
+
+def test_the_mjcf_holds_the_gimbal_at_a_nonzero_locked_at():
+    """Mutation (gimbal): the MJCF's lock equalities with the angle's sign flipped passed. MuJoCo's
+    own residual of each <joint>_lock is zero with the gimbal at LOCK, and 2 LOCK at -LOCK."""
+    mujoco = pytest.importorskip("mujoco")
+    model = mujoco.MjModel.from_xml_string(_locked_touch().mjcf)
+    data = mujoco.MjData(model)
+    for sign in (1, -1):
+        for joint, angle in zip(("joint4", "joint5", "joint6"), LOCK):
+            data.qpos[model.joint(joint).qposadr[0]] = sign * angle
+        mujoco.mj_forward(model, data)
+        residual = {model.equality(data.efc_id[i]).name: data.efc_pos[i] for i in range(data.nefc)
+                    if data.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_EQUALITY}
+        expected = [0.0, 0.0, 0.0] if sign == 1 else [-2 * a for a in LOCK]
+        np.testing.assert_allclose([residual[f"joint{j}_lock"] for j in (4, 5, 6)], expected, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("index, beyond", [(1, "upper"), (1, "lower"), (2, "upper")])
+def test_a_locked_at_outside_the_gimbals_range_is_refused(index, beyond):
+    """Mutation (gimbal): a locked_at outside the gimbal's range was accepted once the check was
+    removed. The ranges as gimbal.yaml states them (PyYAML)."""
+    stated = yaml.safe_load((config.MODELS["touch"].config / "gimbal.yaml").read_text())["joints"]
+    joint = f"joint{4 + index}"
+    angle = stated[joint][beyond] + (1e-9 if beyond == "upper" else -1e-9)
+    with pytest.raises(ParameterFileError, match=f"locked_at: {joint} at {angle!r} rad is outside its range"):
+        config.read("touch", {f"locked_at.{index}": angle})
+    assert config.read("touch", {f"locked_at.{index}": stated[joint][beyond]}).gimbal.locked_at[index] == \
+        stated[joint][beyond]
