@@ -3,6 +3,7 @@ something independent of the code under test (the configuration files' own numbe
 forms, a second tool)."""
 
 import json
+import re
 import shutil
 import warnings
 from pathlib import Path
@@ -346,3 +347,31 @@ def test_a_locked_at_outside_the_gimbals_range_is_refused(index, beyond):
         config.read("touch", {f"locked_at.{index}": angle})
     assert config.read("touch", {f"locked_at.{index}": stated[joint][beyond]}).gimbal.locked_at[index] == \
         stated[joint][beyond]
+
+
+@pytest.mark.parametrize("source, key, value, message", [
+    ("touch", "segment_df.com", -1e7, "segment_df.com must be at most 1e+06 in magnitude (SI units), got -10000000.0"),
+    ("premium_1_5", "housing.com.2", -1e300, "housing.com must be a list of 3 finite numbers of magnitude at most "
+                                             "1e+06, got [0, 0, -1e+300]"),
+    ("premium_1_5_cad", "links.forearm_link.com.0", 1e300, "links.forearm_link.com must be a list of 3 finite "
+                                                           "numbers of magnitude at most 1e+06, got [1e+300, "),
+])
+def test_the_magnitude_bound_holds_for_negative_numbers_and_list_items(source, key, value, message):
+    """Mutations (config): the 1e6 bound not holding for negative numbers, nor for lists (com.0 =
+    1e300 gave NaN gravity), passed."""
+    with pytest.raises(ParameterFileError, match=re.escape(message)):
+        config.read(source, {key: value})
+
+
+def test_a_continuous_torque_equal_to_the_stall_torque_is_refused():
+    """Mutation (config): `continuous >= stall` weakened to `>` passed: a motor whose continuous
+    torque equals its stall torque (the data sheet's 129 mN m, read with PyYAML) was accepted;
+    just below it is a motor (the check is strict, as a winding cannot run at stall)."""
+    stated = yaml.safe_load((config.MODELS["premium_1_5"].config / "actuation.yaml").read_text())["motor"]
+    key = "actuation.motor.max_continuous_torque"
+    current = {"actuation.motor.max_continuous_current": 0.998 * stated["stall_current"]}  # Kt I = the torque
+    with pytest.raises(ParameterFileError, match=f"max_continuous_torque {stated['stall_torque']:g} N m must be "
+                                                 f"below stall_torque {stated['stall_torque']:g} N m"):
+        config.read("premium_1_5", {key: stated["stall_torque"], **current})
+    below = config.read("premium_1_5", {key: stated["stall_torque"] * (1 - 1e-9), **current})
+    assert below.actuation.motor.max_continuous_torque < stated["stall_torque"]
