@@ -473,3 +473,159 @@ def test_hold_raises_diverged_when_the_state_leaves_the_finite_numbers():
     _, plant = _plant()
     with pytest.raises(Diverged):
         plant.hold([0.0, 0.5, 0.9], [0.0] * 3, [1e300, 0.0, 0.0], 1e-3, 1)
+
+
+# -- identification: each threshold against a log built here with a known truth --------------
+
+def _sines(t, amplitude=0.2, seed=1):
+    """Five sines per joint of seeded frequencies (0.1-1 Hz) and phases around (0, 0.3, 0.45) rad,
+    at any times ``t`` (s): theta, dtheta, ddtheta, exact."""
+    rng = np.random.default_rng(seed)
+    w, phase = 2 * np.pi * rng.uniform(0.1, 1.0, (3, 5)), rng.uniform(0, 2 * np.pi, (3, 5))
+    arg, a = w * t[:, None, None] + phase, amplitude / 5
+    return (np.array([0.0, 0.3, 0.45]) + a * np.sin(arg).sum(-1), a * (w * np.cos(arg)).sum(-1),
+            -a * (w**2 * np.sin(arg)).sum(-1))
+
+
+def _torques(phantom, theta, dtheta, ddtheta, coulomb=None):
+    """The model's inverse dynamics plus the shipped friction law (its Coulomb torques replaced)."""
+    law = phantom.config.actuation.friction
+    coulomb = law.coulomb if coulomb is None else coulomb
+    return (phantom.inverse_dynamics(theta, dtheta, ddtheta) + np.array(law.viscous) * dtheta
+            + np.array(coulomb) * np.sign(dtheta))
+
+
+T10 = np.arange(10001) / 1000.0
+
+
+def test_identify_passes_min_speed_to_the_fit(tmp_path, monkeypatch):
+    """Mutation (identification): --min-speed parsed and then ignored passed."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = _sines(T10)
+    io.write_log(tmp_path / "log.csv", T10, theta, _torques(phantom, theta, dtheta, ddtheta))
+    seen = {}
+
+    def spy(*args, **kwargs):
+        seen.update(kwargs)
+        raise io.LogError("stopped by the test")
+
+    monkeypatch.setattr(estimation, "estimate", spy)
+    assert main(["identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"), "--min-speed", "0.05"]) == 2
+    assert seen["min_speed"] == 0.05
+
+
+def test_a_log_with_torques_beyond_1000_n_m_is_refused_at_once():
+    """Mutation (identification): the early torque guard at 1e6 N m while its message says 1000
+    passed. A log of the model's torques with 2000 N m on joint 2's: refused before any fit."""
+    import time
+
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = _sines(T10)
+    tau = _torques(phantom, theta, dtheta, ddtheta)
+    tau[100, 1] = 2000.0
+    start = time.monotonic()
+    with pytest.raises(io.LogError, match=r"tau2: the log's torques reach 2e\+03 N m, more than 1000 N m"):
+        estimation.estimate(io.Log(T10, theta, tau), phantom)
+    assert time.monotonic() - start < 1.0
+
+
+def test_a_joint_moving_in_fewer_than_50_samples_is_too_little_motion():
+    """Mutation (identification): the "too little motion" check at 5 samples instead of 50
+    passed. Joint 3 swings 3.4 mrad at 0.5 Hz (peak 10.7 mrad/s): at --min-speed 10.5 mrad/s
+    the filtered log has between 5 and 50 of its samples moving (counted by
+    estimation.filtered), which is too little motion."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = _sines(T10)
+    w, amplitude = np.pi, 0.0034
+    theta[:, 2], dtheta[:, 2], ddtheta[:, 2] = (0.45 + amplitude * np.sin(w * T10), amplitude * w * np.cos(w * T10),
+                                                -amplitude * w * w * np.sin(w * T10))
+    log = io.Log(T10, theta, _torques(phantom, theta, dtheta, ddtheta))
+    moving = estimation.filtered(log, 20.0, phantom.config.actuation.friction, min_speed=0.0105).moving.sum(axis=0)
+    assert 5 < moving[2] < 50 and (moving[:2] >= 50).all(), moving
+    with pytest.raises(io.LogError, match="too little motion: joint.s. 3 move faster than 0.0105 rad/s in fewer "
+                                          "than 50 samples"):
+        estimation.estimate(log, phantom, min_speed=0.0105)
+
+
+@pytest.mark.parametrize("gain, corrected", [(1.005, False), (2.5, None)])
+def test_a_gain_is_corrected_only_beyond_1_percent_and_refused_beyond_2(gain, corrected):
+    """Mutations (identification): a gain corrected beyond 1 % OR 4 sigma (instead of AND), and a
+    gain between 2 and 3 accepted and "corrected", passed. The model's own torques with joint 2's
+    (or 3's) logged 1 / gain times too small: 0.5 % off (thousands of sigma on a noiseless log,
+    but within 1 %) is estimated and kept at 1; 2.5 is refused as no drive's tolerance."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = _sines(T10)
+    joint = 1 if corrected is not None else 2
+    tau = _torques(phantom, theta, dtheta, ddtheta)
+    tau[:, joint] /= gain
+    fit = estimation.estimate(io.Log(T10, theta, tau), phantom, timing="sampled")
+    values, sigma = fit.gains_estimated
+    assert values[joint] == pytest.approx(gain, rel=1e-4) and abs(values[joint] - gain) < 10 * sigma[joint] + 1e-4
+    if corrected is False:
+        assert abs(values[joint] - 1) > 4 * sigma[joint] and fit.gains[joint] == 1.0
+    else:
+        assert any(f"tau3 is {1 / gain:.3g} times joint 1's torque scale (gain {gain:.3g}, outside 0.5-2" in p
+                   for p in fit.problems), fit.problems
+
+
+def test_a_delay_between_the_grid_points_is_estimated_to_a_tenth_of_the_grid_step():
+    """Mutation (identification): the delay's sub-sample step doubled passed (the tested delays sat
+    on the 0.25 ms grid). Torques logged 1.1 ms after the positions they belong to (the model's
+    at t - 1.1 ms), 0.4 of a grid step past 1 ms: estimated within 25 us (12 us measured; with the
+    step doubled, 124 us)."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    delay = 1.1e-3
+    theta = _sines(T10)[0]
+    fit = estimation.estimate(io.Log(T10, theta, _torques(phantom, *_sines(T10 - delay))), phantom,
+                              timing="sampled", delay=None)
+    assert fit.delay_estimated and abs(fit.delay - delay) < 2.5e-5, fit.delay
+
+
+def test_friction_estimated_3_to_30_sigma_below_zero_is_refused():
+    """Mutation (identification): negative friction flagged only beyond 30 sigma passed. Two logs
+    with the same seeded torque noise (2 mN m): joint 1's Coulomb torque 0 gives its standard
+    deviation s; -10 s as the truth is estimated about 10 s below zero and refused as negative."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = _sines(T10)
+    noise = np.random.default_rng(7).normal(0, 2e-3, (len(T10), 3))
+    law = phantom.config.actuation.friction
+
+    def fit(coulomb1):
+        tau = _torques(phantom, theta, dtheta, ddtheta, (coulomb1, *law.coulomb[1:])) + noise
+        return estimation.estimate(io.Log(T10, theta, tau), phantom, timing="sampled")
+
+    s = fit(0.0).friction[1][3]
+    refused = fit(-10 * s)
+    value, sigma = refused.friction[0][3], refused.friction[1][3]
+    assert -15 < value / sigma < -5, value / sigma
+    assert any(p.startswith("negative friction (") for p in refused.problems), refused.problems
+
+
+@pytest.mark.parametrize("ratio, refused", [(1.12, True), (1.08, False)])
+def test_a_model_worse_than_the_prior_by_more_than_10_percent_is_refused(ratio, refused):
+    """Mutation (identification): the worse-than-prior threshold anywhere in 1.0-2.5 passed; the
+    module states 1.1 ("markedly worse")."""
+    from phantom_pin.identification import prediction
+
+    shares = dict(log=np.zeros(3), states=np.zeros(3), prior_states=np.zeros(3), directions=(), spread=0.3)
+    prior_log = np.array([0.01, 0.02, 0.03])
+    fit_log = prior_log * [1.0, ratio, 1.0]
+    assert (prediction.Prediction(fit_log=fit_log, prior_log=prior_log, **shares).worse() is not None) == refused
