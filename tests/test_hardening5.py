@@ -629,3 +629,23 @@ def test_a_model_worse_than_the_prior_by_more_than_10_percent_is_refused(ratio, 
     prior_log = np.array([0.01, 0.02, 0.03])
     fit_log = prior_log * [1.0, ratio, 1.0]
     assert (prediction.Prediction(fit_log=fit_log, prior_log=prior_log, **shares).worse() is not None) == refused
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["ik", "1e308", "0", "0"], "position: [1.e+308 0.e+000 0.e+000] m is 1e+308 m from the shoulder, outside the "
+                                "reachable shell [0.0450, 0.3850] m"),                       # L1: not 309 digits
+    (["--set", "=0.2", "fk", "0", "0", "0"], "--set: expected KEY=NUMBER, got '=0.2' (no key)"),       # L2
+    (["urdf", "-o", "/dev/full", "-f"], "--output: cannot write /dev/full (No space left on device)"),  # L3
+    (["--config", "{tmp}", "info"], "{tmp}: not a configuration folder (it has none of kinematics.yaml, "),  # L7
+    (["excite", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),  # L5
+    (["urdf", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),
+])
+def test_low_items_name_the_option_in_one_readable_line(tmp_path, capsys, argv, message):
+    """L1 `ik 1e308` printed a 309-digit distance; L2 `--set =0.2` named an empty key; L3
+    `urdf -o /dev/full` named no option; L5 excite said "add --force", the rest "use --force";
+    L7 `--config /tmp` said kinematics.yaml could not be read, not that it is no configuration."""
+    (tmp_path / "old.csv").write_text("kept\n")
+    code, out, err = run(capsys, *[a.replace("{tmp}", str(tmp_path)) for a in argv])
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert err.startswith("phantom-pin: error: " + message.replace("{tmp}", str(tmp_path))), err
+    assert (tmp_path / "old.csv").read_text() == "kept\n"

@@ -247,7 +247,7 @@ def test_forced_friction_is_never_negative(run, tmp_path):
     text = (tmp_path / "id.yaml").read_text()
     assert "# problem, written with --accept:" in text
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--accept")
-    assert code == 2 and "exists; add --force to overwrite it" in err   # --accept is no licence to overwrite
+    assert code == 2 and "exists; use --force to overwrite it" in err   # --accept is no licence to overwrite
     keys = read_overrides(tmp_path / "id.yaml")
     written = [keys[f"actuation.friction.{kind}.joint{j}"] for kind in ("viscous", "coulomb") for j in (1, 2, 3)]
     assert min(written) >= 0        # all six written, each 0 or more

@@ -100,6 +100,8 @@ def overrides(args: argparse.Namespace) -> dict[str, object]:
         raise PhantomPinError(str(error), argument="--params") from None
     for item in args.set:
         key, _, value = item.partition("=")
+        if not key.strip():
+            raise PhantomPinError(f"expected KEY=NUMBER, got {item!r} (no key)", argument="--set")
         try:
             given[key] = float(value)
         except ValueError:
@@ -128,6 +130,14 @@ def output(args: argparse.Namespace, option: str = "--output") -> Path:
     if value is None or str(value) == "":
         raise PhantomPinError("empty; give a file name", argument=option)
     return output_path(value, args.force, option, "--force")
+
+
+def write_text(path: Path, text: str, option: str = "--output") -> None:
+    """``text`` into the file ``path``; PhantomPinError naming ``option`` if it cannot be written."""
+    try:
+        path.write_text(text)
+    except OSError as error:
+        raise PhantomPinError(f"cannot write {path} ({error.strerror})", argument=option) from None
 
 
 def show(args: argparse.Namespace, data: dict, text: str) -> None:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import emit, output, phantom, warn
+from phantom_pin.cli.common import emit, output, phantom, warn, write_text
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
@@ -171,10 +171,7 @@ def simulate_command(args: argparse.Namespace) -> int:
     if target is None:
         emit(text)
         return 0
-    try:
-        target.write_text(text)
-    except OSError as error:
-        raise PhantomPinError(f"cannot write {target} ({error.strerror})", argument="--output") from None
+    write_text(target, text)
     print(f"wrote {target} ({len(result.t)} samples)")
     return 0
 

@@ -35,7 +35,7 @@ def _periods(duration: float, period: float) -> int:
 
 def _refuse(path: Path, force: bool) -> None:
     if path.exists() and not force:
-        raise PhantomPinError(f"--output: {path} exists; add --force to overwrite it")
+        raise PhantomPinError(f"--output: {path} exists; use --force to overwrite it")
 
 
 def _writable(path: Path) -> None:

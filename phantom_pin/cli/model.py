@@ -12,7 +12,17 @@ import numpy as np
 
 from phantom_pin import verification
 from phantom_pin.cli import device
-from phantom_pin.cli.common import description, output, overrides, phantom, positive_integer, show, vector, warn_limits
+from phantom_pin.cli.common import (
+    description,
+    output,
+    overrides,
+    phantom,
+    positive_integer,
+    show,
+    vector,
+    warn_limits,
+    write_text,
+)
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
@@ -129,15 +139,15 @@ def write(args: argparse.Namespace) -> int:
     made = description(args, prefix=args.prefix, robot_file=robot_file)
     robot = xacro_model(made.config).robot_name
     if args.kind == "urdf" and args.convention == "driver":
-        target.write_text(driver_urdf(made.config.folder if made.model is None else made.config.name,
-                                      prefix=args.prefix, overrides=overrides(args)))
+        write_text(target, driver_urdf(made.config.folder if made.model is None else made.config.name,
+                                       prefix=args.prefix, overrides=overrides(args)))
         print(f"wrote {target}")
         return 0
     texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
-    target.write_text(texts[args.kind])
+    write_text(target, texts[args.kind])
     print(f"wrote {target}")
     if scene is not None:
-        scene.write_text(made.scene)
+        write_text(scene, made.scene, "--scene")
         print(f"wrote {scene}")
     return 0
 

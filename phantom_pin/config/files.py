@@ -89,7 +89,11 @@ def is_number(value: object) -> bool:
 
 def read_documents(folder: Path) -> dict[str, dict]:
     """Each parameter file of ``folder`` read once: its mapping by xacro argument name (an
-    empty mapping for an OPTIONAL file the folder does not have)."""
+    empty mapping for an OPTIONAL file the folder does not have); ParameterFileError naming the
+    folder if it has none of them (not a configuration folder)."""
+    if not any((folder / name).exists() for name in FILES.values()):
+        raise ParameterFileError(f"{folder}: not a configuration folder (it has none of "
+                                 f"{', '.join(FILES.values())}; see robots/phantom_description/config)")
     return {arg: {} if arg in OPTIONAL and not (folder / name).exists() else read_yaml(folder / name)
             for arg, name in FILES.items()}
 
