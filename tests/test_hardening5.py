@@ -649,3 +649,21 @@ def test_low_items_name_the_option_in_one_readable_line(tmp_path, capsys, argv, 
     assert (code, out) == (2, "") and err.count("\n") == 1
     assert err.startswith("phantom-pin: error: " + message.replace("{tmp}", str(tmp_path))), err
     assert (tmp_path / "old.csv").read_text() == "kept\n"
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["urdf", "-o", "{tmp}/a.urdf", "--output", "{tmp}/b.urdf"], "--output: given twice; give it once"),
+    (["simulate", "--theta0", "0", "0.3", "0.4", "--duration", "0.1", "-o", "{tmp}/a.json", "-o", "{tmp}/b.json"],
+     "-o: given twice; give it once"),
+    (["excite", "-o", "{tmp}/a.csv", "-o", "{tmp}/b.csv"], "-o: given twice; give it once"),
+    (["--set", "l1=0.2", "fk", "0", "0", "0", "--set", "l1=0.3"], "--set: l1 given twice; give it once"),
+])
+def test_an_option_given_twice_is_refused_not_silently_the_last(tmp_path, capsys, argv, message):
+    """L11: -o twice or --set of one key twice silently took the last (a second --model was
+    refused). --params then --set of one key stays an override (the README's order)."""
+    code, out, err = run(capsys, *[a.replace("{tmp}", str(tmp_path)) for a in argv])
+    assert (code, out, err) == (2, "", f"phantom-pin: error: {message}\n")
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "p.yaml").write_text("l1: 0.25\n")
+    code, out, _ = run(capsys, "--params", str(tmp_path / "p.yaml"), "--set", "l1=0.3", "fk", "0", "0", "0", "--json")
+    assert code == 0 and json.loads(out) == json.loads(run(capsys, "--set", "l1=0.3", "fk", "0", "0", "0", "--json")[1])

@@ -98,10 +98,14 @@ def overrides(args: argparse.Namespace) -> dict[str, object]:
         given: dict[str, object] = dict(read_overrides(args.params)) if args.params else {}
     except PhantomPinError as error:
         raise PhantomPinError(str(error), argument="--params") from None
+    set_here: set[str] = set()
     for item in args.set:
         key, _, value = item.partition("=")
         if not key.strip():
             raise PhantomPinError(f"expected KEY=NUMBER, got {item!r} (no key)", argument="--set")
+        if key in set_here:
+            raise PhantomPinError(f"{key} given twice; give it once", argument="--set")
+        set_here.add(key)
         try:
             given[key] = float(value)
         except ValueError:

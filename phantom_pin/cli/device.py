@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import emit, output, phantom, warn, write_text
+from phantom_pin.cli.common import Once, emit, output, phantom, warn, write_text
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
@@ -71,7 +71,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--format", choices=["json", "csv"],
                          help="output format (default: the --output file's extension, .json or .csv; json on "
                               "standard output)")
-    command.add_argument("--output", "-o", help="file to write (default: standard output)")
+    command.add_argument("--output", "-o", action=Once, help="file to write (default: standard output)")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import description, overrides, warn
+from phantom_pin.cli.common import Once, description, overrides, warn
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -69,7 +69,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add the excite and identify subcommands to the phantom-pin parser."""
     excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
     excite.set_defaults(run=excite_command)
-    excite.add_argument("--output", "-o", required=True, type=Path)
+    excite.add_argument("--output", "-o", required=True, type=Path, action=Once)
     excite.add_argument("--duration", type=float, default=20.0,
                         help="seconds of trajectory, rounded up to whole periods (default 20)")
     excite.add_argument("--rate", type=float, default=1000.0, help="samples per second (default 1000)")
@@ -87,7 +87,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread",
                                                                  "delay": "--delay", "min_speed": "--min-speed"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
-    identify.add_argument("--output", "-o", required=True, type=Path)
+    identify.add_argument("--output", "-o", required=True, type=Path, action=Once)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "

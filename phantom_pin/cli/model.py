@@ -13,6 +13,7 @@ import numpy as np
 from phantom_pin import verification
 from phantom_pin.cli import device
 from phantom_pin.cli.common import (
+    Once,
     description,
     output,
     overrides,
@@ -214,7 +215,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         command = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config"
                                  if kind != "links" else "write the links in full (mass, COM, inertia; the "
                                  "xacro's links_file) of --model or --config")
-        command.add_argument("--output", "-o", required=True)
+        command.add_argument("--output", "-o", required=True, action=Once)
         command.add_argument("--prefix", default="")
         command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
         command.set_defaults(kind=kind, run=write)
