@@ -667,3 +667,18 @@ def test_an_option_given_twice_is_refused_not_silently_the_last(tmp_path, capsys
     (tmp_path / "p.yaml").write_text("l1: 0.25\n")
     code, out, _ = run(capsys, "--params", str(tmp_path / "p.yaml"), "--set", "l1=0.3", "fk", "0", "0", "0", "--json")
     assert code == 0 and json.loads(out) == json.loads(run(capsys, "--set", "l1=0.3", "fk", "0", "0", "0", "--json")[1])
+
+
+def test_the_readmes_command_table_lists_every_command_and_the_newest_options():
+    """L13: the README's command table lacked ros2, show --gimbal and urdf --convention driver.
+    Against the parser itself: every subcommand has a row."""
+    from phantom_pin.cli.app import parser
+
+    readme = (Path(__file__).parents[1] / "README.md").read_text()
+    table = readme.split("## Command line")[1].split("\n\n")[1]
+    rows = [line for line in table.splitlines() if line.startswith("| `phantom-pin")]
+    commands = next(a for a in parser()._actions if a.dest == "command").choices
+    for command in commands:
+        assert any(re.search(rf"[ `]{command}[ `]", row.split("` |")[0] + "`") for row in rows), command
+    assert any("show [" in row and "--gimbal" in row for row in rows)
+    assert any("urdf -o" in row and "--convention driver" in row for row in rows)
