@@ -682,3 +682,14 @@ def test_the_readmes_command_table_lists_every_command_and_the_newest_options():
         assert any(re.search(rf"[ `]{command}[ `]", row.split("` |")[0] + "`") for row in rows), command
     assert any("show [" in row and "--gimbal" in row for row in rows)
     assert any("urdf -o" in row and "--convention driver" in row for row in rows)
+
+
+@pytest.mark.parametrize("argv, option", [(["identify", "{missing}", "-o", "{tmp}/id.yaml"], "LOG"),
+                                          (["simulate", "--trajectory", "{missing}"], "--trajectory")])
+def test_a_missing_log_or_trajectory_is_named_by_its_option(tmp_path, capsys, argv, option):
+    """L4: a missing --trajectory or log showed Python's errno text ("[Errno 2] ... : 'x.csv'")
+    without the option."""
+    missing = tmp_path / "missing.csv"
+    code, out, err = run(capsys, *[a.replace("{missing}", str(missing)).replace("{tmp}", str(tmp_path)) for a in argv])
+    assert (code, out) == (2, "") and err == f"phantom-pin: error: {option}: {missing}: cannot read (No such file or " \
+                                             "directory)\n"

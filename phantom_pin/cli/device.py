@@ -23,7 +23,7 @@ from phantom_pin.progress import Progress
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization")} | {
-    "device": "the model (--model, --config, --params, --set)"}
+    "device": "the model (--model, --config, --params, --set)", "path": "--trajectory"}
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}

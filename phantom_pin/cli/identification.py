@@ -84,8 +84,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
-    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread",
-                                                                 "delay": "--delay", "min_speed": "--min-speed"})
+    identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
+                                                         "prior_spread": "--prior-spread", "delay": "--delay",
+                                                         "min_speed": "--min-speed"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
     identify.add_argument("--output", "-o", required=True, type=Path, action=Once)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")

@@ -96,8 +96,10 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, s
     of a bad row. The header is the first data line; its units (in []) by column, _units."""
     try:
         text = path.read_text(encoding="utf-8-sig")           # a UTF-8 byte order mark is dropped
-    except (OSError, UnicodeDecodeError) as error:
-        raise LogError(f"{path}: cannot read ({error})") from None
+    except OSError as error:
+        raise LogError(f"{path}: cannot read ({error.strerror})", argument="path") from None
+    except UnicodeDecodeError as error:
+        raise LogError(f"{path}: not a text file (not UTF-8 at byte {error.start})", argument="path") from None
     # (line number, text) of the lines that hold data: blank lines and # comments are skipped
     lines = [(number, line) for number, line in enumerate(text.splitlines(), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
