@@ -693,3 +693,19 @@ def test_a_missing_log_or_trajectory_is_named_by_its_option(tmp_path, capsys, ar
     code, out, err = run(capsys, *[a.replace("{missing}", str(missing)).replace("{tmp}", str(tmp_path)) for a in argv])
     assert (code, out) == (2, "") and err == f"phantom-pin: error: {option}: {missing}: cannot read (No such file or " \
                                              "directory)\n"
+
+
+def test_identify_accept_warns_on_stderr(tmp_path, capsys):
+    """L8: identify --accept printed its warnings on stdout, among the results (every other
+    command warns on stderr). The model's own torques with tau3 2.5 times too small: a gain
+    outside 0.5-2 (a problem --accept writes anyway)."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = _sines(T10)
+    io.write_log(tmp_path / "log.csv", T10, theta, _torques(phantom, theta, dtheta, ddtheta) / [1, 1, 2.5])
+    code, out, err = run(capsys, "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"), "--accept",
+                         "--torque-timing", "sampled")
+    assert code == 0 and out.startswith("10001 samples") and "warning" not in out
+    assert "phantom-pin: warning: (written with --accept) tau3 is 0.4 times joint 1's torque scale (gain 2.5" in err

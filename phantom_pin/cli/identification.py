@@ -234,9 +234,9 @@ def identify_command(args: argparse.Namespace) -> int:
     for note in notes:
         print(note)
     for warning in fit.prediction.warnings() + [w for w in (fit.timing_warning(), fit.gain_warning()) if w]:
-        print(f"warning: {warning}")
+        warn(warning)              # on stderr, as every command's (and in the overlay's header)
     for problem in fit.problems:
-        print(f"warning (written with --accept): {problem}")
+        warn(f"(written with --accept) {problem}")
     write_overlay(args.output, fit, args.log.name, keys, notes)
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
