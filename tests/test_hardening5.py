@@ -709,3 +709,16 @@ def test_identify_accept_warns_on_stderr(tmp_path, capsys):
                          "--torque-timing", "sampled")
     assert code == 0 and out.startswith("10001 samples") and "warning" not in out
     assert "phantom-pin: warning: (written with --accept) tau3 is 0.4 times joint 1's torque scale (gain 2.5" in err
+
+
+@pytest.mark.parametrize("prefix, valid", [('a"b', False), ("a b", False), ("9lives", False), ("arm/", True),
+                                           ("left_", True), ("", True)])
+def test_urdf_refuses_a_prefix_that_is_no_ros_name(tmp_path, capsys, prefix, valid):
+    """L6: urdf/srdf --prefix took names no ROS name can hold (a space, a quote, a leading digit;
+    codegen's checks its own). ROS 2's rule for names: tokens of letters, digits and _, not
+    starting with a digit, separated by /."""
+    code, out, err = run(capsys, "srdf", "-o", str(tmp_path / "p.srdf"), "--prefix", prefix)
+    assert code == (0 if valid else 2) and (tmp_path / "p.srdf").exists() == valid
+    if not valid:
+        assert err == ("phantom-pin: error: --prefix: expected a ROS name's start (letters, digits, _ and /, not "
+                       f"starting with a digit), got {prefix!r}\n")

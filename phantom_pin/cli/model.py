@@ -218,7 +218,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         command.add_argument("--output", "-o", required=True, action=Once)
         command.add_argument("--prefix", default="")
         command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
-        command.set_defaults(kind=kind, run=write)
+        command.set_defaults(kind=kind, run=write, options={"prefix": "--prefix"})
         if kind == "urdf":
             command.add_argument("--convention", choices=CONVENTIONS, default="report",
                                  help="joint names: report (joint1..3 = theta, the default) or driver "

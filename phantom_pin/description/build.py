@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import re
 import tempfile
 import xml.dom.minidom
 import xml.etree.ElementTree as ET
@@ -125,12 +126,20 @@ def xacro_model(config: Config) -> Model:
     return next(m for m in named if (m.config / "gimbal.yaml").is_file() == (config.gimbal is not None))
 
 
+#: A prefix of joint and frame names: ROS names' tokens (a letter or _ then letters, digits and
+#: _), each optionally followed by / (a namespace), e.g. "left_" or "arm/"; or none.
+PREFIX = re.compile(r"(?:[A-Za-z_][A-Za-z0-9_]*/?)*")
+
+
 def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | None,
               convention: str = "report") -> tuple[Config, Model, str, str]:
     """(config, model, URDF, SRDF) of a model name or folder: each file read once, xacro run on
     the checked Config (``convention`` passed to the URDF's top-level xacro unless the report's)."""
     if not isinstance(prefix, str):
         raise InvalidInputError(f"prefix: expected a string, got {prefix!r}")
+    if not PREFIX.fullmatch(prefix):
+        raise InvalidInputError(f"expected a ROS name's start (letters, digits, _ and /, not starting with a digit), "
+                                f"got {prefix!r}", argument="prefix")
     config = configuration.read(source, overrides)
     model = xacro_model(config)
     arguments = {"prefix": prefix, **({} if convention == "report" else {"convention": convention})}
