@@ -501,7 +501,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     args = parser.parse_args(argv)
     if args.output is not None and args.output.exists() and not args.force:
-        parser.error(f"--output: {args.output} exists; add --force to overwrite it")
+        parser.error(f"--output: {args.output} exists; use --force to overwrite it")
     if args.iterations < 1 or args.restarts < 1:
         parser.error("--iterations, --restarts: expected integers of at least 1")
     names = args.setups or (["cad"] if args.quick else list(setups()))

@@ -213,7 +213,10 @@ def test_negative_friction_is_refused_as_an_override_before_any_model():
 
 
 def test_missing_file(tmp_path):
-    with pytest.raises(ParameterFileError, match="cannot read"):
+    with pytest.raises(ParameterFileError, match="not a configuration folder"):   # an empty folder
+        config.read(tmp_path)
+    (tmp_path / "kinematics.yaml").write_text("l1: 0.2\nl2: 0.2\nl3: 0.03\n")
+    with pytest.raises(ParameterFileError, match="physical_parameters.yaml: cannot read"):
         config.read(tmp_path)
 
 
@@ -228,7 +231,7 @@ def test_overrides_nested_dotted_and_qualified_keys_are_the_same(tmp_path):
     unchanged = dataclasses.replace(
         changed, overridden=False, report=dataclasses.replace(changed.report, Iaxx=shipped_config.report.Iaxx),
         actuation=dataclasses.replace(changed.actuation, motor=shipped_config.actuation.motor),
-        links=shipped_config.links)
+        links=shipped_config.links, sources=shipped_config.sources)  # the motor's says what changed
     assert unchanged == shipped_config  # nothing else changed
 
 

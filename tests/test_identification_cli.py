@@ -169,7 +169,8 @@ def test_excite_checks_its_options_before_any_work(tmp_path, capsys, option, mes
 
     path = tmp_path / "traj.csv"
     start = time.monotonic()
-    code, out, err = run(capsys, "excite", "-o", path, *option)
+    output = [] if option[0] == "-o" else ["-o", path]      # -o given once (twice is refused)
+    code, out, err = run(capsys, "excite", *output, *option)
     assert time.monotonic() - start < 1.0
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert not path.exists() and list(tmp_path.iterdir()) == []

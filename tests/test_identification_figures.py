@@ -49,5 +49,5 @@ def test_the_quick_figures_meet_the_documented_accuracy_and_keep_an_existing_fil
     assert abs(viscous) < 0.013 and abs(coulomb) < 0.013             # +0.3 % and -0.1 % measured
     assert clean[9].strip() == "accepted" and clean[10].strip() == "yes |"
     again = run("--quick", "--conditions", "clean", "-o", str(output))
-    assert again.returncode == 2 and "--output: " in again.stderr and "add --force" in again.stderr
+    assert again.returncode == 2 and "--output: " in again.stderr and "use --force" in again.stderr
     assert output.read_text() == result.stdout

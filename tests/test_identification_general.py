@@ -213,11 +213,11 @@ def test_a_joints_torque_gain_is_found_corrected_and_reported(run, case, tmp_pat
     assert (np.abs(found[:, 0] - 1 / factor[1:]) < 4 * found[:, 1]).all() and (found[:, 1] < 5e-3).all()
     scaled = [j for j in (1, 2) if factor[j] != 1]
     for j in scaled:    # the log's scale against joint 1's (1 / the gain), to the 4 digits printed
-        shown = float(re.search(rf"tau{j + 1} is (\S+) times", out).group(1))
+        shown = float(re.search(rf"tau{j + 1} is (\S+) times", err).group(1))     # the gain warning: stderr
         assert abs(shown - factor[j]) < 4 * found[j - 1, 1] + 1e-4, (shown, factor[j])
-    assert "torque constant in your driver by" in out
+    assert "torque constant in your driver by" in err
     if len(scaled) == 2:
-        ratios = [float(v) for v in re.findall(r"(\S+) instead of the model's 11.6", out)]
+        ratios = [float(v) for v in re.findall(r"(\S+) instead of the model's 11.6", err)]
         assert len(ratios) == 2 and all(abs(r - 11.2) < 0.1 for r in ratios), ratios
     rng = np.random.default_rng(17)
     theta = sample_postures(CONFIG.limits, 500, rng, draws=2000)
@@ -242,12 +242,12 @@ def test_forced_friction_is_never_negative(run, tmp_path):
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--force")
     assert code == 2 and "--accept writes it anyway" in err and not (tmp_path / "id.yaml").exists()
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--accept")
-    assert code == 0 and "warning (written with --accept): tau: the logged torques are -0.99" in out, err
-    assert "negative friction (viscous1" in out
+    assert code == 0 and "phantom-pin: warning: (written with --accept) tau: the logged torques are -0.99" in err, err
+    assert "negative friction (viscous1" in err and "warning" not in out
     text = (tmp_path / "id.yaml").read_text()
     assert "# problem, written with --accept:" in text
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--accept")
-    assert code == 2 and "exists; add --force to overwrite it" in err   # --accept is no licence to overwrite
+    assert code == 2 and "exists; use --force to overwrite it" in err   # --accept is no licence to overwrite
     keys = read_overrides(tmp_path / "id.yaml")
     written = [keys[f"actuation.friction.{kind}.joint{j}"] for kind in ("viscous", "coulomb") for j in (1, 2, 3)]
     assert min(written) >= 0        # all six written, each 0 or more

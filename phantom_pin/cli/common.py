@@ -98,8 +98,14 @@ def overrides(args: argparse.Namespace) -> dict[str, object]:
         given: dict[str, object] = dict(read_overrides(args.params)) if args.params else {}
     except PhantomPinError as error:
         raise PhantomPinError(str(error), argument="--params") from None
+    set_here: set[str] = set()
     for item in args.set:
         key, _, value = item.partition("=")
+        if not key.strip():
+            raise PhantomPinError(f"expected KEY=NUMBER, got {item!r} (no key)", argument="--set")
+        if key in set_here:
+            raise PhantomPinError(f"{key} given twice; give it once", argument="--set")
+        set_here.add(key)
         try:
             given[key] = float(value)
         except ValueError:
@@ -130,9 +136,32 @@ def output(args: argparse.Namespace, option: str = "--output") -> Path:
     return output_path(value, args.force, option, "--force")
 
 
+def write_text(path: Path, text: str, option: str = "--output") -> None:
+    """``text`` into the file ``path``; PhantomPinError naming ``option`` if it cannot be written."""
+    try:
+        path.write_text(text)
+    except OSError as error:
+        raise PhantomPinError(f"cannot write {path} ({error.strerror})", argument=option) from None
+
+
 def show(args: argparse.Namespace, data: dict, text: str) -> None:
     """Print ``data`` as JSON with --json, else ``text``."""
-    print(json.dumps(data, indent=2, allow_nan=False) if getattr(args, "json", False) else text)
+    emit((json.dumps(data, indent=2, allow_nan=False) if getattr(args, "json", False) else text) + "\n")
+
+
+def emit(text: str) -> None:
+    """Write ``text`` to standard output in full, or raise BrokenPipeError (main: exit 141).
+    Unbuffered (PYTHONUNBUFFERED, python -u), sys.stdout writes once to the file descriptor, and
+    a reader that closes the pipe part way leaves a short write and no error: the rest is lost
+    silently, and the command exits 0."""
+    buffer = getattr(sys.stdout, "buffer", None)
+    if buffer is None:  # a replaced stdout (a test's capture)
+        sys.stdout.write(text)
+        return
+    sys.stdout.flush()
+    data = memoryview(text.encode(sys.stdout.encoding or "utf-8"))
+    while data:
+        data = data[buffer.write(data) or 0:]
 
 
 def vector(values: Any, spec: str) -> str:

@@ -6,14 +6,13 @@ import argparse
 import dataclasses
 import json
 import math
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import output, phantom, warn
+from phantom_pin.cli.common import Once, emit, output, phantom, warn, write_text
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
@@ -24,7 +23,7 @@ from phantom_pin.progress import Progress
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization")} | {
-    "device": "the model (--model, --config, --params, --set)"}
+    "device": "the model (--model, --config, --params, --set)", "path": "--trajectory"}
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
          "tau_commanded": "N m", "current": "A", "tip": "m (frame s)"}
@@ -72,7 +71,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--format", choices=["json", "csv"],
                          help="output format (default: the --output file's extension, .json or .csv; json on "
                               "standard output)")
-    command.add_argument("--output", "-o", help="file to write (default: standard output)")
+    command.add_argument("--output", "-o", action=Once, help="file to write (default: standard output)")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
 
 
@@ -170,12 +169,9 @@ def simulate_command(args: argparse.Namespace) -> int:
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
     text = _json(result, settings) if form == "json" else _csv(result)
     if target is None:
-        sys.stdout.write(text)
+        emit(text)
         return 0
-    try:
-        target.write_text(text)
-    except OSError as error:
-        raise PhantomPinError(f"cannot write {target} ({error.strerror})", argument="--output") from None
+    write_text(target, text)
     print(f"wrote {target} ({len(result.t)} samples)")
     return 0
 

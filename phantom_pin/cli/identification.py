@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import description, overrides
+from phantom_pin.cli.common import Once, description, overrides, warn
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -35,7 +35,7 @@ def _periods(duration: float, period: float) -> int:
 
 def _refuse(path: Path, force: bool) -> None:
     if path.exists() and not force:
-        raise PhantomPinError(f"--output: {path} exists; add --force to overwrite it")
+        raise PhantomPinError(f"--output: {path} exists; use --force to overwrite it")
 
 
 def _writable(path: Path) -> None:
@@ -45,6 +45,13 @@ def _writable(path: Path) -> None:
         raise PhantomPinError(f"--output: {path} is a folder; name a file")
     if not folder.is_dir() or not os.access(folder, os.W_OK):
         raise PhantomPinError(f"--output: cannot write in {folder}")
+
+
+def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
+    """--output ends with one of ``suffixes``: the command writes ``kind`` only."""
+    if path.suffix.lower() not in suffixes:
+        raise PhantomPinError(f"{path}: this command writes {kind}; name a {' or '.join(suffixes)} file",
+                              argument="--output")
 
 
 def _delay(text: str | None) -> float | None:
@@ -62,7 +69,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add the excite and identify subcommands to the phantom-pin parser."""
     excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
     excite.set_defaults(run=excite_command)
-    excite.add_argument("--output", "-o", required=True, type=Path)
+    excite.add_argument("--output", "-o", required=True, type=Path, action=Once)
     excite.add_argument("--duration", type=float, default=20.0,
                         help="seconds of trajectory, rounded up to whole periods (default 20)")
     excite.add_argument("--rate", type=float, default=1000.0, help="samples per second (default 1000)")
@@ -77,10 +84,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
-    identify.set_defaults(run=identify_command, options={"cutoff": "--cutoff", "prior_spread": "--prior-spread",
-                                                                 "delay": "--delay", "min_speed": "--min-speed"})
+    identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
+                                                         "prior_spread": "--prior-spread", "delay": "--delay",
+                                                         "min_speed": "--min-speed"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
-    identify.add_argument("--output", "-o", required=True, type=Path)
+    identify.add_argument("--output", "-o", required=True, type=Path, action=Once)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "
@@ -100,8 +108,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                "report: the report's eight constants (a model in the report's form)")
     identify.add_argument("--prior-spread", type=float, default=prior.SPREAD,
                           help="how far the device may lie from the configuration you pass (the prior), as a "
-                               "relative standard deviation of every physical parameter (default 0.3); what the log "
-                               "does not excite comes from the prior; inf: the log alone")
+                               "relative standard deviation of every physical parameter (default 0.3, at most 1e6); "
+                               "what the log does not excite comes from the prior; inf: the log alone")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     identify.add_argument("--accept", action="store_true",
                           help="write the result even where the checks refuse it, each check's reason as a warning "
@@ -136,6 +144,10 @@ def excite_command(args: argparse.Namespace) -> int:
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1
     _writable(args.output)
+    _suffix(args.output, (".csv",), "CSV")
+    if not math.isclose(periods * args.period, args.duration, rel_tol=1e-9):
+        warn(f"--duration {args.duration:g} s rounded up to {periods} whole period(s) of {args.period:g} s: "
+             f"{periods * args.period:g} s (the excitation is periodic; --period sets its length)")
     made = description(args)
     phantom = Phantom(made)
     times = np.arange(rows) / args.rate
@@ -172,6 +184,7 @@ def identify_command(args: argparse.Namespace) -> int:
     """phantom-pin identify, for the configuration of --model or --config (and the overrides)."""
     _refuse(args.output, args.force)
     _writable(args.output)
+    _suffix(args.output, (".yaml", ".yml"), "a YAML overlay")
     given = overrides(args)
     phantom = Phantom(description(args, given))
     if args.structure == "report" and phantom.config.report is None:
@@ -221,9 +234,9 @@ def identify_command(args: argparse.Namespace) -> int:
     for note in notes:
         print(note)
     for warning in fit.prediction.warnings() + [w for w in (fit.timing_warning(), fit.gain_warning()) if w]:
-        print(f"warning: {warning}")
+        warn(warning)              # on stderr, as every command's (and in the overlay's header)
     for problem in fit.problems:
-        print(f"warning (written with --accept): {problem}")
+        warn(f"(written with --accept) {problem}")
     write_overlay(args.output, fit, args.log.name, keys, notes)
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")

@@ -12,9 +12,19 @@ import numpy as np
 
 from phantom_pin import verification
 from phantom_pin.cli import device
-from phantom_pin.cli.common import description, output, overrides, phantom, positive_integer, show, vector, warn_limits
-from phantom_pin.config import DEFAULT, MODELS
-from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml
+from phantom_pin.cli.common import (
+    Once,
+    description,
+    output,
+    overrides,
+    phantom,
+    positive_integer,
+    show,
+    vector,
+    warn_limits,
+    write_text,
+)
+from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -128,17 +138,17 @@ def write(args: argparse.Namespace) -> int:
     # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
     robot_file = target.name if scene is None else os.path.relpath(target.resolve(), scene.resolve().parent)
     made = description(args, prefix=args.prefix, robot_file=robot_file)
-    robot = (made.model or MODELS[DEFAULT]).robot_name
+    robot = xacro_model(made.config).robot_name
     if args.kind == "urdf" and args.convention == "driver":
-        target.write_text(driver_urdf(made.config.folder if made.model is None else made.config.name,
-                                      prefix=args.prefix, overrides=overrides(args)))
+        write_text(target, driver_urdf(made.config.folder if made.model is None else made.config.name,
+                                       prefix=args.prefix, overrides=overrides(args)))
         print(f"wrote {target}")
         return 0
     texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
-    target.write_text(texts[args.kind])
+    write_text(target, texts[args.kind])
     print(f"wrote {target}")
     if scene is not None:
-        scene.write_text(made.scene)
+        write_text(scene, made.scene, "--scene")
         print(f"wrote {scene}")
     return 0
 
@@ -150,8 +160,11 @@ def show_command(args: argparse.Namespace) -> int:
     if args.html is not None:
         output(args, "--html")
     robot = load(description(args))
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit  # the arm's, then a gimbal's
     if args.theta is not None:
-        warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+        warn_limits(args.theta, lower[:3], upper[:3])
+    if args.gimbal is not None and robot.model.nq == 6:
+        warn_limits(args.gimbal, lower[3:], upper[3:], "gimbal")
     with Viewer(robot) as viewer:
         if args.tip_force is not None:
             viewer.set_force(args.tip_force)
@@ -202,10 +215,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         command = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config"
                                  if kind != "links" else "write the links in full (mass, COM, inertia; the "
                                  "xacro's links_file) of --model or --config")
-        command.add_argument("--output", "-o", required=True)
+        command.add_argument("--output", "-o", required=True, action=Once)
         command.add_argument("--prefix", default="")
         command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
-        command.set_defaults(kind=kind, run=write)
+        command.set_defaults(kind=kind, run=write, options={"prefix": "--prefix"})
         if kind == "urdf":
             command.add_argument("--convention", choices=CONVENTIONS, default="report",
                                  help="joint names: report (joint1..3 = theta, the default) or driver "
@@ -222,4 +235,4 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--html", help="write a self-contained HTML file instead of serving")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     command.add_argument("--open", action="store_true", help="open the live viewer in a browser")
-    command.set_defaults(run=show_command)
+    command.set_defaults(run=show_command, options={"gimbal": "--gimbal"})

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from phantom_pin.config.builders import REPORT_SEGMENTS, build, in_full
+from phantom_pin.config.builders import REPORT_SEGMENTS, SOURCES, build, in_full
 from phantom_pin.config.files import FILES, MODEL_KEY, apply_overrides, read_documents, read_overrides
 from phantom_pin.config.models import DEFAULT, MODELS, Model, models, resolve
 from phantom_pin.config.types import (
@@ -54,8 +54,39 @@ def read(source: str | Path = DEFAULT, overrides: dict[str, object] | None = Non
                                      "two ways; give the links in full only")
         documents = in_full(documents, build(documents, name, folder, False))
     if overrides:
-        documents = apply_overrides(documents, overrides)
+        documents = _sourced(documents, apply_overrides(documents, overrides))
     return build(documents, name, folder, bool(overrides))
+
+
+#: The keys of a file whose numbers a section's source speaks for (default: the section's own;
+#: None: the whole file).
+_SPOKEN_FOR = {("actuation_file", "motor"): ("motor", "joint_torque_limit", "joint_velocity_limit"),
+               ("gimbal_file", "gimbal"): None}
+
+
+def _changed(before: object, after: object, prefix: str = "") -> list[str]:
+    """The dotted paths at which ``after`` differs from ``before`` (a number expanded into a
+    mapping of joints compared joint by joint)."""
+    if isinstance(after, dict) and not isinstance(before, (dict, type(None))):
+        before = dict.fromkeys(after, before)
+    if isinstance(before, dict) and isinstance(after, dict):
+        return [path for key in dict.fromkeys([*before, *after])
+                for path in _changed(before.get(key), after.get(key), f"{prefix}{key}.")]
+    return [] if before == after else [prefix.rstrip(".")]
+
+
+def _sourced(before: dict[str, dict], after: dict[str, dict]) -> dict[str, dict]:
+    """``after`` (the documents with the overrides applied) with the source of each section
+    whose numbers the overrides changed saying so: its numbers are no longer all its source's."""
+    for arg, sections in SOURCES.items():
+        for name in sections:
+            spoken = _SPOKEN_FOR.get((arg, name), (name,))
+            keys = [k for k in after[arg] if k != "sources"] if spoken is None else list(spoken)
+            changed = _changed({k: before[arg].get(k) for k in keys}, {k: after[arg].get(k) for k in keys})
+            if changed and isinstance(after[arg].get("sources"), dict) and name in after[arg]["sources"]:
+                after[arg]["sources"][name] = (f"OVERRIDDEN here: {', '.join(changed)} (not from the source); "
+                                               f"the rest: {after[arg]['sources'][name]}")
+    return after
 
 
 def section(key: object) -> str:

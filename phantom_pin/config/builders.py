@@ -322,6 +322,8 @@ def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool)
         trouble = problem(inertial)
         if trouble:
             keys = f"links.{link}, hinge_pin" if report is None else REPORT_KEYS[link]
+            if link in PIN_AT:  # the hinge pin's mass is carved out at the end of the link, a length away
+                keys += f", {PIN_AT[link]} (the hinge pin's distance; the inertias do not follow it)"
             raise r.error("physical_parameters_file", f"link {link}: {trouble} (from {keys})")
     return Config(name, folder, overridden, kinematics, r.number("physical_parameters_file", "gravity", positive=True),
                   types.MappingProxyType(links), _housing(r), report, unprinted, actuation, _limits(r), _mujoco(r),
@@ -329,6 +331,8 @@ def build(documents: dict[str, dict], name: str, folder: Path, overridden: bool)
                   types.MappingProxyType(_sources(r)), _gimbal(r))
 
 
+#: The length at which the hinge pin is carved out of a link (inertial.carve), for error messages.
+PIN_AT = {"lower_bar_link": "l1", "crank_link": "l3"}
 #: The keys of the report's form that feed each link, for error messages.
 REPORT_KEYS = {
     "turret_link": "segment_g.mass, segment_g.inertia_*, actuation.motor.rotor_inertia, "

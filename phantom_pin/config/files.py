@@ -37,12 +37,24 @@ PER_JOINT = {"actuation_file": (("friction", "viscous"), ("friction", "coulomb")
 
 
 class _Loader(yaml.SafeLoader):
-    """PyYAML's safe loader, which also reads 1e-6 and 1.0e6 as numbers.
+    """PyYAML's safe loader, which also reads 1e-6 and 1.0e6 as numbers, and refuses a key
+    given twice in one mapping (PyYAML silently keeps the last; YAML 1.2 forbids it).
 
     PyYAML follows YAML 1.1, whose floats need a dot and a signed exponent: it reads
     ``1e-6`` and ``1.0e6`` as strings (``1.0e-6`` and ``1.0e+6`` as numbers). YAML 1.2
     reads all four as numbers, and so does this loader.
     """
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict:
+        seen: set[object] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise yaml.constructor.ConstructorError(None, None, f"the key {key!r} is given twice",
+                                                        key_node.start_mark)
+            if isinstance(key, (str, int, float)):
+                seen.add(key)
+        return super().construct_mapping(node, deep=deep)
 
 
 _Loader.add_implicit_resolver(
@@ -77,7 +89,11 @@ def is_number(value: object) -> bool:
 
 def read_documents(folder: Path) -> dict[str, dict]:
     """Each parameter file of ``folder`` read once: its mapping by xacro argument name (an
-    empty mapping for an OPTIONAL file the folder does not have)."""
+    empty mapping for an OPTIONAL file the folder does not have); ParameterFileError naming the
+    folder if it has none of them (not a configuration folder)."""
+    if not any((folder / name).exists() for name in FILES.values()):
+        raise ParameterFileError(f"{folder}: not a configuration folder (it has none of "
+                                 f"{', '.join(FILES.values())}; see robots/phantom_description/config)")
     return {arg: {} if arg in OPTIONAL and not (folder / name).exists() else read_yaml(folder / name)
             for arg, name in FILES.items()}
 
@@ -164,7 +180,8 @@ def read_overrides(path: Path | str) -> dict[str, float]:
     """Read a YAML file of parameter overrides into dotted keys.
 
     Nested mappings and dotted keys are equivalent: ``segment_a: {mass: 0.03}`` and
-    ``segment_a.mass: 0.03`` both give ``{"segment_a.mass": 0.03}``.
+    ``segment_a.mass: 0.03`` both give ``{"segment_a.mass": 0.03}``; one number given both
+    ways, or a key given twice, is refused (ParameterFileError naming the file).
     """
     flat: dict[str, float] = {}
 
@@ -173,6 +190,8 @@ def read_overrides(path: Path | str) -> dict[str, float]:
             dotted = f"{prefix}{key}"
             if isinstance(value, dict):
                 walk(value, f"{dotted}.")
+            elif dotted in flat:
+                raise ParameterFileError(f"{path}: {dotted} is given twice (nested and dotted)")
             else:
                 flat[dotted] = value
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import re
 import tempfile
 import xml.dom.minidom
 import xml.etree.ElementTree as ET
@@ -115,9 +116,19 @@ class Description:
     robot_file: str
 
 
-def _model(config: Config) -> Model:
-    """The named model whose xacros generate ``config`` (the default model's for a folder)."""
-    return configuration.MODELS.get(config.name, configuration.MODELS[configuration.DEFAULT])
+def xacro_model(config: Config) -> Model:
+    """The named model whose xacros generate ``config``: its own, or for a folder of one's own
+    the first named model (the default first) with a stylus gimbal if the folder has one (a copy
+    of the Touch's folder is written with the Touch's xacro, gimbal included)."""
+    if config.name in configuration.MODELS:
+        return configuration.MODELS[config.name]
+    named = sorted(configuration.MODELS.values(), key=lambda m: m.name != configuration.DEFAULT)
+    return next(m for m in named if (m.config / "gimbal.yaml").is_file() == (config.gimbal is not None))
+
+
+#: A prefix of joint and frame names: ROS names' tokens (a letter or _ then letters, digits and
+#: _), each optionally followed by / (a namespace), e.g. "left_" or "arm/"; or none.
+PREFIX = re.compile(r"(?:[A-Za-z_][A-Za-z0-9_]*/?)*")
 
 
 def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | None,
@@ -126,8 +137,11 @@ def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | No
     the checked Config (``convention`` passed to the URDF's top-level xacro unless the report's)."""
     if not isinstance(prefix, str):
         raise InvalidInputError(f"prefix: expected a string, got {prefix!r}")
+    if not PREFIX.fullmatch(prefix):
+        raise InvalidInputError(f"expected a ROS name's start (letters, digits, _ and /, not starting with a digit), "
+                                f"got {prefix!r}", argument="prefix")
     config = configuration.read(source, overrides)
-    model = _model(config)
+    model = xacro_model(config)
     arguments = {"prefix": prefix, **({} if convention == "report" else {"convention": convention})}
     with tempfile.TemporaryDirectory() as folder:
         inputs = _xacro_inputs(config, Path(folder))

@@ -303,7 +303,7 @@ class Phantom:
         distance = math.hypot(x, y - p.l2, z + p.l1)  # from the shoulder (0, l2, -l1) in s
         if not abs(p.l1 - p.l2) * (1 - 1e-12) <= distance <= (p.l1 + p.l2) * (1 + 1e-12):
             raise UnreachableTargetError(
-                f"position: {np.array2string(target, precision=4)} m is {distance:.4f} m from "
+                f"position: {np.array2string(target, precision=4)} m is {distance:.4g} m from "
                 f"the shoulder, outside the reachable shell [{abs(p.l1 - p.l2):.4f}, "
                 f"{p.l1 + p.l2:.4f}] m")
         sign = 1.0 if branch == "report" else -1.0

@@ -93,11 +93,13 @@ def write_log(path: Path | str, t: object, theta: object, tau: object, force: bo
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, str]], dict[str, np.ndarray]]:
     """(data lines as (line number, text), {column: values}) of the CSV at ``path``, whose
     header must name ``columns`` (module doc: the dialects it takes); LogError naming the line
-    of a bad row."""
+    of a bad row. The header is the first data line; its units (in []) by column, _units."""
     try:
         text = path.read_text(encoding="utf-8-sig")           # a UTF-8 byte order mark is dropped
-    except (OSError, UnicodeDecodeError) as error:
-        raise LogError(f"{path}: cannot read ({error})") from None
+    except OSError as error:
+        raise LogError(f"{path}: cannot read ({error.strerror})", argument="path") from None
+    except UnicodeDecodeError as error:
+        raise LogError(f"{path}: not a text file (not UTF-8 at byte {error.start})", argument="path") from None
     # (line number, text) of the lines that hold data: blank lines and # comments are skipped
     lines = [(number, line) for number, line in enumerate(text.splitlines(), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
@@ -110,6 +112,9 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, s
     if missing:
         raise LogError(f"{path}: missing column(s) {', '.join(missing)} (header must name "
                        f"{','.join(columns)}, in any order, case or quotes, with or without units in [])")
+    twice = [c for c in columns if header.count(c) > 1]
+    if twice:
+        raise LogError(f"{path}: the header names {twice[0]} {header.count(twice[0])} times; name each column once")
     rows = []
     for number, line in lines[1:]:
         values = line.split(separator)
@@ -178,6 +183,13 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
         raise LogError(f"path: expected a file path, got {path!r}")
     path = Path(path)
     lines, column = _read_table(path, LOG_COLUMNS)
+    expected = "mN m" if convention == "openhaptics" else "N m"
+    for name, unit in _units(lines[0][1]).items():
+        plain = "".join(unit.split()).replace("*", "").replace(".", "")     # N m, Nm, N*m, N.m
+        if name.startswith("tau") and plain != "".join(expected.split()):
+            raise LogError(f"{path}: {name} is in {unit} (its header), the {convention} convention's torques in "
+                           f"{expected}: give the convention of the log (--convention; OpenHaptics': mN m) or "
+                           "convert it")
     t = column["t"]
     step = np.diff(t)
     if len(t) < 2:
@@ -194,6 +206,13 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     if convention == "openhaptics":
         theta, tau = drivers.theta_from_openhaptics(theta), drivers.tau_from_openhaptics_torque(tau)
     return Log(t, theta, tau)
+
+
+def _units(header: str) -> dict[str, str]:
+    """The units a header line gives in [] (its dialect as _read_table's), by column name."""
+    separator = max((",", ";", "\t"), key=header.count)
+    fields = [field.strip().strip('"').strip("'") for field in header.split(separator)]
+    return {_column_name(field): field.split("[", 1)[1].split("]")[0].strip() for field in fields if "[" in field}
 
 
 def _column_name(text: str) -> str:

@@ -138,8 +138,10 @@ def poorly_excited(information: np.ndarray, typical: np.ndarray, names: tuple[st
 
 
 def _words(vector: np.ndarray, names: tuple[str, ...]) -> str:
-    """A direction in words: its components of more than 0.2 of its square, largest first."""
-    order = [k for k in np.argsort(-np.abs(vector)) if vector[k] ** 2 > 0.2][:3]
+    """A direction in words: its components of more than 0.2 of its square, largest first (at
+    most three; the three largest when it spreads over many, none that large)."""
+    ranked = [int(k) for k in np.argsort(-np.abs(vector), kind="stable")]
+    order = [k for k in ranked if vector[k] ** 2 > 0.2][:3] or ranked[:3]
     if len(order) == 1:
         return _short(names[order[0]])
     sign = np.sign(vector[order[0]])

@@ -39,14 +39,20 @@ from phantom_pin.exceptions import InvalidInputError
 
 #: The prior's relative standard deviation of every physical parameter (module doc).
 SPREAD = 0.3
+#: The largest finite spread: beyond it the prior no longer moves the fit (at 1e6 it equals the
+#: log alone's to 1e-12), and its variances, (spread scale)^2, overflow from about 1e150.
+MAX_SPREAD = 1e6
 
 
 def spread_argument(value: object) -> float:
-    """``value`` as a prior spread: a number > 0, inf for none (the log alone); InvalidInputError
-    naming ``prior_spread`` otherwise."""
+    """``value`` as a prior spread: a number > 0 and at most MAX_SPREAD, inf for none (the log
+    alone); InvalidInputError naming ``prior_spread`` otherwise."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or np.isnan(value) or value <= 0:
         raise InvalidInputError(f"expected a relative standard deviation > 0 (inf: no prior), got {value!r}",
                                 argument="prior_spread")
+    if MAX_SPREAD < value < np.inf:
+        raise InvalidInputError(f"{value!r} is beyond {MAX_SPREAD:g}, where the prior no longer counts; give inf "
+                                "for no prior", argument="prior_spread")
     return float(value)
 
 
