@@ -27,8 +27,8 @@ from collections.abc import Sequence
 from functools import cache
 
 import numpy as np
-import yaml
 
+from phantom_pin.config.files import read_yaml
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.paths import DESCRIPTION_DIR
 
@@ -136,6 +136,19 @@ class Profile:
         return self.force.to_openhaptics @ force
 
 
+#: The suffix of the relay's topic (relayed()).
+RELAY = "_relay"
+
+
+def relayed(profile: Profile) -> Profile:
+    """The profile with its force sent as geometry_msgs/Vector3 (the same three numbers, N, the
+    driver's frame) on its force topic + RELAY, for a one-file relay in the driver's workspace to
+    put into its own message type (omni_msgs is not on PyPI: docs/drivers.md)."""
+    force = dataclasses.replace(profile.force, topic=profile.force.topic + RELAY, type=FORCE_TYPES[0], field=None,
+                                header=False)
+    return dataclasses.replace(profile, force=force)
+
+
 def names() -> tuple[str, ...]:
     """The profiles' names, sorted."""
     return tuple(sorted(path.stem for path in PROFILES_DIR.glob("*.yaml")))
@@ -211,7 +224,7 @@ def load(name: str) -> Profile:
     if not isinstance(name, str) or name not in names():
         raise InvalidInputError(f"unknown driver profile {name!r} (known: {', '.join(names())})", argument="driver")
     path = PROFILES_DIR / f"{name}.yaml"
-    node = yaml.safe_load(path.read_text(encoding="utf-8"))
+    node = read_yaml(path)
     try:
         return Profile(node["name"], node["description"], _joint_states(node["joint_states"], f"{path}: joint_states"),
                        _force(node["force"], f"{path}: force"),

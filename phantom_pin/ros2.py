@@ -226,7 +226,8 @@ def message_type(name: str) -> type:
         return getattr(importlib.import_module(f"{package}.msg"), kind)
     except (ImportError, AttributeError):
         raise MissingDataError(f"the driver's message type {name} is not installed here (omni_msgs is not on "
-                               "PyPI: source the driver's ROS 2 workspace, or run the relay of docs/drivers.md)",
+                               "PyPI: source the driver's ROS 2 workspace, or add --relay and run the relay of "
+                               "docs/drivers.md)",
                                argument="driver") from None
 
 

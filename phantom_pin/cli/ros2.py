@@ -66,14 +66,17 @@ def ros2(args: argparse.Namespace) -> int:
     driver = None
     if args.driver is not None:
         profile = profiles.load(args.driver)
+        if args.relay:
+            profile = profiles.relayed(profile)
         if robot.config.gimbal is None:
             raise PhantomPinError(f"the drivers' profiles are the Touch's; {robot.config.name} has no stylus gimbal "
                                   "(use --model touch)", argument="--driver")
         node.message_type(profile.force.type)  # installed, else one line
         driver = node.DriverBridge(robot, profile, COMPENSATE[args.compensate], args.max_force)
-    elif args.compensate != "gravity" or not math.isinf(args.max_force):
+    elif args.compensate != "gravity" or not math.isinf(args.max_force) or args.relay:
         raise PhantomPinError("goes with --driver (the force command of a driver)",
-                              argument="--compensate" if args.compensate != "gravity" else "--max-force")
+                              argument="--relay" if args.relay else "--compensate" if args.compensate != "gravity"
+                              else "--max-force")
     node.Bridge(robot)
     return node.spin(robot, topics, driver)
 
@@ -124,6 +127,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                               "rate)")
     command.add_argument("--max-force", type=_max_force, default=math.inf, metavar="N",
                          help="the largest force sent (N; also the driver's clamp and the motors' limits)")
+    command.add_argument("--relay", action="store_true",
+                         help="send the force as geometry_msgs/Vector3 on the driver's force topic + _relay, for the "
+                              "one-file relay of docs/drivers.md (a driver whose message type is not on PyPI)")
     command.set_defaults(run=ros2, options={"prefix": "--prefix", "topics": "--topic", "driver": "--driver",
                                             "compensate": "--compensate", "max_force": "--max-force"})
     simulated = sub.add_parser("sim-driver", help="a simulated driver: the device's plant under a driver's force "
