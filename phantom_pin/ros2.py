@@ -36,6 +36,7 @@ publishers reliable, depth 100.
 from __future__ import annotations
 
 import dataclasses
+import gc
 import importlib
 import math
 import threading
@@ -314,9 +315,11 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
                     theta, gimbal = driver.state(message.name, message.position)
                     self.send_force(theta, gimbal, stamp)
                     now = time.monotonic()
-                    if now < self.next_outputs:  # the servo path first: the rest at OUTPUTS_RATE
-                        return
+                    if now < self.next_outputs:  # the servo path first: the rest at OUTPUTS_RATE,
+                        return                   # and only while someone listens
                     self.next_outputs = now + 1.0 / OUTPUTS_RATE
+                    if not any(p.get_subscription_count() for p in self.outputs.values()):
+                        return
                     out = bridge(model_names, [*theta, *(gimbal if gimbal is not None else ())])
             except InvalidInputError as error:
                 self.dropped += 1
@@ -404,6 +407,10 @@ def run(make: Callable[[], Any], ready: str, loop: Callable[[Any, threading.Even
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     try:
         node = make()
+        # the models and message types built: nothing of theirs to collect, so the collector's full
+        # passes (several ms over Pinocchio's and rclpy's objects) leave the servo path alone
+        gc.collect()
+        gc.freeze()
         executor = SingleThreadedExecutor()
         executor.add_node(node)
         target = executor.spin if loop is None else (lambda: loop(executor, stop))
