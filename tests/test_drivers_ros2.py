@@ -152,6 +152,9 @@ def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
         results = [_stop(process) for process in (simulated, node)]
     for code, err in results:
         assert code == 0 and "Traceback" not in err, err
+    if profiles.load(name).force.hold == "held":
+        warnings = [line for line in results[1][1].splitlines() if "dropped a wrench message" in line]
+        assert any("force" in w for w in warnings) and any("frame_id" in w for w in warnings), warnings
 
 
 def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) -> None:
@@ -191,6 +194,15 @@ def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) ->
     print(f"{name}: {len(errors)} forces checked against the closed form; 0.5 N up lifted the tip "
           f"{(after - before) * 1e3:.1f} mm")
     assert after - before > 1e-3
+    # bad wrenches: dropped (one throttled warning each kind, checked by the caller), nothing sent beyond
+    # the driver's clamp or not finite
+    watcher.push("base_link", (float("nan"), 0.0, 0.0))
+    watcher.push("base_link", (1e9, 0.0, 0.0))
+    watcher.spin(1.1)            # the warnings are throttled to one a second
+    watcher.push("nowhere", (0.0, 0.0, 0.1))
+    watcher.spin(0.2)
+    sent = np.array([ref.FORCE[name](force) for force in watcher.forces])
+    assert np.isfinite(sent).all() and np.linalg.norm(sent, axis=1).max() <= watcher.profile.force.clamp * (1 + 1e-12)
 
 
 def test_without_the_node_the_stylus_falls():
