@@ -171,3 +171,33 @@ def test_bad_options_and_messages_are_refused_naming_them(touch):
         with pytest.raises(InvalidInputError) as error:
             bridge.state(given, positions)
         assert error.value.argument == argument
+
+
+def test_the_relay_sends_the_same_numbers_as_a_vector3_beside_the_drivers_topic(touch):
+    """--relay: the geomagic driver's numbers (its swapped frame) as geometry_msgs/Vector3 on
+    /phantom/force_feedback_relay; the relay of docs/drivers.md copies them into OmniFeedback."""
+    profile = profiles.load("geomagic_touch_ros2")
+    relayed = profiles.relayed(profile)
+    assert (relayed.force.topic, relayed.force.type) == ("/phantom/force_feedback_relay", "geometry_msgs/msg/Vector3")
+    theta, g = ref.states(5, seed=14)
+    for t, gg in zip(theta, g):
+        direct, relay = DriverBridge(touch, profile).renderer(t, gg), DriverBridge(touch, relayed).renderer(t, gg)
+        vector = message(relayed)
+        fill_force(vector, relayed, relay.message)
+        omni = SimpleNamespace(force=vector)     # what the relay publishes
+        assert np.array_equal(ref.FORCE["geomagic_touch_ros2"](omni), direct.openhaptics)
+
+
+def test_every_profile_cites_its_sources_for_the_joint_states_and_the_force():
+    """Each fact of a profile with the driver's file and line (owner/repo@commit path:lines, or a page of
+    the OpenHaptics guide the driver ships)."""
+    import re
+
+    import yaml
+
+    for name in PROFILES:
+        node = yaml.safe_load((profiles.PROFILES_DIR / f"{name}.yaml").read_text())
+        for section in ("joint_states", "force"):
+            sources = node[section]["sources"]
+            cited = r"[\w.-]+/[\w.-]+@[0-9a-f]{7}\b.*(:\d| p\.\d)"
+            assert sources and all(re.match(cited, s) for s in sources.values()), (name, section, sources)
