@@ -229,3 +229,13 @@ def test_a_missing_config_folder_is_blamed_on_config(tmp_path, capsys):
     assert main(["codegen", "--config", str(tmp_path / "none"), "-o", str(tmp_path / "a.h")]) == 2
     assert capsys.readouterr().err.startswith("phantom-pin: error: --config: ")
     assert not (tmp_path / "a.h").exists()
+
+
+def test_an_overlays_banner_is_wrapped_into_short_comment_lines():
+    """L10: identify's overlay sets dozens of keys; the banner lists each, in lines of at most
+    100 characters (it was one line of 3,400), and the header still compiles (-Werror)."""
+    text = header("premium_1_5_cad", overrides=OVERLAY)
+    overlay = text.split(" * Overlay: ")[1].split(" * Gravity:")[0].splitlines()
+    assert len(overlay) > 1 and max(len(line) for line in overlay) <= 100
+    flat = " ".join(line.strip(" *") for line in overlay)
+    assert all(f"{key} = {value!r}" in flat for key, value in OVERLAY.items())

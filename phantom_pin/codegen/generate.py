@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import textwrap
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -341,6 +342,12 @@ def header(source: str | Path | Description, prefix: str = "phantom",
     return _header(description, prefix, origin, overlay_text, progress or (lambda share: None))
 
 
+def _wrapped(text: str) -> str:
+    """``text`` in comment lines of at most 100 characters (an overlay's keys: one line each
+    would be thousands of characters)."""
+    return "\n *   ".join(textwrap.wrap(text, 88, break_long_words=False, break_on_hyphens=False)) or text
+
+
 def _header(description: Description, prefix: str, origin: str, overlay: str,
             progress: Callable[[float], None]) -> str:
     model = _Model(description)
@@ -377,7 +384,7 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
         f" *\n"
         f" * Model: {name} (URDF robot {ET.fromstring(description.urdf).get('name')})\n"
         f" * Configuration: {origin}\n"
-        f" * Overlay: {overlay}\n"
+        f" * Overlay: {_wrapped(overlay)}\n"
         f" * Gravity: {description.config.gravity!r} m/s^2 along base_link's -z; armature (kg m^2): "
         f"{', '.join(repr(a) for a in description.config.actuation.armature)}\n"
         f" *\n"
