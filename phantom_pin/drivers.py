@@ -153,30 +153,44 @@ def joint_state_from_gimbal(gimbal: object, prefix: str = "", convention: str = 
         return names, finite_result(signs * g + (0 if rates else offsets), "gimbal")
 
 
+def _rigid(pose: np.ndarray, argument: str) -> None:
+    """InvalidInputError naming ``argument`` unless every (4, 4) of ``pose`` is a rigid transform:
+    a proper rotation (R R^T = I and det R = 1, to 1e-6: a mirror has det -1) and a last row of
+    0 0 0 1 (a row-major transform read column-major has its translation there)."""
+    rotation = pose[..., :3, :3]
+    if (not np.allclose(rotation @ np.swapaxes(rotation, -1, -2), np.eye(3), atol=1e-6)
+            or not np.allclose(np.linalg.det(rotation), 1.0, atol=1e-6)
+            or not np.allclose(pose[..., 3, :], [0, 0, 0, 1], atol=1e-12)):
+        raise InvalidInputError("is not a rigid transform (a proper rotation and a translation, column-major, "
+                                "last row 0 0 0 1)", argument=argument)
+
+
 def pose_from_openhaptics_transform(transform: object) -> np.ndarray:
     """The stylus's pose (4, 4) in frame s (m) of OpenHaptics' HD_CURRENT_TRANSFORM: 16 numbers,
     column-major, translation in mm (or (N, 16) for a batch); its rotation must be proper (a
     rotation to 1e-6), else InvalidInputError naming ``transform``."""
     flat, _ = as_states(transform, "transform", width=16)
     pose = np.swapaxes(flat.reshape(flat.shape[:-1] + (4, 4)), -1, -2).copy()
-    rotation = pose[..., :3, :3]
-    if (not np.allclose(rotation @ np.swapaxes(rotation, -1, -2), np.eye(3), atol=1e-6)
-            or not np.allclose(np.linalg.det(rotation), 1.0, atol=1e-6)
-            or not np.allclose(pose[..., 3, :], [0, 0, 0, 1], atol=1e-12)):
-        raise InvalidInputError("is not a rigid transform (a rotation and a translation, column-major, "
-                                "last row 0 0 0 1)", argument="transform")
+    _rigid(pose, "transform")
     pose[..., :3, 3] *= METRE_PER_MM
     return pose
 
 
 def openhaptics_transform_from_pose(pose: object) -> np.ndarray:
     """HD_CURRENT_TRANSFORM's 16 numbers (column-major, mm) of a pose (4, 4) in frame s (m),
-    e.g. Phantom.stylus_pose's; (N, 16) of (N, 4, 4)."""
-    p = np.array(pose, dtype=float)
-    if p.shape[-2:] != (4, 4) or not np.isfinite(p).all():
+    e.g. Phantom.stylus_pose's; (N, 16) of (N, 4, 4). InvalidInputError naming ``pose`` for
+    anything but finite rigid transforms (as pose_from_openhaptics_transform's), or a
+    translation whose mm overflow."""
+    try:
+        p = np.array(pose, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"expected finite 4x4 poses, got {pose!r}", argument="pose") from None
+    if p.ndim < 2 or p.shape[-2:] != (4, 4) or not np.isfinite(p).all():
         raise InvalidInputError(f"expected finite 4x4 poses, got shape {p.shape}", argument="pose")
-    p[..., :3, 3] /= METRE_PER_MM
-    return np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,))
+    _rigid(p, "pose")
+    with np.errstate(over="ignore"):  # reported by finite_result, naming pose
+        p[..., :3, 3] /= METRE_PER_MM
+    return finite_result(np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,)), "pose")
 
 
 def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:
