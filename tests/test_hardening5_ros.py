@@ -10,8 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from phantom_pin import drivers
+from phantom_pin import Phantom, closed_form, drivers, ros2
+from phantom_pin.config import read
 from phantom_pin.exceptions import InvalidInputError
+from test_ros2 import DRIVER, driver_states, expected  # the closed form's reference for the node
 
 
 def rodrigues(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -105,3 +107,131 @@ def test_gimbal_joint_states_with_a_prefix_read_their_own_names():
     with pytest.raises(InvalidInputError) as error:
         drivers.gimbal_from_joint_state(["yaw", "pitch", "roll"], [0, 0, 0], prefix="left_")
     assert error.value.argument == "names"
+
+
+# -- M2, L15 and the mutations of ros2.py ----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def touch() -> Phantom:
+    return Phantom("touch")
+
+
+@pytest.mark.parametrize("names", [
+    ["waist", "waist", "shoulder", "elbow"],
+    ["waist", "shoulder", "elbow", "yaw", "pitch", "roll", "pitch"],
+    ["joint1", "joint2", "joint3", "joint3"],
+    ["joint1", "joint2", "joint3", "joint4", "joint5", "joint6", "joint4"],
+])
+def test_a_name_given_twice_is_refused_as_the_drivers_conversions_refuse_it(touch, names):
+    """M2: the node took the last of a name given twice; drivers.theta_from_joint_state (and
+    gimbal_from_joint_state) refuse it, naming the names: the node now drops it naming ``name``."""
+    position = [0.1] * len(names)
+    with pytest.raises(InvalidInputError) as error:
+        ros2.Bridge(touch)(names, position)
+    assert error.value.argument == "name"
+    if names[0] == "waist":
+        convert = drivers.theta_from_joint_state if len(names) == 4 else drivers.gimbal_from_joint_state
+        with pytest.raises(InvalidInputError) as error:
+            convert(names, position)
+        assert error.value.argument == "names"
+
+
+@pytest.mark.parametrize("gimbal_names", [("joint4", "joint5", "joint6"), ("yaw", "pitch", "roll")])
+@pytest.mark.parametrize("arm_names", ["driver", "model"])
+def test_the_gimbal_is_read_under_either_names_with_either_arm(touch, arm_names, gimbal_names):
+    """M2: the gimbal sent under the model's own names (joint4..joint6) beside the drivers' arm
+    names was silently ignored (gravity at locked_at, no stylus pose). Each pairing now gives the
+    closed form's gravity with the gimbal's reference load and Ubitrack's stylus pose (1e-12)."""
+    bridge = ros2.Bridge(touch)
+    for position in driver_states(5, seed=11):
+        reference = expected(touch.config.report, position)
+        waist, shoulder, elbow, *g = position
+        arm = ((["waist", "shoulder", "elbow"], [waist, shoulder, elbow]) if arm_names == "driver"
+               else (["joint1", "joint2", "joint3"], [waist, shoulder, shoulder + elbow]))
+        out = bridge([*gimbal_names, *arm[0]], [*g, *arm[1]])
+        e = reference["effort"]     # conjugate to (waist, shoulder, elbow); the model's names get tau itself
+        effort = e if arm_names == "driver" else np.array([e[0], e[1] - e[2], e[2]])
+        assert np.abs(out.effort - effort).max() < 1e-12
+        assert out.stylus is not None and np.abs(out.stylus - reference["stylus"]).max() < 1e-12
+
+
+@pytest.mark.parametrize("names", [["waist", "shoulder", "elbow", "yaw"], ["waist", "shoulder", "elbow", "joint5"],
+                                   ["joint1", "joint2", "joint3", "yaw", "pitch"],
+                                   ["waist", "shoulder", "elbow", "yaw", "pitch", "roll", "joint4", "joint5",
+                                    "joint6"]])
+def test_some_of_the_gimbals_names_are_refused_naming_name(touch, names):
+    """Mutation (ros2): a message with some of the gimbal's names raised KeyError (which the node
+    does not catch: it died). Refused with InvalidInputError naming ``name``; so is the gimbal
+    given twice, under both sets of names."""
+    with pytest.raises(InvalidInputError) as error:
+        ros2.Bridge(touch)(names, [0.1] * len(names))
+    assert error.value.argument == "name"
+
+
+def test_a_velocity_of_the_wrong_length_is_refused(touch):
+    """L15: a velocity field of another length than the names was taken. One value per name, or
+    none (the drivers that publish no velocity), is."""
+    names, position = list(DRIVER), list(driver_states(1, seed=12)[0])
+    bridge = ros2.Bridge(touch)
+    for velocity in ([0.0, 0.1], [0.0] * 7):
+        with pytest.raises(InvalidInputError) as error:
+            bridge(names, position, velocity)
+        assert error.value.argument == "velocity"
+    assert np.array_equal(bridge(names, position, [0.5] * 6).effort, bridge(names, position).effort)
+
+
+def test_the_bridge_of_a_model_without_a_gimbal_answers_from_the_closed_form():
+    """Mutation (ros2): the Bridge of a model without a gimbal (premium_1_5) failing on every
+    message passed, the node being tested on the Touch only. Against the report's closed form
+    (eqs 10, 93-94) and the URDF's mimic tags written out here: the drivers' names (their yaw,
+    pitch, roll ignored, there being no gimbal), the model's, 1e-12 (N m, m)."""
+    config = read("premium_1_5")
+    bridge = ros2.Bridge(Phantom("premium_1_5"))
+    l1, l2 = config.kinematics.l1, config.kinematics.l2
+    base_from_s = np.eye(4)                      # the macro's report_s: at (l1, 0, -l2), axes (y, z, x)
+    base_from_s[:3, :3] = [[0, 0, 1], [1, 0, 0], [0, 1, 0]]
+    base_from_s[:3, 3] = l1, 0, -l2
+    rng = np.random.default_rng(13)
+    lower, upper = np.array(config.limits.stops.lower), np.array(config.limits.stops.upper)
+    for theta in rng.uniform(lower, upper, (20, 3)):
+        tau = closed_form.gravity(theta, config.report)
+        out = bridge(["yaw", "elbow", "shoulder", "pitch", "waist", "roll"],
+                     [9.0, theta[2] - theta[1], theta[1], 9.0, theta[0], 9.0])
+        assert out.stylus is None and out.names == ("waist", "shoulder", "elbow")
+        assert np.abs(out.effort - [tau[0], tau[1] + tau[2], tau[2]]).max() < 1e-12
+        assert np.abs(out.tip - base_from_s @ closed_form.forward_kinematics(theta, config.report)).max() < 1e-12
+        assert np.abs(out.openhaptics - 1000 * tau * [-1, 1, 1]).max() < 1e-9
+        model = {"joint1": theta[0], "joint2": theta[1], "joint3": theta[2], "crank_pin_a": -theta[2],
+                 "crank_pin_b": theta[1], "forearm_pin_a": -theta[1], "forearm_pin_b": theta[2]}
+        assert dict(zip(out.model_names, out.model_positions)) == pytest.approx(model, abs=1e-15)
+        mine = bridge(["joint1", "joint2", "joint3"], list(theta))
+        assert mine.stylus is None and np.abs(mine.effort - tau).max() < 1e-12
+
+
+class _Publisher:
+    def __init__(self) -> None:
+        self.messages: list = []
+
+    def publish(self, message) -> None:
+        self.messages.append(message)
+
+
+def test_the_openhaptics_topic_names_its_torques_turret_thigh_shin(touch):
+    """Mutation (ros2): the OpenHaptics topic's joint names swapped (thigh/shin) passed. OpenHaptics'
+    reference guide names its joints "Turet Left +, Thigh Up +, Shin Up +", in the order of
+    HD_CURRENT_JOINT_ANGLES; its torque on each is 1000 (-tau1, tau2, tau3) mN m (SensAble's
+    CommandJointTorque sample), tau the closed form's: each name carries its own joint's torque."""
+    position = driver_states(1, seed=14)[0]
+    out = ros2.Bridge(touch)(list(DRIVER), list(position))
+    outputs = {role: _Publisher() for role in ("gravity_torque", "gravity_torque_openhaptics", "tip_pose",
+                                               "stylus_pose", "model_joint_states")}
+    from builtin_interfaces.msg import Time
+
+    ros2._publish_outputs(outputs, out, Time(sec=1, nanosec=2), "", "left_")
+    message = outputs["gravity_torque_openhaptics"].messages[0]
+    torques = dict(zip(message.name, message.effort))
+    reference = expected(touch.config.report, position)["openhaptics"]
+    assert list(torques) == ["left_turret", "left_thigh", "left_shin"]
+    assert [torques["left_turret"], torques["left_thigh"], torques["left_shin"]] == pytest.approx(
+        reference, abs=1e-9)
