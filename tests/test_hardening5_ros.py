@@ -235,3 +235,106 @@ def test_the_openhaptics_topic_names_its_torques_turret_thigh_shin(touch):
     assert list(torques) == ["left_turret", "left_thigh", "left_shin"]
     assert [torques["left_turret"], torques["left_thigh"], torques["left_shin"]] == pytest.approx(
         reference, abs=1e-9)
+
+
+# -- H5: OpenHaptics' origin -------------------------------------------------------------------------
+
+#: The ranges of a real Touch's logged HD_CURRENT_TRANSFORM positions (mm, OpenHaptics'
+#: coordinates; iLUVE69/Limb-Impedance-measurement-using-GeoMagic-Touch-Haptic-Device,
+#: NoDrift_Batch1/2_data.csv, the stylus slid in a horizontal plane): facts about the file,
+#: which has no licence and is not copied.
+LOGGED = {"x": (-75.0, 57.0), "y": (-83.0, -62.0), "z": (-66.0, -39.0)}
+
+
+def touch_stops_yaml() -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The Touch's stops as joint_limits.yaml states them (PyYAML): per joint, and coupled."""
+    import yaml
+
+    from helpers import CONFIG_DIR
+
+    stops = yaml.safe_load((CONFIG_DIR.parent / "touch" / "joint_limits.yaml").read_text())["stops"]
+    joints = ("joint1", "joint2", "joint3")
+    return (np.array([stops[j]["lower"] for j in joints]), np.array([stops[j]["upper"] for j in joints]),
+            stops["theta2_minus_theta3_max"], stops["theta3_minus_theta2_max"])
+
+
+def reachable_inside_the_stops(position: np.ndarray, report) -> bool:
+    """Whether the report's closed-form inverse kinematics (eqs 11-20, either elbow branch) puts
+    the gimbal centre at ``position`` (m, frame s) with theta inside the Touch's stops (its YAML)."""
+    from phantom_pin.exceptions import UnreachableTargetError
+
+    lower, upper, below, above = touch_stops_yaml()
+    for branch in ("report", "other"):
+        try:
+            theta = closed_form.inverse_kinematics(position, report, branch=branch)
+        except UnreachableTargetError:
+            return False
+        assert np.abs(closed_form.forward_kinematics(theta, report)[:3, 3] - position).max() < 1e-12
+        if (np.all(lower <= theta) and np.all(theta <= upper) and theta[1] - theta[2] <= below
+                and theta[2] - theta[1] <= above):
+            return True
+    return False
+
+
+def logged_box(n: int = 3) -> np.ndarray:
+    """An n x n x n grid over the logged ranges (mm), its corners included."""
+    axes = [np.linspace(*LOGGED[axis], n) for axis in "xyz"]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def test_the_logged_positions_of_a_real_touch_are_reached_inside_its_stops_from_the_estimated_origin():
+    """H5: drivers took OpenHaptics' origin to be frame s's (Ubitrack's calibration model), with
+    which a real Touch's logged positions need theta2 < 0 (the Touch's stop is 0). With
+    gimbal.yaml's openhaptics_shoulder (Carrot404's base_ref, an estimate) every point of the
+    logged box (a 3x3x3 grid, its corners included; the translation of an HD_CURRENT_TRANSFORM
+    is the gimbal centre, the stylus frame's origin) maps to a gimbal-centre position that the
+    report's inverse kinematics reaches inside the stops; with the origins equal none does."""
+    report = read("touch").report
+    for point in logged_box():
+        flat = np.eye(4)
+        flat[:3, 3] = point
+        flat = flat.T.ravel()                                 # column-major, mm
+        estimated = drivers.pose_from_openhaptics_transform(flat)[:3, 3]
+        assert reachable_inside_the_stops(estimated, report), point
+        equal = drivers.pose_from_openhaptics_transform(flat, origin=np.zeros(3))[:3, 3]
+        assert not reachable_inside_the_stops(equal, report), point
+
+
+def test_the_origin_is_gimbal_yamls_shoulder_less_the_shoulder_in_frame_s():
+    """openhaptics_origin: gimbal.yaml's openhaptics_shoulder less the shoulder's position in
+    frame s, which the report's forward kinematics places at (0, l2, -l1) (the zero posture's
+    upper arm l1 along +z, forearm l2 along -y, from the shoulder to frame s's origin): read
+    through the configuration, an override moves it, a value in mm and a model without a
+    gimbal are refused naming the key and the argument."""
+    import yaml
+
+    from helpers import CONFIG_DIR
+    from phantom_pin import describe
+    from phantom_pin.exceptions import ParameterFileError
+
+    stated = yaml.safe_load((CONFIG_DIR.parent / "touch" / "gimbal.yaml").read_text())["openhaptics_shoulder"]
+    report = read("touch").report
+    # the shoulder: the point every posture's elbow stays l1 from, on the joint-1 axis
+    shoulder = np.array([0.0, report.l2, -report.l1])
+    for theta in np.random.default_rng(15).uniform(-1, 1, (10, 3)):
+        tip = closed_form.forward_kinematics(theta, report)[:3, 3]
+        assert abs(np.linalg.norm(tip - shoulder) ** 2 - (report.l1**2 + report.l2**2
+                                                          + 2 * report.l1 * report.l2 * math.sin(theta[2] - theta[1]))
+                   ) < 1e-12
+    assert np.abs(drivers.openhaptics_origin() - (np.array(stated) - shoulder)).max() < 1e-15
+    assert np.array_equal(drivers.openhaptics_origin(Phantom("touch")), drivers.openhaptics_origin())
+    moved = describe("touch", overrides={"openhaptics_shoulder.2": -0.2})
+    assert np.abs(drivers.openhaptics_origin(moved) - drivers.openhaptics_origin() - [0, 0, -0.2 - stated[2]]
+                  ).max() < 1e-15
+    back = drivers.pose_from_openhaptics_transform(drivers.openhaptics_transform_from_pose(
+        transform(ROTATION, [0.01, 0.02, 0.03]) / [[1], [1], [1], [1]], origin=drivers.openhaptics_origin(moved)),
+        origin=drivers.openhaptics_origin(moved))
+    assert np.abs(back[:3, 3] - [0.01, 0.02, 0.03]).max() < 1e-15
+    with pytest.raises(ParameterFileError, match="openhaptics_shoulder"):
+        describe("touch", overrides={"openhaptics_shoulder.2": -157})
+    with pytest.raises(InvalidInputError) as error:
+        drivers.openhaptics_origin(Phantom("premium_1_5"))
+    assert error.value.argument == "model"
+    with pytest.raises(InvalidInputError) as error:
+        drivers.pose_from_openhaptics_transform(np.eye(4).ravel(), origin=[[0, 0, 0]])
+    assert error.value.argument == "origin"
