@@ -38,18 +38,29 @@ positions do, without the offsets (``rates=True``). The drivers' efforts follow 
 ``openhaptics_torque_to_tau``.
 
 HD_CURRENT_TRANSFORM (``pose_from_openhaptics_transform``): the 16 numbers of the stylus's
-column-major 4x4 transform, translation in mm, in OpenHaptics' axes, which are frame s's (its
-origin OpenHaptics' own: Ubitrack's formula puts it at the zero posture's tip, as frame s).
+column-major 4x4 transform, translation in mm, in OpenHaptics' axes, which are frame s's. Its
+origin is OpenHaptics' own, which no public source states: ``openhaptics_origin`` gives frame
+s's origin (the zero posture's gimbal centre, eq. 10) in OpenHaptics' coordinates from a
+model's gimbal.yaml (``openhaptics_shoulder``, the shoulder's position there; for the Touch an
+ESTIMATE, +-10-20 mm: Carrot404/Touch_ROS_Drivers_Applications' touch.urdf, commit 00863fb,
+base_ref, which puts the shoulder at (0, 35, -157) mm). Ubitrack's calibration model
+(PhantomForwardKinematics.h above) puts OpenHaptics' origin at frame s's (its offsets zero);
+a real Touch's logged HD_CURRENT_TRANSFORM positions (iLUVE69/Limb-Impedance-measurement-
+using-GeoMagic-Touch-Haptic-Device) reach no posture inside the stops with that, and all of
+them with the estimate (tests/test_hardening5_ros.py). Check it on your device: the gimbal
+centre's HD_CURRENT_POSITION at a known posture gives it.
 
 Arrays: one vector (3,) or a batch (N, 3), as the rest of phantom_pin.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
+from phantom_pin.config import Config, read
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.validation import as_states, finite_result
 
@@ -153,30 +164,81 @@ def joint_state_from_gimbal(gimbal: object, prefix: str = "", convention: str = 
         return names, finite_result(signs * g + (0 if rates else offsets), "gimbal")
 
 
-def pose_from_openhaptics_transform(transform: object) -> np.ndarray:
-    """The stylus's pose (4, 4) in frame s (m) of OpenHaptics' HD_CURRENT_TRANSFORM: 16 numbers,
-    column-major, translation in mm (or (N, 16) for a batch); its rotation must be proper (a
-    rotation to 1e-6), else InvalidInputError naming ``transform``."""
-    flat, _ = as_states(transform, "transform", width=16)
-    pose = np.swapaxes(flat.reshape(flat.shape[:-1] + (4, 4)), -1, -2).copy()
+def _rigid(pose: np.ndarray, argument: str) -> None:
+    """InvalidInputError naming ``argument`` unless every (4, 4) of ``pose`` is a rigid transform:
+    a proper rotation (R R^T = I and det R = 1, to 1e-6: a mirror has det -1) and a last row of
+    0 0 0 1 (a row-major transform read column-major has its translation there)."""
     rotation = pose[..., :3, :3]
     if (not np.allclose(rotation @ np.swapaxes(rotation, -1, -2), np.eye(3), atol=1e-6)
             or not np.allclose(np.linalg.det(rotation), 1.0, atol=1e-6)
             or not np.allclose(pose[..., 3, :], [0, 0, 0, 1], atol=1e-12)):
-        raise InvalidInputError("is not a rigid transform (a rotation and a translation, column-major, "
-                                "last row 0 0 0 1)", argument="transform")
-    pose[..., :3, 3] *= METRE_PER_MM
+        raise InvalidInputError("is not a rigid transform (a proper rotation and a translation, column-major, "
+                                "last row 0 0 0 1)", argument=argument)
+
+
+def openhaptics_origin(model: object = None) -> np.ndarray:
+    """Frame s's origin (the zero posture's gimbal centre) in OpenHaptics' coordinates (m),
+    (3,): ``openhaptics_shoulder`` of the model's gimbal.yaml less the shoulder's position in
+    frame s, (0, l2, -l1). ``model``: a Config, or anything carrying one as ``.config`` (Phantom,
+    Description), of a model with a gimbal; None: the shipped Touch's (an ESTIMATE: the
+    module's doc). InvalidInputError naming ``model`` for a model without a gimbal.yaml."""
+    if model is None:
+        return _touch_origin().copy()
+    config = getattr(model, "config", model)
+    if not isinstance(config, Config) or config.gimbal is None:
+        raise InvalidInputError(f"expected the Config (or Phantom) of a model with a stylus gimbal "
+                                f"(gimbal.yaml, whose openhaptics_shoulder places OpenHaptics' origin), got {model!r}",
+                                argument="model")
+    k = config.kinematics
+    return np.array(config.gimbal.openhaptics_shoulder) - [0.0, k.l2, -k.l1]
+
+
+@functools.cache
+def _touch_origin() -> np.ndarray:
+    return openhaptics_origin(read("touch"))
+
+
+def _origin(origin: object) -> np.ndarray:
+    """``origin`` (m, (3,)) checked; None: the shipped Touch's (openhaptics_origin())."""
+    if origin is None:
+        return _touch_origin()
+    value, batch = as_states(origin, "origin")
+    if batch:
+        raise InvalidInputError(f"expected one point (3,), got shape {value.shape}", argument="origin")
+    return value
+
+
+def pose_from_openhaptics_transform(transform: object, origin: object = None) -> np.ndarray:
+    """The stylus's pose (4, 4) in frame s (m) of OpenHaptics' HD_CURRENT_TRANSFORM: 16 numbers,
+    column-major, translation in mm (or (N, 16) for a batch); its rotation must be proper (a
+    rotation to 1e-6), else InvalidInputError naming ``transform``. ``origin``: frame s's origin
+    in OpenHaptics' coordinates (m, (3,)), subtracted from the translation; None: the shipped
+    Touch's ESTIMATE (openhaptics_origin(); for another configuration pass
+    openhaptics_origin(phantom))."""
+    flat, _ = as_states(transform, "transform", width=16)
+    offset = _origin(origin)
+    pose = np.swapaxes(flat.reshape(flat.shape[:-1] + (4, 4)), -1, -2).copy()
+    _rigid(pose, "transform")
+    pose[..., :3, 3] = pose[..., :3, 3] * METRE_PER_MM - offset
     return pose
 
 
-def openhaptics_transform_from_pose(pose: object) -> np.ndarray:
+def openhaptics_transform_from_pose(pose: object, origin: object = None) -> np.ndarray:
     """HD_CURRENT_TRANSFORM's 16 numbers (column-major, mm) of a pose (4, 4) in frame s (m),
-    e.g. Phantom.stylus_pose's; (N, 16) of (N, 4, 4)."""
-    p = np.array(pose, dtype=float)
-    if p.shape[-2:] != (4, 4) or not np.isfinite(p).all():
+    e.g. Phantom.stylus_pose's; (N, 16) of (N, 4, 4); ``origin`` as pose_from_openhaptics_transform's,
+    added to the translation. InvalidInputError naming ``pose`` for anything but finite rigid
+    transforms (as pose_from_openhaptics_transform's), or a translation whose mm overflow."""
+    offset = _origin(origin)
+    try:
+        p = np.array(pose, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"expected finite 4x4 poses, got {pose!r}", argument="pose") from None
+    if p.ndim < 2 or p.shape[-2:] != (4, 4) or not np.isfinite(p).all():
         raise InvalidInputError(f"expected finite 4x4 poses, got shape {p.shape}", argument="pose")
-    p[..., :3, 3] /= METRE_PER_MM
-    return np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,))
+    _rigid(p, "pose")
+    with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result, naming pose
+        p[..., :3, 3] = (p[..., :3, 3] + offset) / METRE_PER_MM
+    return finite_result(np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,)), "pose")
 
 
 def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:

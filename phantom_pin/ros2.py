@@ -5,8 +5,9 @@ packages from PyPI).
 Input, ``joint_states`` (sensor_msgs/JointState): the Touch-era drivers' names (``waist,
 shoulder, elbow`` with the elbow relative to the shoulder, and, for a model with a stylus
 gimbal, ``yaw, pitch, roll``, OpenHaptics' raw gimbal angles; phantom_pin.drivers), or the
-model's own (``joint1..joint3``, ``joint4..joint6``), each with the node's prefix. Other
-names are ignored; without the gimbal's names the gimbal is taken at its ``locked_at``.
+model's own (``joint1..joint3``, ``joint4..joint6``), each with the node's prefix; the gimbal's
+under either set of names, whichever names the arm. Other names are ignored; without the
+gimbal's names the gimbal is taken at its ``locked_at``.
 
 Output, every message carrying the input's header stamp:
 
@@ -24,7 +25,9 @@ Output, every message carrying the input's header stamp:
 - ``model_joint_states`` (sensor_msgs/JointState): every joint of the model's URDF (the mimic
   joints of the parallelogram included), rad, for robot_state_publisher with that URDF.
 
-A message with a missing name, a length that does not match its names, a value that is not
+A message with a missing name, a name it reads given twice, some of the gimbal's three names but
+not all (the drivers' or the model's: either set goes with either arm's), a position or velocity
+field whose length does not match its names (an empty velocity is fine), a value that is not
 finite or an angle more than a turn beyond the stops is dropped with one warning per second
 naming the field; the node keeps running. Quality of service: the subscription is best effort
 (a 1 kHz sensor stream: it matches reliable and best-effort publishers alike), keep last 10: a
@@ -170,11 +173,19 @@ class Bridge:
         self.full, self.base_from_s = self.frames.full, self.frames.base_from_s
         self.model_names = tuple(self.full.tree.names[1:])
 
-    def _values(self, names: Sequence[str], positions: Sequence[float]) -> tuple[dict[str, float], bool]:
+    def _values(self, names: Sequence[str], positions: Sequence[float],
+                velocity: Sequence[float]) -> tuple[dict[str, float], bool]:
         """The input by name, and whether it uses the drivers' names (else the model's)."""
         given = list(names)
         if len(positions) != len(given):
             raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
+        if len(velocity) not in (0, len(given)):
+            raise InvalidInputError(f"{len(velocity)} values for {len(given)} names (one per name, or none)",
+                                    argument="velocity")
+        read = (*self.driver_names, *self.model_arm, *self.driver_gimbal, *self.model_gimbal)
+        twice = [n for n in read if given.count(n) > 1]
+        if twice:
+            raise InvalidInputError(f"{', '.join(twice)} given more than once, in {given}", argument="name")
         values = dict(zip(given, (float(p) for p in positions)))
         driver = all(n in values for n in self.driver_names)
         if not driver and not all(n in values for n in self.model_arm):
@@ -182,14 +193,31 @@ class Bridge:
                                     f"{', '.join(self.model_arm)}), in {given}", argument="name")
         return values, driver
 
-    def __call__(self, names: Sequence[str], positions: Sequence[float]) -> Output:
-        values, driver = self._values(names, positions)
+    def _gimbal(self, values: dict[str, float]) -> np.ndarray | None:
+        """The raw gimbal angles of the input, under the drivers' names or the model's (either
+        with either arm's), or None (locked_at) where it names none of them; a model without a
+        gimbal ignores them all."""
+        if self.gimbal is None:
+            return None
+        named = [names for names in (self.driver_gimbal, self.model_gimbal) if any(n in values for n in names)]
+        if not named:
+            return None
+        if len(named) > 1:
+            raise InvalidInputError(f"the gimbal given twice, as {', '.join(self.driver_gimbal)} and as "
+                                    f"{', '.join(self.model_gimbal)}", argument="name")
+        missing = [n for n in named[0] if n not in values]
+        if missing:
+            raise InvalidInputError(f"missing {', '.join(missing)}: give the gimbal's three angles or none "
+                                    f"(none: its locked_at), in {list(values)}", argument="name")
+        return np.array([values[n] for n in named[0]])  # raw angles (the Touch-era drivers')
+
+    def __call__(self, names: Sequence[str], positions: Sequence[float], velocity: Sequence[float] = ()) -> Output:
+        """Output of one joint_states message; ``velocity`` (its velocity field) is checked only:
+        empty or one value per name."""
+        values, driver = self._values(names, positions, velocity)
         arm = [values[n] for n in (self.driver_names if driver else self.model_arm)]
         theta = np.array([arm[0], arm[1], arm[1] + arm[2]]) if driver else np.array(arm)
-        gimbal_names = self.driver_gimbal if driver else self.model_gimbal
-        gimbal = None
-        if self.gimbal is not None and all(n in values for n in gimbal_names):
-            gimbal = np.array([values[n] for n in gimbal_names])  # raw angles (the Touch-era drivers')
+        gimbal = self._gimbal(values)
         state = np.concatenate([theta, gimbal if gimbal is not None else
                                 (self.gimbal.locked_at if self.gimbal else [])])
         if not np.isfinite(state).all():

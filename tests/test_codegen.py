@@ -109,15 +109,34 @@ def test_every_function_matches_pinocchio(name, overlay, tmp_path):
     assert np.array_equal(mass, mass.transpose(0, 2, 1))  # symmetric by construction
 
 
-def test_openhaptics_helpers_follow_the_drivers(tmp_path):
-    """The header's OpenHaptics conversions equal phantom_pin.drivers' (exactly: sign flips
-    and a scaling by 1000)."""
-    from phantom_pin import drivers
+def test_openhaptics_helpers_follow_the_published_conventions(tmp_path):
+    """The header's OpenHaptics conversions against the published conventions written out here,
+    not against phantom_pin.drivers (the same convention twice). Angles: Ubitrack/
+    component_haptic_calibration's PhantomForwardKinematics.h lines 101-103 put the tip of
+    OpenHaptics' angles a at x = -(l1 c2 + l2 s3) s1, y = l1 s2 - l2 c3 + l2, z = -l1 + (l1 c2 +
+    l2 s3) c1 (l1 = l2 = 133.35 mm, its default): the header's tip at theta_from_openhaptics(a)
+    is there (1e-12 m), and theta = (-a1, a2, a3) exactly. Torques: SensAble's CommandJointTorque
+    sample gives HD_CURRENT_JOINT_TORQUE in mN m on OpenHaptics' own angles, so it does tau's
+    power on their rates (1e-9 relative) and equals 1000 (-tau1, tau2, tau3) exactly; a spring
+    restoring theta is the sample's restoring spring, torque = k (0 - a) with k > 0."""
     library = build(header("touch"), tmp_path)
-    values = np.random.default_rng(5).normal(0, 1, (50, 3))
-    assert np.array_equal(call(library, "theta_from_openhaptics", 3, values), drivers.theta_from_openhaptics(values))
-    assert np.array_equal(call(library, "openhaptics_torque_from_tau", 3, values),
-                          drivers.openhaptics_torque_from_tau(values))
+    rng = np.random.default_rng(5)
+    angles = rng.uniform([-0.98, 0.0, 0.0], [0.98, 1.75, 2.0], (50, 3))   # inside the Touch's stops
+    theta = call(library, "theta_from_openhaptics", 3, angles)
+    assert np.array_equal(theta, np.column_stack([-angles[:, 0], angles[:, 1], angles[:, 2]]))
+    length = 0.13335
+    s1, c1, s2, c2, s3, c3 = (f(angles[:, k]) for k in range(3) for f in (np.sin, np.cos))
+    ubitrack = np.column_stack([-(length * c2 + length * s3) * s1, length * s2 - length * c3 + length,
+                                -length + (length * c2 + length * s3) * c1])
+    assert np.abs(call(library, "tip_position", 3, theta) - ubitrack).max() < 1e-12
+    tau, rates = rng.normal(0, 1, (50, 3)), rng.normal(0, 1, (50, 3))   # N m; OpenHaptics' angle rates
+    torque = call(library, "openhaptics_torque_from_tau", 3, tau)
+    assert np.array_equal(torque, 1000 * np.column_stack([-tau[:, 0], tau[:, 1], tau[:, 2]]))
+    theta_rates = np.column_stack([-rates[:, 0], rates[:, 1], rates[:, 2]])   # d theta / dt of d a / dt
+    power_mw = np.einsum("ni,ni->n", torque, rates)
+    assert np.abs(power_mw - 1000 * np.einsum("ni,ni->n", tau, theta_rates)).max() < 1e-9 * np.abs(power_mw).max()
+    restoring = call(library, "openhaptics_torque_from_tau", 3, -0.5 * theta)   # a spring to theta = 0
+    assert np.all(restoring * angles <= 0) and np.all(restoring[angles != 0] != 0)  # the sample's: to a = 0
 
 
 @pytest.mark.parametrize("name", models())

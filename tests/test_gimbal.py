@@ -197,12 +197,18 @@ def test_the_drivers_gimbal_conventions():
 
 def test_hd_current_transform_is_the_stylus_pose_column_major_in_mm(touch):
     """HD_CURRENT_TRANSFORM's 16 numbers: the rotation's columns first, the translation (mm) at
-    12..14, 1 at 15; to and from the stylus's pose (m)."""
+    12..14, from OpenHaptics' origin (gimbal.yaml's openhaptics_shoulder less the shoulder's
+    position (0, l2, -l1) in frame s, read here from the YAML), 1 at 15; to and from the
+    stylus's pose (m)."""
+    kinematics = yaml.safe_load((TOUCH / "kinematics.yaml").read_text())
+    origin = np.array(GIMBAL_YAML["openhaptics_shoulder"]) - [0, kinematics["l2"], -kinematics["l1"]]
     theta, gimbal = states(5, seed=9)
     pose = touch.stylus_pose(theta[0], gimbal[0])
     flat = drivers.openhaptics_transform_from_pose(pose)
     assert np.array_equal(flat[0:3], pose[:3, 0]) and np.array_equal(flat[4:7], pose[:3, 1])
-    assert np.allclose(flat[12:15], pose[:3, 3] * 1000, rtol=1e-15) and flat[15] == 1 and flat[3] == 0
+    assert np.allclose(flat[12:15], (pose[:3, 3] + origin) * 1000, rtol=1e-14) and flat[15] == 1 and flat[3] == 0
+    at_zero = drivers.openhaptics_transform_from_pose(pose, origin=np.zeros(3))
+    assert np.allclose(at_zero[12:15], pose[:3, 3] * 1000, rtol=1e-15)
     back = drivers.pose_from_openhaptics_transform(flat)
     assert np.abs(back - pose).max() < 1e-15
     batch = drivers.pose_from_openhaptics_transform(drivers.openhaptics_transform_from_pose(

@@ -49,3 +49,20 @@ def test_a_loader_without_mimic_opens_the_parallelogram():
     assert not np.allclose(gravity[:3], Phantom().gravity(theta), rtol=1e-3)
     closed = pin.RobotWrapper.BuildFromURDF(robot_descriptions.URDF_PATH, mimic=True)
     assert closed.model.nq == 3
+
+
+def test_the_touch_has_the_path_of_its_drivers_convention_urdf():
+    """L16: no path named urdf/phantom_touch_driver.urdf. The Touch's DRIVER_URDF_PATH is that
+    committed file, whose joints are the drivers' published joint_states names (waist, shoulder,
+    elbow, yaw, pitch, roll: fsuarez6/phantom_omni omni_state.cpp, jhu-saw/sawSensablePhantom);
+    the models without drivers' convention have none."""
+    import xml.etree.ElementTree as ET
+
+    path = Path(robot_descriptions.touch.DRIVER_URDF_PATH)
+    assert path.is_absolute() and path == Path(robot_descriptions.touch.PACKAGE_PATH, "urdf",
+                                                "phantom_touch_driver.urdf")
+    joints = {joint.get("name") for joint in ET.parse(path).getroot().iter("joint")}
+    assert {"waist", "shoulder", "elbow", "yaw", "pitch", "roll"} <= joints
+    for name in models():
+        if name != "touch":
+            assert not hasattr(getattr(robot_descriptions, name), "DRIVER_URDF_PATH")

@@ -178,6 +178,12 @@ def _sources(r: Reader) -> dict[str, str]:
             if r.documents[arg] or arg not in OPTIONAL}
 
 
+#: Largest |coordinate| (m) of the shoulder in OpenHaptics' coordinates: OpenHaptics' origin lies
+#: in the device's workspace, within a desk-top arm's reach of its shoulder (the Touch's
+#: l1 + l2 = 0.27 m); a number in mm (157 for 0.157) is refused.
+OPENHAPTICS_REACH = 1.0
+
+
 def _gimbal(r: Reader) -> Gimbal | None:
     """The stylus gimbal of gimbal.yaml (None without the file): its joints' ranges, and its three
     links computed from the stated solids (ABS of ``density``), in the URDF link frames
@@ -218,9 +224,13 @@ def _gimbal(r: Reader) -> Gimbal | None:
         if not lo <= angle <= hi:
             raise r.error(arg, f"locked_at: {joint} at {angle!r} rad is outside its range {lo!r} .. {hi!r}")
     geometry = {key: r.node(arg, key) for key in ("yoke", "pitch_block", "stylus")}
+    shoulder = r.vector(arg, "openhaptics_shoulder", length=3)
+    if max(abs(v) for v in shoulder) > OPENHAPTICS_REACH:
+        raise r.error(arg, f"openhaptics_shoulder: {list(shoulder)!r} m is not within {OPENHAPTICS_REACH:g} m of "
+                           "OpenHaptics' origin on every axis (metres, not mm?)")
     return Gimbal(vector3(lo for lo, _ in ranges), vector3(hi for _, hi in ranges),
                   r.number(arg, "velocity_limit", positive=True), tip, vector3(locked),
-                  types.MappingProxyType(links), cast(Mapping[str, object], freeze(geometry)))
+                  types.MappingProxyType(links), cast(Mapping[str, object], freeze(geometry)), vector3(shoulder))
 
 
 def _report(r: Reader, kinematics: Kinematics,

@@ -259,7 +259,10 @@ class Gimbal:
     (rad) at which the arm's 3-DoF dynamics (Phantom, simulate, Device, the identification) carry
     the gimbal and stylus as a rigid load; ``links``: GIMBAL_LINKS in full (URDF link frames,
     parallel to base_link at the zero configuration; kg, m, kg m^2); ``geometry``: the solids
-    those links are computed from and drawn as (read-only YAML data, m)."""
+    those links are computed from and drawn as (read-only YAML data, m); ``openhaptics_shoulder``:
+    the shoulder (the joint-1/joint-2 axes' intersection) in OpenHaptics' coordinates (m; an
+    ESTIMATE for the Touch), where HD_CURRENT_TRANSFORM's translation puts it
+    (phantom_pin.drivers.openhaptics_origin)."""
 
     lower: tuple[float, float, float]
     upper: tuple[float, float, float]
@@ -268,6 +271,7 @@ class Gimbal:
     locked_at: tuple[float, float, float]
     links: Mapping[str, Inertial]
     geometry: Mapping[str, object]
+    openhaptics_shoulder: tuple[float, float, float]
 
 
 @dataclasses.dataclass(frozen=True)
