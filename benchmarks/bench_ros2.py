@@ -28,12 +28,14 @@ from sensor_msgs.msg import JointState
 from geometry_msgs.msg import WrenchStamped
 rclpy.init()
 node = rclpy.create_node("echo")
-out = node.create_publisher(WrenchStamped, sys.argv[2], QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
+out = node.create_publisher(WrenchStamped, sys.argv[2],
+                            QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
 def answer(message):
     command = WrenchStamped()
     command.header.stamp = message.header.stamp
     out.publish(command)
-node.create_subscription(JointState, sys.argv[1], answer, QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+node.create_subscription(JointState, sys.argv[1], answer,
+                         QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
 print("echo ready", file=sys.stderr, flush=True)
 rclpy.spin(node)
 """
@@ -53,7 +55,8 @@ latencies = []
 def received(message):
     stamp = message.header.stamp
     latencies.append((time.time_ns() - (stamp.sec * 10**9 + stamp.nanosec)) * 1e-9)
-node.create_subscription(WrenchStamped, out_topic, received, QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT))
+qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT)
+node.create_subscription(WrenchStamped, out_topic, received, qos)
 executor = SingleThreadedExecutor()
 executor.add_node(node)
 deadline = time.monotonic() + 60

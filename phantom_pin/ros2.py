@@ -110,11 +110,15 @@ class DriverBridge:
         self.lower = np.array([*stops.lower, *(self.gimbal.lower if self.gimbal else ())]) - BEYOND
         self.upper = np.array([*stops.upper, *(self.gimbal.upper if self.gimbal else ())]) + BEYOND
 
-    def state(self, names: Sequence[str], positions: Sequence[float]) -> tuple[np.ndarray, np.ndarray | None]:
-        """(theta, g) (rad) of one joint_states message; g None for a model without a gimbal."""
+    def state(self, names: Sequence[str], positions: Sequence[float],
+              velocity: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray | None]:
+        """(theta, g) (rad) of one joint_states message; g None for a model without a gimbal.
+        ``velocity`` (its velocity field) is checked only: empty or one value per name."""
         given = list(names)
         if len(positions) != len(given):
             raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
+        if len(velocity) not in (0, len(given)):
+            raise InvalidInputError(f"{len(velocity)} values for {len(given)} names", argument="velocity")
         wanted = self.names if self.gimbal is not None else self.names[:3]
         wrong = [n for n in wanted if given.count(n) != 1]
         if wrong:
@@ -338,9 +342,9 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
             stamp = message.header.stamp
             try:
                 if driver is None:
-                    out = bridge(message.name, message.position)
+                    out = bridge(message.name, message.position, message.velocity)
                 else:
-                    theta, gimbal = driver.state(message.name, message.position)
+                    theta, gimbal = driver.state(message.name, message.position, message.velocity)
                     self.send_force(theta, gimbal, stamp)
                     now = time.monotonic()
                     if now < self.next_outputs:  # the servo path first: the rest at OUTPUTS_RATE,

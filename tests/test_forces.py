@@ -171,6 +171,10 @@ def test_bad_options_and_messages_are_refused_naming_them(touch):
         with pytest.raises(InvalidInputError) as error:
             bridge.state(given, positions)
         assert error.value.argument == argument
+    with pytest.raises(InvalidInputError) as error:
+        bridge.state(names, [0.1] * 6, [0.0] * 5)
+    assert error.value.argument == "velocity"
+    assert bridge.state(names, [0.1] * 6, [0.0] * 6)[0].shape == (3,)
 
 
 def test_the_relay_sends_the_same_numbers_as_a_vector3_beside_the_drivers_topic(touch):
