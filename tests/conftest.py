@@ -99,7 +99,8 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 #: --dist loadgroup; every other test is handed out one by one): a group name for each test
 #: whose node id contains the key. A module whose module-scoped fixture (or a cache of its
 #: helpers, shared with another module) is expensive computes it once, not once per worker
-#: (test_codegen: its headers, generated once per arguments);
+#: (test_codegen: its headers, generated once per arguments; the SymPy derivations of
+#: cad_reference and phantom_pin.report.derivation);
 #: tests that start a meshcat server run one at a time, since meshcat takes the first free port
 #: from 7000 and test_cli's `show` tests check that the URL is dead once it stopped (another
 #: worker's new server would answer there); the ROS 2 node tests over loopback likewise.
@@ -110,6 +111,8 @@ GROUPS = {
     "test_identification_end_to_end.py::": "identification_end_to_end",
     "test_gazebo.py::": "gazebo",
     "test_codegen.py::": "codegen",
+    "test_cad_model.py::": "cad_model",
+    "test_derivation.py::": "derivation",
     "test_viewer.py::": "meshcat",
     "test_meshcat_server.py::": "meshcat",
     "test_cli.py::test_show_": "meshcat",
