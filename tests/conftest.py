@@ -100,10 +100,8 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 #: whose node id contains the key. A module whose module-scoped fixture (or a cache of its
 #: helpers, shared with another module) is expensive computes it once, not once per worker
 #: (test_codegen: its headers, generated once per arguments; the SymPy derivations of
-#: cad_reference and phantom_pin.report.derivation);
-#: tests that start a meshcat server run one at a time, since meshcat takes the first free port
-#: from 7000 and test_cli's `show` tests check that the URL is dead once it stopped (another
-#: worker's new server would answer there); the ROS 2 node tests over loopback likewise.
+#: cad_reference and phantom_pin.report.derivation); the ROS 2 node tests over loopback run one
+#: at a time.
 GROUPS = {
     "test_identification_general.py::": "identification_general",
     "test_identification_prior.py::": "lab_log",
@@ -113,15 +111,34 @@ GROUPS = {
     "test_codegen.py::": "codegen",
     "test_cad_model.py::": "cad_model",
     "test_derivation.py::": "derivation",
-    "test_viewer.py::": "meshcat",
-    "test_meshcat_server.py::": "meshcat",
-    "test_cli.py::test_show_": "meshcat",
-    "test_gimbal.py::test_the_viewer_": "meshcat",
-    "test_touch.py::test_the_command_line_serves_the_touch": "meshcat",
-    "test_examples.py::test_visualize_": "meshcat",
-    "test_examples.py::test_existing_output_is_kept_without_force[visualize.py]": "meshcat",
     "test_ros2.py::test_the_node_": "ros2",
 }
+
+#: Tests that start a meshcat server (a share of the lock below), and those that check that a
+#: server's URL is dead once it stopped (the whole lock): meshcat takes the first free port
+#: from 7000, so a server another worker started meanwhile would answer there.
+MESHCAT_SERVERS = ("test_viewer.py::", "test_meshcat_server.py::", "test_cli.py::test_show_html_",
+                   "test_gimbal.py::test_the_viewer_", "test_touch.py::test_the_command_line_serves_the_touch",
+                   "test_examples.py::test_visualize_", "test_examples.py::test_existing_output_is_kept_without_force")
+MESHCAT_URL_CHECKS = ("test_cli.py::test_show_serves_", "test_cli.py::test_show_stops_")
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> object:
+    """Under xdist, a lock file the workers share, held over a test's setup, call and teardown
+    (module fixtures' servers included): MESHCAT_SERVERS share it, MESHCAT_URL_CHECKS hold it
+    alone (no other worker's server starts during them)."""
+    exclusive = any(key in item.nodeid for key in MESHCAT_URL_CHECKS)
+    if not os.environ.get("PYTEST_XDIST_WORKER") or not (
+            exclusive or any(key in item.nodeid for key in MESHCAT_SERVERS)):
+        return (yield)
+    import fcntl
+
+    # the run's temporary root, shared by its workers (each has its own basetemp below it)
+    path = item.config._tmp_path_factory.getbasetemp().parent / "meshcat-ports.lock"  # type: ignore[attr-defined]
+    with open(path, "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+        return (yield)
 
 
 def group(nodeid: str) -> str | None:
