@@ -23,11 +23,13 @@ rotor inertia J_mot Eta_i^2 is added on the diagonal, as mahilab's step_dynamics
 
     mass_matrix(theta) -> (3, 3) kg m^2,  gravity(theta) -> (3,) N m (dV/dtheta)
 
-both lambdified once, at import. ``python tests/cad_reference.py`` runs the self-check
+both lambdified once, on first use. ``python tests/cad_reference.py`` runs the self-check
 against a purely numeric model of the links in our YAML (see ``_self_check``).
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 import sympy as sp
@@ -98,21 +100,24 @@ def _lagrangian() -> tuple[sp.Matrix, sp.Matrix]:
     return m, n
 
 
-_M, _N = _lagrangian()
-_mass = sp.lambdify(_Q, _M, modules="numpy", cse=True)
-_gravity = sp.lambdify(_Q, _N, modules="numpy", cse=True)
+@functools.cache
+def _lambdified() -> tuple:
+    """(mass matrix, gravity) as NumPy functions of q1..q3, derived on the first call (a second
+    of SymPy that a test process importing this module without using it does not pay)."""
+    m, n = _lagrangian()
+    return sp.lambdify(_Q, m, modules="numpy", cse=True), sp.lambdify(_Q, n, modules="numpy", cse=True)
 
 
 def mass_matrix(theta) -> np.ndarray:
     """Joint-space mass matrix (kg m^2) at theta = (theta1, theta2, theta3) (rad), rotors included."""
     t = np.asarray(theta, dtype=float).reshape(3)
-    return np.array(_mass(*t), dtype=float).reshape(3, 3)
+    return np.array(_lambdified()[0](*t), dtype=float).reshape(3, 3)
 
 
 def gravity(theta) -> np.ndarray:
     """Gravity torque dV/dtheta (N m) at theta (rad)."""
     t = np.asarray(theta, dtype=float).reshape(3)
-    return np.array(_gravity(*t), dtype=float).reshape(3)
+    return np.array(_lambdified()[1](*t), dtype=float).reshape(3)
 
 
 # --- self-check (run: python tests/cad_reference.py) ------------------------------------------

@@ -1,11 +1,24 @@
-"""Shared fixtures (one Phantom, seeded random states inside the joint limits) and the pytest
-markers of the Debian packages some tests need. What tests import lives in helpers.py."""
+"""Shared fixtures (one Phantom, seeded random states inside the joint limits, the command line
+run in-process), the pytest markers of the Debian packages some tests need, and the groups the
+xdist workers keep together. What tests import lives in helpers.py."""
 
+import os
 import shutil
 import subprocess
+from collections.abc import Callable
 
-import numpy as np
 import pytest
+
+# One BLAS thread in the test processes and the scripts they start, set before NumPy loads
+# OpenBLAS: the identification's SVDs and least squares on tall (3N, P) matrices took 3 to 5
+# times the CPU with OpenBLAS's threads on a 2-core machine (an `identify` of a 20 s log: 5.8 s
+# of CPU against 1.1 s), and with the xdist workers filling the cores a script's threads could
+# take minutes (`check -n 2e7` took 64 s to answer Ctrl-C). The setting the suite found ("" for
+# none) is kept beside it for machine_environment; the xdist workers inherit both.
+os.environ.setdefault("PHANTOM_PIN_TESTS_OPENBLAS_NUM_THREADS", os.environ.get("OPENBLAS_NUM_THREADS", ""))
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # after the setting above
 
 from helpers import CONFIG, N_STATES
 from phantom_pin import Phantom
@@ -21,6 +34,31 @@ def phantom() -> Phantom:
 def limits() -> tuple[np.ndarray, np.ndarray]:
     p = CONFIG.limits
     return np.array(p.lower), np.array(p.upper)
+
+
+@pytest.fixture(scope="session")
+def machine_environment() -> dict[str, str]:
+    """The environment with OpenBLAS's threads as the suite found them (the machine's default
+    unless OPENBLAS_NUM_THREADS was set): for a script whose printed figures the docs quote (the
+    fit of examples/identify_simulated.py differs in its last digits with OpenBLAS's threads)."""
+    environment = {k: v for k, v in os.environ.items() if k != "PHANTOM_PIN_TESTS_OPENBLAS_NUM_THREADS"}
+    environment["OPENBLAS_NUM_THREADS"] = os.environ["PHANTOM_PIN_TESTS_OPENBLAS_NUM_THREADS"]
+    if not environment["OPENBLAS_NUM_THREADS"]:
+        del environment["OPENBLAS_NUM_THREADS"]
+    return environment
+
+
+@pytest.fixture()
+def cli(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str, str]]:
+    """phantom-pin in this process: ``cli(*arguments)`` (each passed as str) runs the command
+    line's main() and gives (exit code, stdout, stderr)."""
+    from phantom_pin.cli import main
+
+    def run(*arguments: object) -> tuple[int, str, str]:
+        code = main([str(a) for a in arguments])
+        out, err = capsys.readouterr()
+        return code, out, err
+    return run
 
 
 @pytest.fixture()
@@ -54,3 +92,74 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
             present, missing = REQUIREMENTS[marker.name]
             if not present():
                 pytest.fail(missing, pytrace=False)
+
+
+
+#: Tests kept on one pytest-xdist worker, in the order collected (pyproject's addopts: -n auto
+#: --dist loadgroup; every other test is handed out one by one): a group name for each test
+#: whose node id contains the key. A module whose module-scoped fixture (or a cache of its
+#: helpers, shared with another module) is expensive computes it once, not once per worker
+#: (test_codegen: its headers, generated once per arguments; the SymPy derivations of
+#: cad_reference and phantom_pin.report.derivation); the ROS 2 node tests over loopback run one
+#: at a time.
+GROUPS = {
+    "test_identification_general.py::": "identification_general",
+    "test_identification_prior.py::": "lab_log",
+    "test_identification_delay.py::": "lab_log",
+    "test_identification_end_to_end.py::": "identification_end_to_end",
+    "test_gazebo.py::": "gazebo",
+    "test_codegen.py::": "codegen",
+    "test_cad_model.py::": "cad_model",
+    "test_derivation.py::": "derivation",
+    "test_ros2.py::test_the_node_": "ros2",
+    "test_drivers_ros2.py::test_the_stylus_floats": "ros2",
+    "test_drivers_ros2.py::test_without_the_node": "ros2",
+}
+
+#: Tests that start a meshcat server (a share of the lock below), and those that check that a
+#: server's URL is dead once it stopped (the whole lock): meshcat takes the first free port
+#: from 7000, so a server another worker started meanwhile would answer there.
+MESHCAT_SERVERS = ("test_viewer.py::", "test_meshcat_server.py::", "test_cli.py::test_show_html_",
+                   "test_gimbal.py::test_the_viewer_", "test_touch.py::test_the_command_line_serves_the_touch",
+                   "test_examples.py::test_visualize_", "test_examples.py::test_existing_output_is_kept_without_force")
+MESHCAT_URL_CHECKS = ("test_cli.py::test_show_serves_", "test_cli.py::test_show_stops_")
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> object:
+    """Under xdist, a lock file the workers share, held over a test's setup, call and teardown
+    (module fixtures' servers included): MESHCAT_SERVERS share it, MESHCAT_URL_CHECKS hold it
+    alone (no other worker's server starts during them)."""
+    exclusive = any(key in item.nodeid for key in MESHCAT_URL_CHECKS)
+    if not os.environ.get("PYTEST_XDIST_WORKER") or not (
+            exclusive or any(key in item.nodeid for key in MESHCAT_SERVERS)):
+        return (yield)
+    import fcntl
+
+    # the run's temporary root, shared by its workers (each has its own basetemp below it)
+    path = item.config._tmp_path_factory.getbasetemp().parent / "meshcat-ports.lock"  # type: ignore[attr-defined]
+    with open(path, "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+        return (yield)
+
+
+def group(nodeid: str) -> str | None:
+    """The GROUPS name of a test's node id, or None."""
+    return next((name for key, name in GROUPS.items() if key in nodeid), None)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
+    """--dist loadgroup with GROUPS (pytest-xdist's own marks no longer reach the node ids under
+    pytest 9): each group is one unit of work, the largest handed out first; every other test
+    is its own."""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadScopeScheduling
+
+    class GroupScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return group(nodeid) or nodeid
+
+    config.option.loadscopereorder = True
+    return GroupScheduling(config, log)

@@ -19,37 +19,30 @@ import pytest
 from helpers import CONFIG, RAISED, REPORT, dark, frame_pose, patch, render
 from phantom_pin import closed_form as cf
 from phantom_pin import describe
-from phantom_pin.cli import main
 from phantom_pin.config import MODELS
 from phantom_pin.config.sampling import random_states
 
 CONFIG_DIR, URDF_PATH = MODELS["premium_1_5"].config, MODELS["premium_1_5"].urdf
 
 
-def run(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def test_check_passes_and_reports_every_method(capsys):
-    code, out, _ = run(capsys, "check", "-n", "200", "--json")
+def test_check_passes_and_reports_every_method(cli):
+    code, out, _ = cli("check", "-n", "200", "--json")
     report = json.loads(out)
     assert code == 0 and report["passed"] and len(report["checks"]) == 8
 
 
-def test_fk_and_ik_agree_with_the_closed_form(capsys):
+def test_fk_and_ik_agree_with_the_closed_form(cli):
     theta = [0.2, 0.3, 0.4]
-    code, out, _ = run(capsys, "fk", *map(str, theta), "--json")
+    code, out, _ = cli("fk", *map(str, theta), "--json")
     assert code == 0
     np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics(theta, REPORT), atol=1e-12)
     position = cf.forward_kinematics(theta, REPORT)[:3, 3]
-    code, out, _ = run(capsys, "ik", *(str(float(x)) for x in position), "--json")
+    code, out, _ = cli("ik", *(str(float(x)) for x in position), "--json")
     np.testing.assert_allclose(json.loads(out)["theta"], theta, atol=1e-9)
 
 
-def test_dynamics_agrees_with_the_closed_form(capsys):
-    code, out, _ = run(capsys, "dynamics", "--theta", "0.1", "0.2", "0.3", "--dtheta", "1", "2", "3",
+def test_dynamics_agrees_with_the_closed_form(cli):
+    code, out, _ = cli("dynamics", "--theta", "0.1", "0.2", "0.3", "--dtheta", "1", "2", "3",
                        "--ddtheta", "0", "1", "0", "--json")
     data = json.loads(out)
     np.testing.assert_allclose(data["tau"], cf.inverse_dynamics([0.1, 0.2, 0.3], [1, 2, 3], [0, 1, 0], REPORT),
@@ -57,8 +50,8 @@ def test_dynamics_agrees_with_the_closed_form(capsys):
     np.testing.assert_allclose(data["M"], cf.mass_matrix([0.1, 0.2, 0.3], REPORT), rtol=1e-9)
 
 
-def test_info_lists_the_report_masses(capsys):
-    code, out, _ = run(capsys, "info", "--json")
+def test_info_lists_the_report_masses(cli):
+    code, out, _ = cli("info", "--json")
     masses = {link["name"]: link["mass"] for link in json.loads(out)["links"]}
     # each hinge pin's mass is taken from its neighbour: together they are the report's segment
     masses["crank_link"] += masses.pop("crank_pin_link")
@@ -74,12 +67,12 @@ def test_info_lists_the_report_masses(capsys):
     (["check", "-n", "0"], "-n"),
     (["bogus"], "invalid choice"),
 ])
-def test_bad_arguments_give_one_line_and_exit_code_2(capsys, argv, message):
-    code, _, err = run(capsys, *argv)
+def test_bad_arguments_give_one_line_and_exit_code_2(cli, argv, message):
+    code, _, err = cli(*argv)
     assert code == 2 and message in err and err.count("\n") == 1
 
 
-def test_coupled_stops_without_a_posture_exit_2_and_write_nothing(tmp_path, capsys):
+def test_coupled_stops_without_a_posture_exit_2_and_write_nothing(tmp_path, cli):
     """`check` looped for ever on them; the MJCF was written with an inverted tendon range."""
     config = tmp_path / "config"
     shutil.copytree(CONFIG_DIR, config)
@@ -87,30 +80,30 @@ def test_coupled_stops_without_a_posture_exit_2_and_write_nothing(tmp_path, caps
     limits.write_text(limits.read_text().replace("theta2_minus_theta3_max: 1.1344640137963142",
                                                  "theta2_minus_theta3_max: -1.0"))
     for argv in (["check", "-n", "10"], ["mjcf", "-o", str(tmp_path / "phantom.xml")]):
-        code, _, err = run(capsys, "--config", str(config), *argv)
+        code, _, err = cli("--config", str(config), *argv)
         assert code == 2 and "stops.theta2_minus_theta3_max" in err and err.count("\n") == 1
-    code, _, err = run(capsys, "mjcf", "-o", str(tmp_path / "phantom.xml"),
+    code, _, err = cli("mjcf", "-o", str(tmp_path / "phantom.xml"),
                        "--set", "stops.theta3_minus_theta2_max=-1.2")
     assert code == 2 and "after the overrides" in err and err.count("\n") == 1
     assert not (tmp_path / "phantom.xml").exists()
 
 
-def test_urdf_refuses_to_overwrite_without_force(tmp_path, capsys):
+def test_urdf_refuses_to_overwrite_without_force(tmp_path, cli):
     target = tmp_path / "phantom.urdf"
-    assert run(capsys, "urdf", "--output", str(target))[0] == 0
+    assert cli("urdf", "--output", str(target))[0] == 0
     assert target.read_text() == URDF_PATH.read_text()
     target.write_text("keep me")
-    code, _, err = run(capsys, "urdf", "--output", str(target))
+    code, _, err = cli("urdf", "--output", str(target))
     assert code == 2 and "--force" in err and target.read_text() == "keep me"
-    assert run(capsys, "urdf", "--output", str(target), "--force", "--prefix", "r_")[0] == 0
+    assert cli("urdf", "--output", str(target), "--force", "--prefix", "r_")[0] == 0
     assert 'name="r_joint1"' in target.read_text()
 
 
-def test_urdf_overrides_reach_kinematics_dynamics_and_mimic_tags(tmp_path, capsys):
+def test_urdf_overrides_reach_kinematics_dynamics_and_mimic_tags(tmp_path, cli):
     params = tmp_path / "params.yaml"
     params.write_text("segment_a: {mass: 0.03}\nsegment_be.inertia.xx: 12.0e-4\n")
     target = tmp_path / "phantom.urdf"
-    code, _, _ = run(capsys, "urdf", "-o", str(target), "--params", str(params), "--set", "l1=0.2096")
+    code, _, _ = cli("urdf", "-o", str(target), "--params", str(params), "--set", "l1=0.2096")
     assert code == 0
     model = pin.buildModelFromUrdf(str(target), mimic=True)
     expected = dataclasses.replace(REPORT, l1=0.2096, ma=0.03, Ibexx=12.0e-4)
@@ -127,16 +120,16 @@ def test_urdf_overrides_reach_kinematics_dynamics_and_mimic_tags(tmp_path, capsy
     assert target.read_text().count("<mimic ") == 4
 
 
-def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, capsys):
+def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, cli):
     """The SRDF carries the rotor inertia; the whole configuration is checked, so 2e-6 kg m^2
     (which leaves upper_arm_link's inertia non-physical) writes no SRDF either."""
     target = tmp_path / "phantom.srdf"
-    assert run(capsys, "srdf", "-o", str(target), "--set", "actuation.motor.rotor_inertia=1.1e-6")[0] == 0
+    assert cli("srdf", "-o", str(target), "--set", "actuation.motor.rotor_inertia=1.1e-6")[0] == 0
     model = pin.buildModelFromUrdf(str(URDF_PATH), mimic=True)
     pin.loadRotorParameters(model, str(target), False)
     np.testing.assert_allclose(model.armature, [1.1e-6 * r**2 for r in CONFIG.actuation.ratios],
                                rtol=1e-12)
-    code, _, err = run(capsys, "srdf", "-o", str(tmp_path / "bad.srdf"), "--set", "actuation.motor.rotor_inertia=2e-6")
+    code, _, err = cli("srdf", "-o", str(tmp_path / "bad.srdf"), "--set", "actuation.motor.rotor_inertia=2e-6")
     assert code == 2 and "upper_arm_link" in err and not (tmp_path / "bad.srdf").exists()
 
 
@@ -149,14 +142,14 @@ def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, capsy
     (["--set", "l1=-0.1"], "l1 must be positive"),
     (["--params", "/nonexistent/params.yaml"], "--params"),
 ])
-def test_bad_overrides_give_one_line_and_exit_code_2(tmp_path, capsys, argv, message):
+def test_bad_overrides_give_one_line_and_exit_code_2(tmp_path, cli, argv, message):
     target = tmp_path / "phantom.urdf"
-    code, _, err = run(capsys, "urdf", "-o", str(target), *argv)
+    code, _, err = cli("urdf", "-o", str(target), *argv)
     assert code == 2 and message in err and err.count("\n") == 1 and not target.exists()
 
 
 @pytest.mark.chromium
-def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, capsys):
+def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, cli):
     """--config with l1 = 0.25: the tip ball is drawn where that model (not the
     shipped one) puts it; an existing file is kept without --force."""
     config = tmp_path / "config"
@@ -165,13 +158,13 @@ def test_show_html_puts_the_tip_where_the_overridden_kinematics_say(tmp_path, ca
     kinematics.write_text(kinematics.read_text().replace("l1: 0.215 ", "l1: 0.25 "))
     html = tmp_path / "scene.html"
     argv = ["--config", str(config), "show", "--html", str(html), "--theta", *map(str, RAISED)]
-    assert run(capsys, *argv)[0] == 0
+    assert cli(*argv)[0] == 0
     image = render(html, tmp_path / "scene.png")
     tips = [frame_pose(pin.buildModelFromXML(urdf, mimic=True), RAISED, "tip").translation
             for urdf in (describe(config).urdf, URDF_PATH.read_text())]
     assert np.linalg.norm(tips[0] - tips[1]) > 0.03
     assert dark(patch(image, tips[0])) and not dark(patch(image, tips[1]))
-    code, _, err = run(capsys, *argv)
+    code, _, err = cli(*argv)
     assert code == 2 and "--force" in err
 
 
@@ -238,20 +231,20 @@ def _config(tmp_path, file, old, new):
     return config
 
 
-def test_check_of_a_custom_configuration_passes_and_skips_the_appendix(tmp_path, capsys):
+def test_check_of_a_custom_configuration_passes_and_skips_the_appendix(tmp_path, cli):
     """The README's example l1 = 0.2096: Phantom vs closed form with the same parameters
     passes; the appendix's torques are not the numbers of this arm, so their row is n/a."""
     config = _config(tmp_path, "kinematics.yaml", "l1: 0.215 ", "l1: 0.2096 ")
-    code, out, _ = run(capsys, "--config", str(config), "check", "-n", "300", "--json")
+    code, out, _ = cli("--config", str(config), "check", "-n", "300", "--json")
     report = json.loads(out)
     assert code == 0 and report["passed"] and len(report["checks"]) == 8
     assert report["checks"][-1]["max_error"] is None
     assert all(row["max_error"] < 1e-9 for row in report["checks"][:-1])
-    code, out, _ = run(capsys, "--config", str(config), "check", "-n", "30")
+    code, out, _ = cli("--config", str(config), "check", "-n", "30")
     assert code == 0 and "n/a" in out and "all checks pass" in out
 
 
-def test_check_draws_and_evaluates_in_chunks(monkeypatch, capsys):
+def test_check_draws_and_evaluates_in_chunks(monkeypatch, cli):
     """250 states in chunks of 7: 35 chunks of 7 and one of 5, every check passes."""
     sizes = []
 
@@ -260,7 +253,7 @@ def test_check_draws_and_evaluates_in_chunks(monkeypatch, capsys):
         return random_states(limits, n, seed)
     monkeypatch.setattr("phantom_pin.verification.CHUNK", 7)
     monkeypatch.setattr("phantom_pin.verification.random_states", spy)
-    report = json.loads(run(capsys, "check", "-n", "250", "--json")[1])
+    report = json.loads(cli("check", "-n", "250", "--json")[1])
     assert sizes == [7] * 35 + [5] and report["passed"] and report["states"] == 250
 
 
@@ -273,8 +266,8 @@ def test_check_draws_and_evaluates_in_chunks(monkeypatch, capsys):
     (["check", "-n", "1.5"], "-n: expected a positive whole number"),
     (["ik", "0", "0.17", "0.17", "--branch", "left"], "invalid choice"),
 ])
-def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, capsys, argv, message):
-    code, out, err = run(capsys, *(a.format(tmp=tmp_path) for a in argv))
+def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, cli, argv, message):
+    code, out, err = cli(*(a.format(tmp=tmp_path) for a in argv))
     assert code == 2 and message in err and err.count("\n") == 1 and out == ""
 
 
@@ -285,26 +278,26 @@ def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, capsys, argv
     ("actuation.yaml", "motor:", "motor: [", "not valid YAML at line"),
     ("physical_parameters.yaml", "segment_a:", "segment_a: {", "not valid YAML at line"),
 ])
-def test_bad_configuration_gives_one_line_naming_the_file(tmp_path, capsys, file, old, new, message):
+def test_bad_configuration_gives_one_line_naming_the_file(tmp_path, cli, file, old, new, message):
     config = _config(tmp_path, file, old, new)
     for argv in (["check", "-n", "10"], ["urdf", "-o", str(tmp_path / "x.urdf")]):
-        code, _, err = run(capsys, "--config", str(config), *argv)
+        code, _, err = cli("--config", str(config), *argv)
         assert code == 2 and message in err and file in err and err.count("\n") == 1
     assert not (tmp_path / "x.urdf").exists()
 
 
-def test_binary_params_file_is_named(tmp_path, capsys):
+def test_binary_params_file_is_named(tmp_path, cli):
     params = tmp_path / "params.yaml"
     params.write_bytes(bytes(range(128, 256)))
-    code, _, err = run(capsys, "urdf", "-o", str(tmp_path / "x.urdf"), "--params", str(params))
+    code, _, err = cli("urdf", "-o", str(tmp_path / "x.urdf"), "--params", str(params))
     assert code == 2 and "params.yaml: not a text file" in err and err.count("\n") == 1
 
 
-def test_negative_numbers_in_scientific_notation_are_values(capsys):
-    code, out, _ = run(capsys, "fk", "-1e-3", "0", "0", "--json")
+def test_negative_numbers_in_scientific_notation_are_values(cli):
+    code, out, _ = cli("fk", "-1e-3", "0", "0", "--json")
     assert code == 0
     np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics([-1e-3, 0, 0], REPORT), atol=1e-12)
-    code, out, _ = run(capsys, "dynamics", "--theta", "-1e-3", "0.1", "0.2", "--dtheta", "-2E+0", "0", "-.5",
+    code, out, _ = cli("dynamics", "--theta", "-1e-3", "0.1", "0.2", "--dtheta", "-2E+0", "0", "-.5",
                        "--json")
     assert code == 0
     np.testing.assert_allclose(json.loads(out)["tau"], cf.inverse_dynamics([-1e-3, 0.1, 0.2], [-2, 0, -0.5],
@@ -319,8 +312,8 @@ def test_negative_numbers_in_scientific_notation_are_values(capsys):
     (["fk", "1.5707963267948966", "2.076941809873252", "3.036872898470133"], None),  # on the limits: inside
     (["ik", "0", "0.12", "0.05"], None),
 ])
-def test_out_of_limit_angles_are_computed_with_one_warning_line(capsys, argv, warned):
-    code, out, err = run(capsys, *argv)
+def test_out_of_limit_angles_are_computed_with_one_warning_line(cli, argv, warned):
+    code, out, err = cli(*argv)
     assert code == 0 and out
     if warned is None:
         assert err == ""
@@ -369,50 +362,50 @@ def test_huge_check_runs_in_bounded_memory_and_ctrl_c_gives_one_line():
     assert process.stderr.read() == "phantom-pin: interrupted\n"
 
 
-def test_mjcf_scene_includes_the_model_from_its_own_folder(tmp_path, capsys, monkeypatch):
+def test_mjcf_scene_includes_the_model_from_its_own_folder(tmp_path, cli, monkeypatch):
     """-o sub/m.xml --scene s.xml: the scene includes sub/m.xml, and MuJoCo loads it; the scene
     may not be the model's own file."""
     import mujoco
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "sub").mkdir()
-    code, _, _ = run(capsys, "mjcf", "-o", "sub/m.xml", "--scene", "s.xml")
+    code, _, _ = cli("mjcf", "-o", "sub/m.xml", "--scene", "s.xml")
     assert code == 0 and '<include file="sub/m.xml"' in (tmp_path / "s.xml").read_text()
     assert mujoco.MjModel.from_xml_path(str(tmp_path / "s.xml")).njnt == 7
-    code, _, err = run(capsys, "mjcf", "-o", "m.xml", "--scene", "m.xml")
+    code, _, err = cli("mjcf", "-o", "m.xml", "--scene", "m.xml")
     assert code == 2 and err.count("\n") == 1 and "--scene: m.xml is the --output file" in err
     assert not (tmp_path / "m.xml").exists()
 
 
-def test_info_aligns_every_link_name(capsys):
-    code, out, _ = run(capsys, "info")
+def test_info_aligns_every_link_name(cli):
+    code, out, _ = cli("info")
     rows = [line for line in out.splitlines() if line.split(" ")[0].endswith("_link") and "[" in line]
     assert code == 0 and len(rows) == 7 and len({row.index("[") for row in rows}) == 1
 
 
-def test_check_refuses_more_states_than_a_few_minutes_take(capsys):
-    code, out, err = run(capsys, "check", "-n", "100000000000")
+def test_check_refuses_more_states_than_a_few_minutes_take(cli):
+    code, out, err = cli("check", "-n", "100000000000")
     assert code == 2 and out == "" and err == ("phantom-pin: error: -n: 100000000000 states is more than 2e+07 "
                                                "(about 4 minutes); check fewer\n")
 
 
-def test_every_command_takes_the_overrides(capsys, tmp_path):
+def test_every_command_takes_the_overrides(cli, tmp_path):
     """--set and --params reach every command's model: fk with l1, l2 changed follows eq. 10
     with them (written here); info reports the changed mass; check passes on the changed model."""
     params = tmp_path / "p.yaml"
     params.write_text("l1: 0.2\nsegment_a.mass: 0.03\n")
-    code, out, _ = run(capsys, "fk", "0.3", "0.5", "0.7", "--params", str(params), "--set", "l2=0.15", "--json")
+    code, out, _ = cli("fk", "0.3", "0.5", "0.7", "--params", str(params), "--set", "l2=0.15", "--json")
     tip = np.array(json.loads(out)["g_st"])[:3, 3]
     l1, l2, (t1, t2, t3) = 0.2, 0.15, (0.3, 0.5, 0.7)
     reach = l1 * np.cos(t2) + l2 * np.sin(t3)
     np.testing.assert_allclose(tip, [np.sin(t1) * reach, l2 - l2 * np.cos(t3) + l1 * np.sin(t2),
                                      -l1 + np.cos(t1) * reach], rtol=0, atol=1e-12)
-    code, out, _ = run(capsys, "info", "--params", str(params), "--json")
+    code, out, _ = cli("info", "--params", str(params), "--json")
     masses = {link["name"]: link["mass"] for link in json.loads(out)["links"]}
     assert code == 0 and masses["forearm_link"] == pytest.approx(0.03, rel=1e-12)
-    code, out, _ = run(capsys, "check", "-n", "50", "--set", "l1=0.2")
+    code, out, _ = cli("check", "-n", "50", "--set", "l1=0.2")
     assert code == 0 and "all checks pass" in out
-    code, _, err = run(capsys, "dynamics", "--theta", "0", "0", "0", "--set", "foo=1")
+    code, _, err = cli("dynamics", "--theta", "0", "0", "0", "--set", "foo=1")
     assert code == 2 and err.count("\n") == 1 and "foo" in err
 
 

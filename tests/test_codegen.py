@@ -4,6 +4,7 @@ shipped model and on an identified-style overlay; the committed headers are fres
 is refused and nothing is written."""
 
 import ctypes
+import functools
 import shutil
 import subprocess
 
@@ -47,6 +48,17 @@ LOOP(openhaptics_torque_from_tau, phantom_openhaptics_torque_from_tau(a + 3 * k,
 """
 
 
+@functools.cache
+def _generated(name, prefix, overlay):
+    return header(name, prefix=prefix, overrides=dict(overlay) if overlay else None)
+
+
+def generated(name, prefix="phantom", overrides=None):
+    """header(name, prefix, overrides), generated once per arguments in this process (SymPy
+    takes seconds); the tests of header()'s own errors call it directly."""
+    return _generated(name, prefix, tuple(sorted((overrides or {}).items())))
+
+
 def build(text, folder):
     """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the shim as a
     shared library (-O2); returns the ctypes library. Fails in one line without gcc and g++."""
@@ -84,7 +96,7 @@ def test_every_function_matches_pinocchio(name, overlay, tmp_path):
     """Each function of the header, compiled with -Werror as C99 and C++17, equals Phantom's
     (Pinocchio's) to 1e-12 relative per state over 1000 seeded states inside the stops."""
     description = describe(name, overrides=overlay) if overlay else describe(name)
-    library = build(header(name, overrides=overlay), tmp_path)
+    library = build(generated(name, overrides=overlay), tmp_path)
     phantom = Phantom(description)
     theta, dtheta, ddtheta = random_states(description.config.limits, N_STATES, seed=30)
     force = np.random.default_rng(31).normal(0, 2, (N_STATES, 3))
@@ -119,7 +131,7 @@ def test_openhaptics_helpers_follow_the_published_conventions(tmp_path):
     sample gives HD_CURRENT_JOINT_TORQUE in mN m on OpenHaptics' own angles, so it does tau's
     power on their rates (1e-9 relative) and equals 1000 (-tau1, tau2, tau3) exactly; a spring
     restoring theta is the sample's restoring spring, torque = k (0 - a) with k > 0."""
-    library = build(header("touch"), tmp_path)
+    library = build(generated("touch"), tmp_path)
     rng = np.random.default_rng(5)
     angles = rng.uniform([-0.98, 0.0, 0.0], [0.98, 1.75, 2.0], (50, 3))   # inside the Touch's stops
     theta = call(library, "theta_from_openhaptics", 3, angles)
@@ -142,7 +154,7 @@ def test_openhaptics_helpers_follow_the_published_conventions(tmp_path):
 @pytest.mark.parametrize("name", models())
 def test_committed_headers_are_fresh(name):
     """Each shipped model's committed header is what its configuration generates now."""
-    assert committed_header(name).read_text() == header(name), \
+    assert committed_header(name).read_text() == generated(name), \
         f"{name}: run phantom-pin codegen --model {name} -o {committed_header(name)} --force"
 
 
@@ -185,10 +197,10 @@ def test_cli_writes_the_header_and_refuses_bad_input(tmp_path, capsys):
     line naming the option, exit 2, and no file."""
     out = tmp_path / "arm.h"
     assert main(["codegen", "--model", "touch", "--prefix", "arm", "-o", str(out)]) == 0
-    assert out.read_text() == header("touch", prefix="arm")
+    assert out.read_text() == generated("touch", prefix="arm")
     assert main(["codegen", "--model", "touch", "-o", str(out)]) == 2
     assert "--force" in capsys.readouterr().err
-    assert out.read_text() == header("touch", prefix="arm")
+    assert out.read_text() == generated("touch", prefix="arm")
     bad = tmp_path / "bad.h"
     assert main(["codegen", "--model", "touch", "--prefix", "9lives", "-o", str(bad)]) == 2
     err = capsys.readouterr().err
@@ -253,7 +265,7 @@ def test_a_missing_config_folder_is_blamed_on_config(tmp_path, capsys):
 def test_an_overlays_banner_is_wrapped_into_short_comment_lines():
     """L10: identify's overlay sets dozens of keys; the banner lists each, in lines of at most
     100 characters (it was one line of 3,400), and the header still compiles (-Werror)."""
-    text = header("premium_1_5_cad", overrides=OVERLAY)
+    text = generated("premium_1_5_cad", overrides=OVERLAY)
     overlay = text.split(" * Overlay: ")[1].split(" * Gravity:")[0].splitlines()
     assert len(overlay) > 1 and max(len(line) for line in overlay) <= 100
     flat = " ".join(line.strip(" *") for line in overlay)

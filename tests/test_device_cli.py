@@ -14,15 +14,9 @@ from phantom_pin.cli import main
 START = ["0.3", "0.8", "0.4"]
 
 
-def run(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def test_simulate_json_is_the_python_result(tmp_path, capsys):
+def test_simulate_json_is_the_python_result(tmp_path, cli):
     target = tmp_path / "run.json"
-    code, out, _ = run(capsys, "simulate", "--theta0", *START, "--dtheta0", "0", "1", "0", "--duration", "0.05",
+    code, out, _ = cli("simulate", "--theta0", *START, "--dtheta0", "0", "1", "0", "--duration", "0.05",
                        "--rate", "500", "--quantization", "-o", str(target))
     assert code == 0 and "26 samples" in out
     data = json.loads(target.read_text())
@@ -33,8 +27,8 @@ def test_simulate_json_is_the_python_result(tmp_path, capsys):
     assert data["settings"]["saturation"] == "continuous"        # the policy applied (before: null)
 
 
-def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(capsys):
-    code, out, _ = run(capsys, "simulate", "--theta0", *START, "--duration", "0.02", "--controller", "gravity",
+def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(cli):
+    code, out, _ = cli("simulate", "--theta0", *START, "--duration", "0.02", "--controller", "gravity",
                        "--format", "csv")
     rows = list(csv.reader(out.splitlines()))
     assert code == 0 and rows[0][:4] == ["t [s]", "theta1 [rad]", "theta2 [rad]", "theta3 [rad]"] and len(rows) == 22
@@ -45,14 +39,14 @@ def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(capsys):
     assert rows[0][-3:] == ["tip_x [m]", "tip_y [m]", "tip_z [m]"]
 
 
-def test_simulate_keeps_files_and_writes_nothing_on_failure(tmp_path, capsys):
+def test_simulate_keeps_files_and_writes_nothing_on_failure(tmp_path, cli):
     target = tmp_path / "run.csv"
-    code, _, err = run(capsys, "simulate", "--theta0", *START, "--duration", "-1", "-o", str(target))
+    code, _, err = cli("simulate", "--theta0", *START, "--duration", "-1", "-o", str(target))
     assert code == 2 and "duration" in err and err.count("\n") == 1 and not target.exists()
     target.write_text("keep")
-    code, _, err = run(capsys, "simulate", "--theta0", *START, "--duration", "0.01", "-o", str(target))
+    code, _, err = cli("simulate", "--theta0", *START, "--duration", "0.01", "-o", str(target))
     assert code == 2 and "--force" in err and target.read_text() == "keep"
-    code, _, _ = run(capsys, "simulate", "--theta0", *START, "--duration", "0.01", "-o", str(target), "--force",
+    code, _, _ = cli("simulate", "--theta0", *START, "--duration", "0.01", "-o", str(target), "--force",
                      "--format", "csv", "--no-friction", "--no-hard-stops", "--no-saturation")
     assert code == 0 and target.read_text().startswith("t [s],")
 
@@ -71,20 +65,20 @@ def test_simulate_keeps_files_and_writes_nothing_on_failure(tmp_path, capsys):
     (["--trajectory", "t.csv", "--rate", "500"], "error: --rate: --trajectory sets it"),
     (["--trajectory", "t.csv", "--dtheta0", "0", "0", "0"], "error: --dtheta0: --trajectory sets it"),
 ])
-def test_simulate_bad_arguments_give_one_line_and_exit_code_2(capsys, argv, message):
-    code, _, err = run(capsys, "simulate", *argv)
+def test_simulate_bad_arguments_give_one_line_and_exit_code_2(cli, argv, message):
+    code, _, err = cli("simulate", *argv)
     assert code == 2 and message in err and err.count("\n") == 1
 
 
-def test_info_lists_the_device_data_with_sources(capsys):
-    code, out, _ = run(capsys, "info", "--json")
+def test_info_lists_the_device_data_with_sources(cli):
+    code, out, _ = cli("info", "--json")
     device = json.loads(out)["device"]
     assert code == 0 and set(device) == {"stops", "friction", "motor", "encoder", "transmission_ratio"}
     assert all(section["source"] for section in device.values())
     assert device["motor"]["stall_torque"] == 0.129 and device["motor"]["torque_constant"] == 0.0234
     np.testing.assert_allclose(device["encoder"]["resolution"], 2 * np.pi / (4096 * np.array([13.3, 11.6, 11.6])))
     np.testing.assert_allclose(device["stops"]["upper"], np.radians([90, 119, 214]))
-    code, out, _ = run(capsys, "info")
+    code, out, _ = cli("info")
     assert "theta3 - theta2 <= 55.0" in out and "118743" in out and "HEDM-5500" in out
 
 
@@ -129,30 +123,30 @@ def _trajectory(path, degrees=(), milliseconds=False, openhaptics=False):
     ({"degrees": ("dtheta",)}, "the rate of change of theta is 0.01745 times dtheta"),
     ({"degrees": ("theta", "dtheta", "ddtheta")}, "--trajectory: TRAJ: its first state: "),
 ])
-def test_simulate_names_the_trajectory_file_for_its_unit_slips(tmp_path, capsys, slip, message):
+def test_simulate_names_the_trajectory_file_for_its_unit_slips(tmp_path, cli, slip, message):
     """Before: a trajectory in degrees was blamed on --theta0 (not given), one in ms on --duration."""
     traj = _trajectory(tmp_path / "traj.csv", **slip)
-    code, out, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(tmp_path / "log.csv"))
+    code, out, err = cli("simulate", "--trajectory", str(traj), "-o", str(tmp_path / "log.csv"))
     assert code == 2 and out == "" and err.count("\n") == 1 and message.replace("TRAJ", str(traj)) in err, err
     assert not (tmp_path / "log.csv").exists()
 
 
 def test_simulate_tracks_a_consistent_trajectory_and_warns_when_openhaptics_is_read_as_the_report(tmp_path,
-                                                                                                  capsys):
+                                                                                                  cli):
     """The same trajectory in the report's units tracks without a warning; in OpenHaptics' mN m
     read as N m (no --convention) nearly every command saturates: a warning line that says so,
     its share equal to the clipped samples of the written log (tau differs from tau_commanded)."""
     traj, log = _trajectory(tmp_path / "traj.csv"), tmp_path / "log.csv"
-    code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log))
+    code, _, err = cli("simulate", "--trajectory", str(traj), "-o", str(log))
     assert code == 0 and err == ""
     traj = _trajectory(tmp_path / "oh.csv", openhaptics=True)
-    code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log), "--force")
+    code, _, err = cli("simulate", "--trajectory", str(traj), "-o", str(log), "--force")
     data = np.loadtxt(log, delimiter=",", skiprows=1)
     share = 100 * np.mean(np.any(data[:, 7:10] != data[:, 10:13], axis=1))
     assert code == 0 and share > 50 and err == (
         f"phantom-pin: warning: {share:.1f} % of the commanded torques exceeded the saturation and were clipped "
         "(is the file in OpenHaptics' mN m? --convention openhaptics)\n")
-    code, _, err = run(capsys, "simulate", "--trajectory", str(traj), "-o", str(log), "--force",
+    code, _, err = cli("simulate", "--trajectory", str(traj), "-o", str(log), "--force",
                        "--convention", "openhaptics")
     assert code == 0 and err == ""
 
@@ -166,9 +160,9 @@ def test_simulate_tracks_a_consistent_trajectory_and_warns_when_openhaptics_is_r
      "error: the model (--model, --config, --params, --set): with at most 0 N m applied and 0 rad/s at the start, "
      "the device itself diverged"),
 ])
-def test_simulate_blames_what_is_at_fault_in_one_line(tmp_path, capsys, argv, message):
+def test_simulate_blames_what_is_at_fault_in_one_line(tmp_path, cli, argv, message):
     """Before: OverflowError tracebacks for 1e308 s; a stiff friction blamed on --rate; a
     1000 kg segment blamed on "controller or dtheta0" (both zero)."""
-    code, out, err = run(capsys, "simulate", "--theta0", "0.1", "0.3", "0.4", *argv, "-o", str(tmp_path / "r.csv"))
+    code, out, err = cli("simulate", "--theta0", "0.1", "0.3", "0.4", *argv, "-o", str(tmp_path / "r.csv"))
     assert code == 2 and out == "" and err.count("\n") == 1 and message in err, err
     assert not (tmp_path / "r.csv").exists()

@@ -10,6 +10,9 @@ from pathlib import Path
 import pytest
 from PIL import Image
 
+#: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
+pytestmark = pytest.mark.slow
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 

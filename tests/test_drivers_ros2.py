@@ -222,10 +222,8 @@ def test_without_the_node_the_stylus_falls():
     assert code == 0, err
 
 
-def test_the_node_refuses_a_profile_whose_message_type_is_missing_and_bad_options_in_one_line(capsys):
+def test_the_node_refuses_a_profile_whose_message_type_is_missing_and_bad_options_in_one_line(cli):
     """In process (the refusals come before ROS starts): one line naming the option, exit 2."""
-    from phantom_pin.cli import main
-
     cases = [(["ros2", "--driver", "nosuch"], "--driver"),
              (["ros2", "--max-force", "-1", "--driver", "sawsensablephantom"], "--max-force"),
              (["ros2", "--max-force", "nan", "--driver", "sawsensablephantom"], "--max-force"),
@@ -240,8 +238,7 @@ def test_the_node_refuses_a_profile_whose_message_type_is_missing_and_bad_option
     if "geomagic_touch_ros2" not in INSTALLED:
         cases.append((["ros2", "--driver", "geomagic_touch_ros2"], "--driver"))
     for args, option in cases:
-        assert main(["--model", "touch", *args]) == 2, args
-        err = capsys.readouterr().err
-        assert len(err.strip().splitlines()) == 1 and option in err, (args, err)
-    assert main(["ros2", "--driver", "sawsensablephantom"]) == 2     # premium_1_5: no stylus gimbal
-    assert "--model touch" in capsys.readouterr().err
+        code, _, err = cli("--model", "touch", *args)
+        assert code == 2 and len(err.strip().splitlines()) == 1 and option in err, (args, err)
+    code, _, err = cli("ros2", "--driver", "sawsensablephantom")     # premium_1_5: no stylus gimbal
+    assert code == 2 and "--model touch" in err

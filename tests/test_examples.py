@@ -17,12 +17,15 @@ from helpers import CONFIG, REPORT, dark, frame_pose, light_grey, patch, render
 from phantom_pin import Device, Phantom, load
 from phantom_pin import closed_form as cf
 
+#: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
+pytestmark = pytest.mark.slow
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
-def run(script: str, out: Path, *argv: str) -> subprocess.CompletedProcess:
+def run(script: str, out: Path, *argv: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, str(EXAMPLES / script), "--out", str(out), *argv],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, env=env)
 
 
 def number(pattern: str, text: str) -> float:

@@ -19,39 +19,33 @@ from phantom_pin.exceptions import ParameterFileError
 TOUCH = config.read("touch")
 
 
-def run(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def bounds(lower, upper):
     """The warning's "[a b c]..[d e f]" of limits (rad), as warn_limits prints them."""
     return "[" + " ".join(f"{v:.6g}" for v in lower) + "]..[" + " ".join(f"{v:.6g}" for v in upper) + "]"
 
 
-def test_show_on_the_touch_checks_the_arm_and_the_gimbal_against_their_own_ranges(tmp_path, capsys):
+def test_show_on_the_touch_checks_the_arm_and_the_gimbal_against_their_own_ranges(tmp_path, cli):
     """H1: `--model touch show --theta ... --html` failed with "operands could not be broadcast
     together with shapes (6,) (3,)" (the six-joint limits against three angles). M10: gimbal
     angles beyond the gimbal's range got no warning. The ranges are the configuration's."""
     arm, gimbal = TOUCH.limits, TOUCH.gimbal
     inside = (np.array(arm.lower) + np.array(arm.upper)) / 2
-    code, out, err = run(capsys, "--model", "touch", "show", "--theta", *map(str, inside),
+    code, out, err = cli("--model", "touch", "show", "--theta", *map(str, inside),
                          "--gimbal", "0.1", "0.2", "0.3", "--html", str(tmp_path / "in.html"))
     assert code == 0 and err == "" and out.startswith("wrote") and (tmp_path / "in.html").is_file(), err
     beyond = [0.0, 0.0, gimbal.upper[2] + 0.01]  # joint6 just past its stop
-    code, out, err = run(capsys, "--model", "touch", "show", "--theta", *map(str, inside),
+    code, out, err = cli("--model", "touch", "show", "--theta", *map(str, inside),
                          "--gimbal", *map(str, beyond), "--html", str(tmp_path / "gimbal.html"))
     assert code == 0 and err.count("\n") == 1, err
     assert "warning: gimbal" in err and bounds(gimbal.lower, gimbal.upper) in err, err
     above = [0.0, 0.0, arm.upper[2] + 0.01]
-    code, out, err = run(capsys, "--model", "touch", "show", "--theta", *map(str, above),
+    code, out, err = cli("--model", "touch", "show", "--theta", *map(str, above),
                          "--html", str(tmp_path / "arm.html"))
     assert code == 0 and err.count("\n") == 1, err
     assert "warning: theta" in err and bounds(arm.lower, arm.upper) in err, err
 
 
-def test_a_copy_of_the_touchs_folder_is_the_touch(tmp_path, capsys):
+def test_a_copy_of_the_touchs_folder_is_the_touch(tmp_path, cli):
     """H4: a copy of the Touch's configuration folder given with --config wrote a URDF named
     phantom_1_5 without the gimbal and an MJCF MuJoCo could not load (exit 0), and every other
     command failed with "no gimbal joint joint4 to lock". Against the committed files of the
@@ -60,20 +54,20 @@ def test_a_copy_of_the_touchs_folder_is_the_touch(tmp_path, capsys):
     copy = tmp_path / "my_touch"
     shutil.copytree(config.MODELS["touch"].config, copy)
     urdf, mjcf, scene = tmp_path / "t.urdf", tmp_path / "t.xml", tmp_path / "scene.xml"
-    assert run(capsys, "--config", str(copy), "urdf", "-o", str(urdf))[0] == 0
+    assert cli("--config", str(copy), "urdf", "-o", str(urdf))[0] == 0
     assert urdf.read_text() == config.MODELS["touch"].urdf.read_text()
-    assert run(capsys, "--config", str(copy), "mjcf", "-o", str(mjcf), "--scene", str(scene))[0] == 0
+    assert cli("--config", str(copy), "mjcf", "-o", str(mjcf), "--scene", str(scene))[0] == 0
     assert mjcf.read_text() == config.MODELS["touch"].mjcf.read_text()
     assert mujoco.MjModel.from_xml_path(str(scene)).nq == \
         mujoco.MjModel.from_xml_path(str(config.MODELS["touch"].scene)).nq
     theta = ["0.1", "0.3", "0.4"]
-    code, out, err = run(capsys, "--config", str(copy), "fk", *theta, "--json")
+    code, out, err = cli("--config", str(copy), "fk", *theta, "--json")
     assert code == 0 and err == "", err
-    _, named, _ = run(capsys, "--model", "touch", "fk", *theta, "--json")
+    _, named, _ = cli("--model", "touch", "fk", *theta, "--json")
     assert json.loads(out) == json.loads(named)
 
 
-def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_path, capsys):
+def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_path, cli):
     """M1: `identify --prior-spread 1e300` gave NumPy's overflow warning with source lines, then
     "array must not contain infs or NaNs", no option named. The bound's reason, against the fit
     of the log alone (no prior at all): at MAX_SPREAD the prior no longer moves the estimate
@@ -92,7 +86,7 @@ def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_
         widest = estimation.estimate(log, PRIOR, prior_spread=prior.MAX_SPREAD).beta
         assert np.abs(widest - alone).max() < 1e-9 * np.abs(alone).max()
         for spread in ("1e300", "1e7"):
-            code, out, err = run(capsys, "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"),
+            code, out, err = cli("identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"),
                                  "--prior-spread", spread)
             assert code == 2 and out == "" and err == (
                 f"phantom-pin: error: --prior-spread: {float(spread)!r} is beyond 1e+06, where the prior no "
@@ -105,14 +99,14 @@ def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_
     ("segment_a:\n  mass: 0.03\n  mass: 0.04\n", "not valid YAML at line 3, column 3: the key 'mass' is given twice"),
     ("segment_a:\n  mass: 0.03\nsegment_a.mass: 0.04\n", "segment_a.mass is given twice (nested and dotted)"),
 ])
-def test_an_overlay_that_gives_one_number_twice_is_refused(tmp_path, capsys, text, message):
+def test_an_overlay_that_gives_one_number_twice_is_refused(tmp_path, cli, text, message):
     """M4: an overlay with a duplicate key (`l1: 0.2` then `l1: 0.3`), or one number both nested
     and dotted, was taken silently (the last won). PyYAML itself reads such a file without a word
     (the premise); the command refuses it in one line naming --params and the file."""
     overlay = tmp_path / "overlay.yaml"
     overlay.write_text(text)
     yaml.safe_load(text)  # no error from PyYAML: it keeps the last
-    code, out, err = run(capsys, "--params", str(overlay), "fk", "0", "0", "0")
+    code, out, err = cli("--params", str(overlay), "fk", "0", "0", "0")
     assert (code, out) == (2, "") and err == f"phantom-pin: error: --params: {overlay}: {message}\n", err
 
 
@@ -120,31 +114,31 @@ def test_an_overlay_that_gives_one_number_twice_is_refused(tmp_path, capsys, tex
     (["excite"], "t.json", "CSV; name a .csv file"),
     (["identify", "LOG"], "id.json", "a YAML overlay; name a .yaml or .yml file"),
 ])
-def test_excite_and_identify_refuse_an_output_of_another_format(tmp_path, capsys, command, name, kind):
+def test_excite_and_identify_refuse_an_output_of_another_format(tmp_path, cli, command, name, kind):
     """M5: `excite -o t.json` wrote CSV into t.json (and identify YAML into any name)."""
     (tmp_path / "log.csv").write_text("t,theta1,theta2,theta3,tau1,tau2,tau3\n")
     target = tmp_path / name
     argv = [a.replace("LOG", str(tmp_path / "log.csv")) for a in command]
-    code, out, err = run(capsys, *argv, "-o", str(target))
+    code, out, err = cli(*argv, "-o", str(target))
     assert (code, out) == (2, "") and err == f"phantom-pin: error: --output: {target}: this command writes {kind}\n"
     assert not target.exists()
 
 
-def test_excite_says_when_it_rounds_the_duration_up_to_whole_periods(tmp_path, capsys):
+def test_excite_says_when_it_rounds_the_duration_up_to_whole_periods(tmp_path, cli):
     """M5: `excite --duration 3` silently wrote 5 s (one whole period of 5 s). The file's own
     time column is the length the warning states."""
     path = tmp_path / "t.csv"
-    code, out, err = run(capsys, "excite", "-o", str(path), "--duration", "3", "--rate", "100",
+    code, out, err = cli("excite", "-o", str(path), "--duration", "3", "--rate", "100",
                          "--iterations", "2", "--restarts", "1")
     assert code == 0 and err == ("phantom-pin: warning: --duration 3 s rounded up to 1 whole period(s) of 5 s: 5 s "
                                  "(the excitation is periodic; --period sets its length)\n")
     assert np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(5.0, abs=1e-12)
-    code, out, err = run(capsys, "excite", "-o", str(path), "--duration", "10", "--rate", "100", "--force",
+    code, out, err = cli("excite", "-o", str(path), "--duration", "10", "--rate", "100", "--force",
                          "--iterations", "2", "--restarts", "1")
     assert code == 0 and err == "" and np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(10.0)
 
 
-def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_path, capsys):
+def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_path, cli):
     """M6: info with an overlay or --set printed the shipped source ("ESTIMATES ... the same for
     each joint") beside the new numbers. The sources as the files state them (read here with
     PyYAML): a section an override changed says which numbers are not its source's; the others
@@ -155,7 +149,7 @@ def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_
               **yaml.safe_load((folder / "gimbal.yaml").read_text())["sources"]}
     overlay = tmp_path / "overlay.yaml"
     overlay.write_text("actuation:\n  friction:\n    viscous:\n      joint2: 0.01\ntip_offset: 0.04\n")
-    code, out, err = run(capsys, "--model", "touch", "info", "--json", "--params", str(overlay),
+    code, out, err = cli("--model", "touch", "info", "--json", "--params", str(overlay),
                          "--set", "joint_torque_limit.joint1=0.5")
     assert code == 0 and err == ""
     data = json.loads(out)["device"]
@@ -165,7 +159,7 @@ def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_
         assert data[section]["source"] == (stated[section] if changed is None else
                                            f"OVERRIDDEN here: {changed} (not from the source); the rest: "
                                            f"{stated[section]}")
-    code, out, _ = run(capsys, "--model", "touch", "info", "--params", str(overlay))
+    code, out, _ = cli("--model", "touch", "info", "--params", str(overlay))
     assert f"  source: OVERRIDDEN here: tip_offset (not from the source); the rest: {stated['gimbal']}\n" in out
     assert f"  source: {stated['friction']}\n" not in out
 
@@ -180,7 +174,7 @@ def test_the_readme_says_what_ctrl_c_does_to_show_and_ros2():
     assert "`show`'s live viewer and the `ros2` node run until Ctrl-C or SIGTERM and then exit 0" in sentence
 
 
-def test_a_length_that_leaves_the_lower_bar_unphysical_is_named(capsys):
+def test_a_length_that_leaves_the_lower_bar_unphysical_is_named(cli):
     """M8: `--set l1=0.2` on the Touch was refused blaming segment_c and hinge_pin, not l1. The
     hinge pin (mass mp) is carved out of the lower bar (mass mc, transverse inertia I about its
     centre, l1 long) at its end, l1 / 2 from the centre: by the parallel-axis theorem what is
@@ -191,21 +185,21 @@ def test_a_length_that_leaves_the_lower_bar_unphysical_is_named(capsys):
     mc, inertia, axial, mp = (physical["segment_c"]["mass"], physical["segment_c"]["inertia"]["xx"],
                               physical["segment_c"]["inertia"]["zz"], physical["hinge_pin"]["mass"])
     longest = 2 * np.sqrt((inertia - axial / 2) * (mc - mp) / (mp * mc))      # 0.1661 m
-    code, _, err = run(capsys, "--model", "touch", "--set", f"l1={longest * 0.999}", "fk", "0", "0", "0")
+    code, _, err = cli("--model", "touch", "--set", f"l1={longest * 0.999}", "fk", "0", "0", "0")
     assert code == 0 and err == "", err
     l1 = 0.2
-    code, out, err = run(capsys, "--model", "touch", "--set", f"l1={l1}", "fk", "0", "0", "0")
+    code, out, err = cli("--model", "touch", "--set", f"l1={l1}", "fk", "0", "0", "0")
     left = inertia - mp * mc * (l1 / 2) ** 2 / (mc - mp)
     assert (code, out) == (2, "") and err.count("\n") == 1 and "link lower_bar_link" in err
     assert f"principal moments {left:.6g}, {left:.6g}, {axial:.6g} kg m^2)" in err
     assert err.endswith("(from segment_c.mass, segment_c.inertia, hinge_pin.mass, l1 (the hinge pin's distance; "
                         "the inertias do not follow it))\n"), err
-    code, _, _ = run(capsys, "--model", "touch", "--set", f"l1={longest * 1.001}", "fk", "0", "0", "0")
+    code, _, _ = cli("--model", "touch", "--set", f"l1={longest * 1.001}", "fk", "0", "0", "0")
     assert code == 2
 
 
 @pytest.mark.parametrize("second", ["tau1", "TAU1 [mN m]"])
-def test_a_log_naming_one_column_twice_is_refused(tmp_path, capsys, second):
+def test_a_log_naming_one_column_twice_is_refused(tmp_path, cli, second):
     """M9: identify silently used the first of two columns both named tau1 (the second could be
     the one meant: another unit, a filtered copy)."""
     t = np.arange(3001) / 1000.0
@@ -213,7 +207,7 @@ def test_a_log_naming_one_column_twice_is_refused(tmp_path, capsys, second):
     table = np.column_stack([t, theta, 0.01 * theta, 10 * theta[:, 0]])
     log = tmp_path / "log.csv"
     np.savetxt(log, table, delimiter=",", header=f"t,theta1,theta2,theta3,tau1,tau2,tau3,{second}", comments="")
-    code, out, err = run(capsys, "identify", str(log), "-o", str(tmp_path / "id.yaml"))
+    code, out, err = cli("identify", str(log), "-o", str(tmp_path / "id.yaml"))
     assert (code, out) == (2, "") and err == (f"phantom-pin: error: {log}: the header names tau1 2 times; name each "
                                               "column once\n"), err
     assert not (tmp_path / "id.yaml").exists()
@@ -249,7 +243,7 @@ def _log(path, units):
     np.savetxt(path, np.column_stack([t, theta, 10 * theta]), delimiter=",", header=header, comments="")
 
 
-def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(tmp_path, capsys):
+def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(tmp_path, cli):
     """M11: a log in mN m, named as such in its header, was refused after 19.5 s of fitting,
     blaming the motion. Now at once, naming the column and the unit; the units each convention
     takes are read (the report's N m in any spelling, OpenHaptics' mN m)."""
@@ -262,7 +256,7 @@ def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(t
         assert io.read_log(tmp_path / "ok.csv", convention).tau.shape == (3001, 3)
     _log(tmp_path / "log.csv", "mN m")
     start = time.monotonic()
-    code, out, err = run(capsys, "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"))
+    code, out, err = cli("identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"))
     assert time.monotonic() - start < 1.0
     assert (code, out) == (2, "") and err == (
         f"phantom-pin: error: {tmp_path / 'log.csv'}: tau1 is in mN m (its header), the report convention's torques "
@@ -640,12 +634,12 @@ def test_a_model_worse_than_the_prior_by_more_than_10_percent_is_refused(ratio, 
     (["excite", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),  # L5
     (["urdf", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),
 ])
-def test_low_items_name_the_option_in_one_readable_line(tmp_path, capsys, argv, message):
+def test_low_items_name_the_option_in_one_readable_line(tmp_path, cli, argv, message):
     """L1 `ik 1e308` printed a 309-digit distance; L2 `--set =0.2` named an empty key; L3
     `urdf -o /dev/full` named no option; L5 excite said "add --force", the rest "use --force";
     L7 `--config /tmp` said kinematics.yaml could not be read, not that it is no configuration."""
     (tmp_path / "old.csv").write_text("kept\n")
-    code, out, err = run(capsys, *[a.replace("{tmp}", str(tmp_path)) for a in argv])
+    code, out, err = cli(*[a.replace("{tmp}", str(tmp_path)) for a in argv])
     assert (code, out) == (2, "") and err.count("\n") == 1
     assert err.startswith("phantom-pin: error: " + message.replace("{tmp}", str(tmp_path))), err
     assert (tmp_path / "old.csv").read_text() == "kept\n"
@@ -658,15 +652,15 @@ def test_low_items_name_the_option_in_one_readable_line(tmp_path, capsys, argv, 
     (["excite", "-o", "{tmp}/a.csv", "-o", "{tmp}/b.csv"], "-o: given twice; give it once"),
     (["--set", "l1=0.2", "fk", "0", "0", "0", "--set", "l1=0.3"], "--set: l1 given twice; give it once"),
 ])
-def test_an_option_given_twice_is_refused_not_silently_the_last(tmp_path, capsys, argv, message):
+def test_an_option_given_twice_is_refused_not_silently_the_last(tmp_path, cli, argv, message):
     """L11: -o twice or --set of one key twice silently took the last (a second --model was
     refused). --params then --set of one key stays an override (the README's order)."""
-    code, out, err = run(capsys, *[a.replace("{tmp}", str(tmp_path)) for a in argv])
+    code, out, err = cli(*[a.replace("{tmp}", str(tmp_path)) for a in argv])
     assert (code, out, err) == (2, "", f"phantom-pin: error: {message}\n")
     assert list(tmp_path.iterdir()) == []
     (tmp_path / "p.yaml").write_text("l1: 0.25\n")
-    code, out, _ = run(capsys, "--params", str(tmp_path / "p.yaml"), "--set", "l1=0.3", "fk", "0", "0", "0", "--json")
-    assert code == 0 and json.loads(out) == json.loads(run(capsys, "--set", "l1=0.3", "fk", "0", "0", "0", "--json")[1])
+    code, out, _ = cli("--params", str(tmp_path / "p.yaml"), "--set", "l1=0.3", "fk", "0", "0", "0", "--json")
+    assert code == 0 and json.loads(out) == json.loads(cli("--set", "l1=0.3", "fk", "0", "0", "0", "--json")[1])
 
 
 def test_the_readmes_command_table_lists_every_command_and_the_newest_options():
@@ -686,16 +680,16 @@ def test_the_readmes_command_table_lists_every_command_and_the_newest_options():
 
 @pytest.mark.parametrize("argv, option", [(["identify", "{missing}", "-o", "{tmp}/id.yaml"], "LOG"),
                                           (["simulate", "--trajectory", "{missing}"], "--trajectory")])
-def test_a_missing_log_or_trajectory_is_named_by_its_option(tmp_path, capsys, argv, option):
+def test_a_missing_log_or_trajectory_is_named_by_its_option(tmp_path, cli, argv, option):
     """L4: a missing --trajectory or log showed Python's errno text ("[Errno 2] ... : 'x.csv'")
     without the option."""
     missing = tmp_path / "missing.csv"
-    code, out, err = run(capsys, *[a.replace("{missing}", str(missing)).replace("{tmp}", str(tmp_path)) for a in argv])
+    code, out, err = cli(*[a.replace("{missing}", str(missing)).replace("{tmp}", str(tmp_path)) for a in argv])
     assert (code, out) == (2, "") and err == f"phantom-pin: error: {option}: {missing}: cannot read (No such file or " \
                                              "directory)\n"
 
 
-def test_identify_accept_warns_on_stderr(tmp_path, capsys):
+def test_identify_accept_warns_on_stderr(tmp_path, cli):
     """L8: identify --accept printed its warnings on stdout, among the results (every other
     command warns on stderr). The model's own torques with tau3 2.5 times too small: a gain
     outside 0.5-2 (a problem --accept writes anyway)."""
@@ -705,7 +699,7 @@ def test_identify_accept_warns_on_stderr(tmp_path, capsys):
     phantom = Phantom()
     theta, dtheta, ddtheta = _sines(T10)
     io.write_log(tmp_path / "log.csv", T10, theta, _torques(phantom, theta, dtheta, ddtheta) / [1, 1, 2.5])
-    code, out, err = run(capsys, "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"), "--accept",
+    code, out, err = cli("identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"), "--accept",
                          "--torque-timing", "sampled")
     assert code == 0 and out.startswith("10001 samples") and "warning" not in out
     assert "phantom-pin: warning: (written with --accept) tau3 is 0.4 times joint 1's torque scale (gain 2.5" in err
@@ -713,11 +707,11 @@ def test_identify_accept_warns_on_stderr(tmp_path, capsys):
 
 @pytest.mark.parametrize("prefix, valid", [('a"b', False), ("a b", False), ("9lives", False), ("arm/", True),
                                            ("left_", True), ("", True)])
-def test_urdf_refuses_a_prefix_that_is_no_ros_name(tmp_path, capsys, prefix, valid):
+def test_urdf_refuses_a_prefix_that_is_no_ros_name(tmp_path, cli, prefix, valid):
     """L6: urdf/srdf --prefix took names no ROS name can hold (a space, a quote, a leading digit;
     codegen's checks its own). ROS 2's rule for names: tokens of letters, digits and _, not
     starting with a digit, separated by /."""
-    code, out, err = run(capsys, "srdf", "-o", str(tmp_path / "p.srdf"), "--prefix", prefix)
+    code, out, err = cli("srdf", "-o", str(tmp_path / "p.srdf"), "--prefix", prefix)
     assert code == (0 if valid else 2) and (tmp_path / "p.srdf").exists() == valid
     if not valid:
         assert err == ("phantom-pin: error: --prefix: expected a ROS name's start (letters, digits, _ and /, not "

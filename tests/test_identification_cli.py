@@ -7,7 +7,6 @@ import yaml
 
 from helpers import CONFIG, CONFIG_DIR, REPORT
 from phantom_pin import Phantom, closed_form, describe
-from phantom_pin.cli import main
 from phantom_pin.identification import io
 from phantom_pin.identification.excitation import continuous_effort
 
@@ -15,15 +14,9 @@ DESCRIPTION = describe()
 EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
 
 
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
+def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, cli):
     path = tmp_path / "traj.csv"
-    code, out, _ = run(capsys, "excite", "-o", path, "--duration", "5", "--rate", "200",
+    code, out, _ = cli("excite", "-o", path, "--duration", "5", "--rate", "200",
                        "--iterations", "5", "--restarts", "1")
     assert code == 0 and "condition number" in out
     table = np.loadtxt(path, delimiter=",", skiprows=1)
@@ -42,7 +35,7 @@ def test_excite_stays_inside_the_stops_and_torque_limits(tmp_path, capsys):
     # the velocities are the positions' derivatives
     np.testing.assert_allclose(np.gradient(table[:, 1:4], 1 / 200, axis=0)[1:-1], table[1:-1, 4:7],
                                atol=2e-3 * np.abs(table[:, 4:7]).max())
-    code, _, err = run(capsys, "excite", "-o", path)
+    code, _, err = cli("excite", "-o", path)
     assert code == 2 and "exists" in err
 
 
@@ -87,7 +80,7 @@ def good_rows(n=3000, rate=1000.0):
     ("text", "not a number"),
     ("flat", "too little motion: joint(s) 2, 3 move faster than"),
 ])
-def test_malformed_logs_exit_2_with_one_line(tmp_path, capsys, case, message):
+def test_malformed_logs_exit_2_with_one_line(tmp_path, cli, case, message):
     header, rows = "t,theta1,theta2,theta3,tau1,tau2,tau3", good_rows()
     if case == "missing":
         header, rows = "t,theta1,theta2,theta3,tau1,tau2", rows[:, :6]
@@ -106,15 +99,15 @@ def test_malformed_logs_exit_2_with_one_line(tmp_path, capsys, case, message):
     if case == "text":
         log.write_text(log.read_text().replace("0.001,", "abc,", 1))
     out = tmp_path / "id.yaml"
-    code, _, err = run(capsys, "identify", log, "-o", out)
+    code, _, err = cli("identify", log, "-o", out)
     assert code == 2 and message in err and err.count("\n") == 1, err
     assert not out.exists()
 
 
-def test_identify_refuses_to_overwrite(tmp_path, capsys):
+def test_identify_refuses_to_overwrite(tmp_path, cli):
     out = tmp_path / "id.yaml"
     out.write_text("keep")
-    code, _, err = run(capsys, "identify", tmp_path / "missing.csv", "-o", out)
+    code, _, err = cli("identify", tmp_path / "missing.csv", "-o", out)
     assert code == 2 and "exists" in err and out.read_text() == "keep"
 
 
@@ -133,13 +126,13 @@ def test_excitation_respects_a_tight_torque_limit():
     assert share.max() <= 0.2 * 1.02 and share.max() >= 0.15, share
 
 
-def test_excite_writes_whole_periods_and_consistent_columns(tmp_path, capsys):
+def test_excite_writes_whole_periods_and_consistent_columns(tmp_path, cli):
     """--duration 7 --period 5 rounds up to two whole periods (10 s); over the whole file the
     accelerations are the rates' derivatives (central differences) and the torques are the
     report's inverse dynamics (closed form) plus the configuration's friction law, written out
     here: viscous dtheta + coulomb sign(dtheta)."""
     path = tmp_path / "traj.csv"
-    code, _, _ = run(capsys, "excite", "-o", path, "--duration", "7", "--period", "5", "--rate", "500",
+    code, _, _ = cli("excite", "-o", path, "--duration", "7", "--period", "5", "--rate", "500",
                      "--iterations", "3", "--restarts", "1")
     assert code == 0
     table = np.loadtxt(path, delimiter=",", skiprows=1)
@@ -163,22 +156,22 @@ def test_excite_writes_whole_periods_and_consistent_columns(tmp_path, capsys):
     (["--rate", "1"], "--rate: 1 Hz samples the highest harmonic (5 / 5 s) fewer than 20 times per cycle"),
     (["-o", "/nonexistent-folder/traj.csv"], "--output: cannot write in /nonexistent-folder"),
 ])
-def test_excite_checks_its_options_before_any_work(tmp_path, capsys, option, message):
+def test_excite_checks_its_options_before_any_work(tmp_path, cli, option, message):
     """One line, exit 2, nothing written, within a second: before the optimisation."""
     import time
 
     path = tmp_path / "traj.csv"
     start = time.monotonic()
     output = [] if option[0] == "-o" else ["-o", path]      # -o given once (twice is refused)
-    code, out, err = run(capsys, "excite", *output, *option)
+    code, out, err = cli("excite", *output, *option)
     assert time.monotonic() - start < 1.0
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert not path.exists() and list(tmp_path.iterdir()) == []
 
 
-def test_excite_writes_at_least_one_period(tmp_path, capsys):
+def test_excite_writes_at_least_one_period(tmp_path, cli):
     path = tmp_path / "traj.csv"
-    code, _, _ = run(capsys, "excite", "-o", path, "--duration", "1e-9", "--rate", "100", "--iterations", "2",
+    code, _, _ = cli("excite", "-o", path, "--duration", "1e-9", "--rate", "100", "--iterations", "2",
                      "--restarts", "1")
     t = np.loadtxt(path, delimiter=",", skiprows=1)[:, 0]
     assert code == 0 and len(t) == 501 and t[-1] == pytest.approx(5.0)
@@ -200,7 +193,7 @@ def test_the_excitation_holds_its_bounds_at_every_written_sample():
     assert result.min_slack == pytest.approx(CONFIG.limits.slack(states[0]).min(), abs=1e-12)
 
 
-def test_excite_simulate_identify_without_code(tmp_path, capsys):
+def test_excite_simulate_identify_without_code(tmp_path, cli):
     """excite -> simulate --trajectory (feed-forward plus PD on the shipped device: Pinocchio,
     rotors, friction, stops, saturation) -> identify (the general structure): the written
     overlay's mass matrix and gravity are the report's closed form within 0.5 % of their
@@ -210,9 +203,9 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     from phantom_pin.config.sampling import sample_postures
 
     traj, log, overlay = tmp_path / "traj.csv", tmp_path / "log.csv", tmp_path / "id.yaml"
-    assert run(capsys, "excite", "-o", traj, "--duration", "10", "--iterations", "15", "--restarts", "1")[0] == 0
-    assert run(capsys, "simulate", "--trajectory", traj, "--format", "csv", "-o", log)[0] == 0
-    assert run(capsys, "identify", log, "-o", overlay)[0] == 0
+    assert cli("excite", "-o", traj, "--duration", "10", "--iterations", "15", "--restarts", "1")[0] == 0
+    assert cli("simulate", "--trajectory", traj, "--format", "csv", "-o", log)[0] == 0
+    assert cli("identify", log, "-o", overlay)[0] == 0
     keys = read_overrides(overlay)
     identified = Phantom(describe(overrides=keys))
     theta = sample_postures(CONFIG.limits, 200, np.random.default_rng(4), draws=800)
@@ -223,14 +216,14 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     for j in range(3):      # each joint's own law, written per joint
         assert keys[f"actuation.friction.viscous.joint{j + 1}"] == pytest.approx(law.viscous[j], rel=1e-2)
         assert keys[f"actuation.friction.coulomb.joint{j + 1}"] == pytest.approx(law.coulomb[j], rel=1e-2)
-    code, _, err = run(capsys, "simulate", "--trajectory", traj, "--duration", "3")
+    code, _, err = cli("simulate", "--trajectory", traj, "--duration", "3")
     assert code == 2 and "--duration: --trajectory sets it" in err
     # the overlay carries its model and lengths: another model refuses it (before, the CAD
     # model's overlay applied to premium_1_5 silently took the 1.5's lengths)
     assert keys["model"] == "premium_1_5" and (keys["l1"], keys["l2"], keys["l3"]) == (
         CONFIG.kinematics.l1, CONFIG.kinematics.l2, CONFIG.kinematics.l3)
     urdf = tmp_path / "touch.urdf"
-    code, out, err = run(capsys, "--model", "touch", "urdf", "--params", overlay, "-o", urdf)
+    code, out, err = cli("--model", "touch", "urdf", "--params", overlay, "-o", urdf)
     assert code == 2 and out == "" and err.count("\n") == 1 and not urdf.exists()
     assert "model: these overrides were made for the model 'premium_1_5'" in err and "--model premium_1_5" in err
 
@@ -244,7 +237,7 @@ def test_excite_simulate_identify_without_code(tmp_path, capsys):
     (["excite", "-o", "OUT/traj.csv", "--iterations", "0"], "--iterations: expected an integer of at least 1"),
     (["excite", "-o", "OUT", "--force"], "is a folder; name a file"),
 ])
-def test_bad_options_name_themselves_before_any_work(tmp_path, capsys, arguments, message):
+def test_bad_options_name_themselves_before_any_work(tmp_path, cli, arguments, message):
     """What a review tried: one line naming the option, exit 2, nothing written, and no fit or
     optimisation run first (before: a missing folder failed after the whole fit)."""
     path = tmp_path / "log.csv"
@@ -252,6 +245,6 @@ def test_bad_options_name_themselves_before_any_work(tmp_path, capsys, arguments
         np.arange(3001) / 1000.0))
     before = sorted(p.name for p in tmp_path.iterdir())
     args = [a.replace("LOG", str(path)).replace("OUT", str(tmp_path)) for a in arguments]
-    code, out, err = run(capsys, *args)
+    code, out, err = cli(*args)
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert out == "" and sorted(p.name for p in tmp_path.iterdir()) == before

@@ -17,7 +17,7 @@ from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import estimation, io, simulation
 from test_identification_end_to_end import COULOMB, VISCOUS, truth_overrides
-from test_identification_prior import PRIOR, error, lab_log, sum_of_sines
+from test_identification_prior import PRIOR, error, sum_of_sines, truth_log
 
 TRUE_FRICTION = np.array([VISCOUS] * 3 + [COULOMB] * 3)
 
@@ -37,8 +37,8 @@ def device():
 
 
 @pytest.fixture(scope="module")
-def held_log(device):
-    return lab_log(device[0], 60, 0.4, 1)
+def held_log():
+    return truth_log(60, 0.4, 1)          # lab_log(device[0], 60, 0.4, 1), simulated once
 
 
 def test_the_delay_is_estimated_and_corrected(device, held_log):

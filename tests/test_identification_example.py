@@ -5,13 +5,18 @@ the README and docs/identification.md quote are the ones it prints."""
 
 from pathlib import Path
 
+import pytest
+
 from test_examples import figure, number, run
+
+#: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def test_identify_simulated_example(tmp_path):
-    result = run("identify_simulated.py", tmp_path)
+def test_identify_simulated_example(tmp_path, machine_environment):
+    result = run("identify_simulated.py", tmp_path, env=machine_environment)   # as the docs' figures were made
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "identify_simulated.png")
     general = number(r"identified \(general\) (\S+) %", result.stdout)

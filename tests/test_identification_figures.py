@@ -10,9 +10,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from phantom_pin import Phantom, describe
 from phantom_pin.config.sampling import random_states
+
+#: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "benchmarks" / "identification_figures.py"

@@ -8,6 +8,8 @@ identified on the shipped model (the prior). Judged on held-out motion against t
 inverse dynamics (Pinocchio on its description): a second sum-of-sines trajectory and 500
 seeded states inside the stops."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -47,13 +49,20 @@ def lab_log(device, duration, amplitude, seed):
                             seed=seed)
 
 
+@functools.cache
+def truth_log(duration, amplitude, seed):
+    """lab_log of the device of truth_overrides(), simulated once per arguments (the wide log is
+    test_identification_delay's too; conftest.GROUPS keeps both modules on one worker)."""
+    return lab_log(Device(describe(overrides=truth_overrides())), duration, amplitude, seed)
+
+
 @pytest.fixture(scope="module")
 def lab():
     """The narrow, short log (10 s, 0.1 rad) and the wide, long one (60 s, 0.4 rad), fitted with
     the prior; the device's true model; the held-out sets."""
     description = describe(overrides=truth_overrides())
-    device, truth = Device(description), Phantom(description)
-    logs = {name: lab_log(device, duration, amplitude, 1)
+    truth = Phantom(description)
+    logs = {name: truth_log(duration, amplitude, 1)
             for name, duration, amplitude in (("narrow", 10, 0.1), ("wide", 60, 0.4))}
     fits = {name: estimation.estimate(log, PRIOR) for name, log in logs.items()}
     _, theta, dtheta, ddtheta = sum_of_sines(20, 0.4, 99)
