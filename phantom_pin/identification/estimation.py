@@ -44,8 +44,6 @@ from collections.abc import Callable
 
 import numpy as np
 import scipy.linalg
-import scipy.ndimage
-import scipy.signal
 
 from phantom_pin.config import Friction
 from phantom_pin.dynamics.model import Phantom
@@ -345,6 +343,10 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay
         raise LogError(f"{cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
                        f"(this one: {rate:.4g} Hz; central differences need {RATE_PER_CUTOFF:g} samples per "
                        "second per hertz of cutoff); lower --cutoff or log faster", argument="cutoff")
+    # imported here: scipy.signal and scipy.ndimage take 0.4 s, which every command line start paid
+    import scipy.ndimage
+    import scipy.signal
+
     sos = scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
     theta = scipy.signal.sosfiltfilt(sos, log.theta, axis=0)
     tau = scipy.signal.sosfiltfilt(sos, log.tau, axis=0)
