@@ -91,6 +91,20 @@ class ForceCommand:
 
 
 @dataclasses.dataclass(frozen=True)
+class StateTopic:
+    """A state topic a driver publishes beside its joint states, of a type that installs here:
+    ``topic``, ``type`` (STATE_TYPES), ``frame_id``; its vectors are ``axes`` @ OpenHaptics'
+    (a pose's position HD_CURRENT_TRANSFORM's translation in m, a twist's linear velocity in m/s
+    and angular in rad/s), a pose's rotation axes @ R_OH @ axes^T @ ``after``."""
+
+    topic: str
+    type: str
+    frame_id: str
+    axes: np.ndarray
+    after: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True)
 class Profile:
     """One driver: ``name``, ``description``, ``joint_states``, ``force``, ``sources`` (the
     repositories read: owner/name@commit)."""
@@ -100,6 +114,7 @@ class Profile:
     joint_states: JointStates
     force: ForceCommand
     sources: tuple[str, ...]
+    state_topics: tuple[StateTopic, ...] = ()
 
     # -- joint states ------------------------------------------------------------------
     def arm_from_state(self, published: Sequence[float]) -> np.ndarray:
@@ -134,6 +149,10 @@ class Profile:
         """HD_CURRENT_FORCE's direction and size (N, OH) of the message's three numbers (N),
         before the driver's own clamp, damping and spring."""
         return self.force.to_openhaptics @ force
+
+
+#: The state topics' types sim-driver publishes.
+STATE_TYPES = ("geometry_msgs/msg/PoseStamped", "geometry_msgs/msg/TwistStamped")
 
 
 #: The suffix of the relay's topic (relayed()).
@@ -189,14 +208,31 @@ def _joint_states(node: dict, where: str) -> JointStates:
                        _qos(node["qos"], f"{where}.qos"), float(rate))
 
 
+def _axes(value: object, where: str) -> np.ndarray:
+    """A rotation that permutes and signs axes (3x3), else ParameterFileError at ``where``."""
+    matrix = np.array(value, dtype=float)
+    if matrix.shape != (3, 3) or not np.array_equal(matrix @ matrix.T, np.eye(3)) or not set(
+            np.abs(matrix).ravel()) <= {0.0, 1.0} or round(np.linalg.det(matrix)) != 1:
+        raise ParameterFileError(f"{where}: expected a rotation that permutes and signs axes, got {value}")
+    return matrix
+
+
+def _state_topics(nodes: list, where: str) -> tuple[StateTopic, ...]:
+    topics = []
+    for k, node in enumerate(nodes):
+        if node["type"] not in STATE_TYPES:
+            raise ParameterFileError(f"{where}[{k}].type: expected one of {', '.join(STATE_TYPES)}, "
+                                     f"got {node['type']!r}")
+        after = node.get("after", np.eye(3).tolist())
+        topics.append(StateTopic(str(node["topic"]), node["type"], str(node["frame_id"]),
+                                 _axes(node["axes"], f"{where}[{k}].axes"), _axes(after, f"{where}[{k}].after")))
+    return tuple(topics)
+
+
 def _force(node: dict, where: str) -> ForceCommand:
     if node["type"] not in FORCE_TYPES:
         raise ParameterFileError(f"{where}.type: expected one of {', '.join(FORCE_TYPES)}, got {node['type']!r}")
-    matrix = np.array(node["to_openhaptics"], dtype=float)
-    if matrix.shape != (3, 3) or not np.array_equal(matrix @ matrix.T, np.eye(3)) or not set(
-            np.abs(matrix).ravel()) <= {0.0, 1.0} or round(np.linalg.det(matrix)) != 1:
-        raise ParameterFileError(f"{where}.to_openhaptics: expected a rotation that permutes and signs axes, "
-                                 f"got {node['to_openhaptics']}")
+    matrix = _axes(node["to_openhaptics"], f"{where}.to_openhaptics")
     clamp = node["clamp"]
     limit = math.inf if clamp["kind"] == "none" else float(clamp["value"])
     if clamp["kind"] not in ("none", "norm") or not limit > 0:
@@ -228,6 +264,7 @@ def load(name: str) -> Profile:
     try:
         return Profile(node["name"], node["description"], _joint_states(node["joint_states"], f"{path}: joint_states"),
                        _force(node["force"], f"{path}: force"),
-                       tuple(f"{r['repo']}@{str(r['commit'])[:7]}" for r in node["repositories"]))
+                       tuple(f"{r['repo']}@{str(r['commit'])[:7]}" for r in node["repositories"]),
+                       _state_topics(node["state_topics"], f"{path}: state_topics"))
     except (KeyError, TypeError) as error:
         raise ParameterFileError(f"{path}: not a driver profile ({error!r} missing or malformed)") from None

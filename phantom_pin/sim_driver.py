@@ -21,14 +21,16 @@ import math
 import threading
 import time
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from phantom_pin import drivers
 from phantom_pin.device.device import Device
 from phantom_pin.device.plant import MAX_STEP, Plant, contact_substeps
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.profiles import Profile
+from phantom_pin.profiles import Profile, StateTopic
 from phantom_pin.ros2 import _qos, message_type, run
 
 #: The servo loop's period (s): OpenHaptics' 1 kHz.
@@ -105,6 +107,29 @@ class DriverSimulation:
         return list(self.profile.joint_states.names), [float(p) for p in positions], efforts
 
 
+    def state_topics(self, gimbal: Sequence[float]) -> list[tuple[StateTopic, np.ndarray, np.ndarray]]:
+        """The profile's state topics now: (topic, position m or linear velocity m/s, rotation
+        (3, 3) or angular velocity rad/s), in the driver's axes. OpenHaptics' HD_CURRENT_TRANSFORM
+        of the stylus (drivers.openhaptics_transform_from_pose: its origin an ESTIMATE), its
+        velocity J_p dtheta and the stylus's angular velocity (Phantom.stylus_jacobian), the
+        gimbal held still."""
+        phantom, theta, g = self.device.phantom, np.array(self.q), np.asarray(gimbal, dtype=float)
+        out = []
+        for spec in self.profile.state_topics:
+            if spec.type.endswith("PoseStamped"):
+                flat = drivers.openhaptics_transform_from_pose(phantom.stylus_pose(theta, g),
+                                                               drivers.openhaptics_origin(phantom))
+                transform = flat.reshape(4, 4).T                              # column-major, mm
+                out.append((spec, spec.axes @ transform[:3, 3] * drivers.METRE_PER_MM,
+                            spec.axes @ transform[:3, :3] @ spec.axes.T @ spec.after))
+            else:
+                rates = np.concatenate([self.v, np.zeros(3)])
+                angular = (phantom.stylus_jacobian(theta, g) @ rates)[3:]
+                linear = self.device.tip_jacobian(theta) @ np.array(self.v)
+                out.append((spec, spec.axes @ linear, spec.axes @ angular))
+        return out
+
+
 def make_node(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str = "", name: str = "sim_driver"):
     """The rclpy node of a DriverSimulation (rclpy.init must have run): the profile's force topic
     in, its joint states out (``loop`` runs it in real time)."""
@@ -119,6 +144,9 @@ def make_node(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str
         def __init__(self) -> None:
             super().__init__(name)
             self.states = self.create_publisher(JointState, profile.joint_states.topic, _qos(profile.joint_states.qos))
+            qos = _qos(profile.joint_states.qos)
+            self.others: list[Any] = [self.create_publisher(message_type(spec.type), spec.topic, qos)
+                                      for spec in profile.state_topics]
             self.create_subscription(force_type, profile.force.topic, self.on_force, _qos(profile.force.qos))
 
         def on_force(self, message) -> None:
@@ -133,8 +161,28 @@ def make_node(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str
             message.header.stamp = self.get_clock().now().to_msg()
             message.name, message.position, message.effort = [prefix + n for n in names], positions, efforts
             self.states.publish(message)
+            for publisher, (spec, first, second) in zip(self.others, simulation.state_topics(gimbal)):
+                other = message_type(spec.type)()
+                other.header.stamp, other.header.frame_id = message.header.stamp, prefix + spec.frame_id
+                if spec.type.endswith("PoseStamped"):
+                    _pose(other, first, second)
+                else:
+                    _twist(other, first, second)
+                publisher.publish(other)
 
     return SimulatedDriverNode()
+
+
+def _pose(message, position: np.ndarray, rotation: np.ndarray) -> None:
+    p, o = message.pose.position, message.pose.orientation
+    p.x, p.y, p.z = (float(v) for v in position)
+    q = pin.Quaternion(rotation)
+    o.x, o.y, o.z, o.w = float(q.x), float(q.y), float(q.z), float(q.w)
+
+
+def _twist(message, linear: np.ndarray, angular: np.ndarray) -> None:
+    message.twist.linear.x, message.twist.linear.y, message.twist.linear.z = (float(v) for v in linear)
+    message.twist.angular.x, message.twist.angular.y, message.twist.angular.z = (float(v) for v in angular)
 
 
 def loop(simulation: DriverSimulation, node, executor, stop: threading.Event) -> None:

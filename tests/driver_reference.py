@@ -120,3 +120,30 @@ def states(n: int, seed: int, margin: float = 0.05) -> tuple[np.ndarray, np.ndar
 
 
 __all__ = ["FORCE", "L1", "L2", "BASE_FROM_S", "published", "tip_jacobian", "gravity", "stylus_rotation", "states"]
+
+
+# -- each driver's state topics (beside the joint states), its own formulas of OpenHaptics' values -----
+def _ry(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def _rx(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+_B = np.array([[0.0, 0, 1], [1, 0, 0], [0, 1, 0]])   # CalaW's REP-103 basis: x = z_OH, y = x_OH, z = y_OH
+#: topic -> (kind, formula of (t_OH m, R_OH) or (v_OH m/s, w_OH rad/s)), as each driver writes it
+STATE = {
+    # mtsSensableHD.cpp 401-404, 302-306: HD_CURRENT_TRANSFORM in m, OH axes; HD_CURRENT_VELOCITY / 1000
+    "/arm/measured_cp": ("pose", lambda t, r: (t, r)),
+    "/arm/measured_cv": ("twist", lambda v, w: (v, w)),
+    # device_transforms.hpp 46-75, 111-114: B t, B R B^T; B v, B w
+    "/touch/state/pose": ("pose", lambda t, r: (_B @ t, _B @ r @ _B.T)),
+    "/touch/state/twist": ("twist", lambda v, w: (_B @ v, _B @ w)),
+    # phantom_touch_control_node.cpp 267-280, hd++.cpp 194-200: t, R Ry(pi/2) Rx(-pi/2)
+    "/pose_stylus_current": ("pose", lambda t, r: (t, r @ _ry(PI / 2) @ _rx(-PI / 2))),
+    # geomagic_touch_x_component.cpp 184-196: HD_CURRENT_VELOCITY / 1000, HD_CURRENT_ANGULAR_VELOCITY
+    "/geomagic_touch_x/twist": ("twist", lambda v, w: (v, w)),
+}

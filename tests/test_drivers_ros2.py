@@ -8,6 +8,8 @@ refuses that profile in one line."""
 
 from __future__ import annotations
 
+import atexit
+import functools
 import os
 import selectors
 import signal
@@ -39,13 +41,26 @@ REPORT = Phantom("touch").config.report
 BAD_WRENCH = {"sawsensablephantom": ("base_link", (float("nan"), 0.0, 0.0), "force"),
               "touch_ros2_control": ("nowhere", (0.0, 0.0, 0.1), "frame_id"),
               "geomagic_touch_x_ros2": ("base_link", (1e9, 0.0, 0.0), "force")}
-HOLD = 3.0                           # s, before the simulated driver lets go: the node starts meanwhile
+HOLD = 6.0                           # s, before the simulated driver lets go: the node starts meanwhile
 
 
-def _environment(offset: int) -> dict[str, str]:
-    """Loopback only, a ROS domain of this test alone."""
+def _environment(offset: int = 0) -> dict[str, str]:
+    """Loopback only, a ROS domain of this module alone (its tests run one after another, each
+    stopping its processes before the next starts)."""
     return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-            "ROS_DOMAIN_ID": str(1 + (os.getpid() + 37 + offset) % 100), "PYTHONUNBUFFERED": "1"}
+            "ROS_DOMAIN_ID": str(1 + (os.getpid() + 37) % 100), "PYTHONUNBUFFERED": "1"}
+
+
+@functools.cache
+def _context():
+    """One rclpy context for the module's watchers: a fresh context per test, each in a domain of
+    its own, now and then received nothing from the second test on (FastDDS, in one process)."""
+    import rclpy
+
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=int(_environment()["ROS_DOMAIN_ID"]))
+    atexit.register(rclpy.try_shutdown, context=context)
+    return context
 
 
 def _start(env: dict[str, str], *args: str) -> subprocess.Popen:
@@ -53,13 +68,16 @@ def _start(env: dict[str, str], *args: str) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def _wait_for(process: subprocess.Popen, text: str, timeout: float = 60.0) -> None:
+def _wait_for(process: subprocess.Popen, text: str, timeout: float = 60.0, watcher=None) -> None:
+    """Read ``process``'s log until it says ``text``; spin ``watcher`` meanwhile."""
     selector = selectors.DefaultSelector()
     selector.register(process.stderr, selectors.EVENT_READ)
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        if selector.select(timeout=0.5) and text in process.stderr.readline():
+        if selector.select(timeout=0 if watcher else 0.5) and text in process.stderr.readline():
             return
+        if watcher is not None:
+            watcher.spin(0.02)
         assert process.poll() is None, process.communicate()[1]
     raise AssertionError(f"{process.args} did not say {text!r} within {timeout} s")
 
@@ -87,8 +105,7 @@ class Watcher:
         from sensor_msgs.msg import JointState
 
         self.rclpy, self.profile = rclpy, profiles.load(name)
-        self.context = rclpy.Context()
-        rclpy.init(context=self.context, domain_id=int(env["ROS_DOMAIN_ID"]))
+        self.context = _context()
         self.node = rclpy.create_node("watcher", context=self.context)
         from rclpy.executors import SingleThreadedExecutor
 
@@ -101,6 +118,9 @@ class Watcher:
         self.received: list[float] = []     # when each force arrived (monotonic s)
         self.node.create_subscription(message_type(self.profile.force.type), self.profile.force.topic,
                                       self.on_force, qos)
+        self.others = {spec.topic: [] for spec in self.profile.state_topics}   # the driver's other state topics
+        for spec in self.profile.state_topics:
+            self.node.create_subscription(message_type(spec.type), spec.topic, self.others[spec.topic].append, qos)
         self.wrench = self.node.create_publisher(WrenchStamped, "wrench",
                                                  QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE))
 
@@ -135,7 +155,8 @@ class Watcher:
         self.wrench.publish(message)
 
     def close(self) -> None:
-        self.rclpy.try_shutdown(context=self.context)
+        self.executor.shutdown()
+        self.node.destroy_node()
 
 
 def tip(theta: np.ndarray) -> np.ndarray:
@@ -167,9 +188,12 @@ def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
 
 
 def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) -> None:
-    _wait_for(simulated, "released")
-    watcher.spin(0.1)
-    assert watcher.states, "no joint states from the simulated driver"
+    _wait_for(simulated, "released", watcher=watcher)
+    # the node must have connected while the driver held the stylus (ROS discovery now and then takes
+    # seconds here: HOLD leaves it 4 s after the node is up)
+    assert watcher.states and watcher.forces, (f"within the {HOLD} s hold: {len(watcher.states)} states, "
+                                               f"{len(watcher.forces)} forces")
+    watcher.spin(0.05)
     released, start = watcher.states[-1][0], tip(THETA0)
     one_tick = watcher.profile.force.hold == "one_tick"
     watcher.spin(1.0 if one_tick else 5.0)   # the float's 5 s, where a float is possible (below)
@@ -185,6 +209,10 @@ def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) ->
         assert answered > 0.8
         return
     assert drift < 2e-3
+    # the driver's other state topics arrive with the joint states, in its frame_id
+    assert all(len(m) > 100 and {x.header.frame_id for x in m} == {spec.frame_id}
+               for spec, m in ((s, watcher.others[s.topic]) for s in watcher.profile.state_topics)), \
+        {k: len(v) for k, v in watcher.others.items()}
     # (c) every force received so far, by the driver's own formula: the closed form's gravity at the
     # release posture (the stylus still there), the gimbal at the driver's locked_at (0)
     jacobian, gravity = ref.tip_jacobian(THETA0), ref.gravity(THETA0, np.zeros(3), REPORT)
@@ -219,7 +247,7 @@ def test_without_the_node_the_stylus_falls():
     simulated = _start(env, "sim-driver", "--driver", "sawsensablephantom", "--hold", "0.5",
                        "--theta0", *map(str, THETA0))
     try:
-        _wait_for(simulated, "released")
+        _wait_for(simulated, "released", watcher=watcher)
         watcher.spin(3.0)
         lowest = min(tip(theta)[1] for _, theta, _ in watcher.states)
         assert tip(THETA0)[1] - lowest > 10e-3

@@ -124,3 +124,35 @@ def test_a_users_force_moves_the_stylus_its_way(device, name):
     axis = ref.stylus_rotation(theta0, np.zeros(3))[:, 2]
     pushed = run(device, name, theta0, 0.1, user=("stylus", np.array([0.0, 0.0, 0.5])))
     assert (pushed[-1] - start) @ axis > 1e-3
+
+
+def test_the_state_topics_are_each_drivers_own_of_the_stylus_pose_and_velocity(device):
+    """HD_CURRENT_TRANSFORM of the stylus (Ubitrack's position and rotation of OpenHaptics' angles,
+    plus frame s's origin in OpenHaptics' coordinates from gimbal.yaml's openhaptics_shoulder, an
+    ESTIMATE) and its velocities (complex steps of Ubitrack's formulas along the joint rates), each
+    through the driver's own formula (driver_reference.STATE): 1e-12."""
+    import yaml
+
+    from gimbal_reference import derivative, openhaptics, ubitrack
+
+    shoulder = np.array(yaml.safe_load((ref.TOUCH / "gimbal.yaml").read_text())["openhaptics_shoulder"])
+    origin = shoulder - [0.0, ref.L2, -ref.L1]       # the zero posture's gimbal centre in OpenHaptics' frame
+    theta, gimbal, rates = np.array([0.15, 0.55, 0.62]), np.zeros(3), np.array([0.3, -0.2, 0.4])
+    position, rotation = ubitrack(openhaptics(theta, gimbal))
+
+    def along(function):   # d function(theta + s rates)/ds at s = 0, complex step
+        return derivative(lambda s: function(theta + s[0] * rates), np.zeros(1), 0)
+
+    velocity = along(lambda t: ubitrack(np.array([-t[0], t[1], t[2], 0, 0, 0], dtype=complex))[0])
+    spin = along(lambda t: ubitrack(np.array([-t[0], t[1], t[2], 0, 0, 0], dtype=complex))[1]) @ rotation.T
+    angular = np.array([spin[2, 1], spin[0, 2], spin[1, 0]])
+    seen = set()
+    for name in PROFILES:
+        simulation = DriverSimulation(device, profiles.load(name), theta)
+        simulation.q, simulation.v = list(theta), list(rates)
+        for spec, first, second in simulation.state_topics(gimbal):
+            kind, formula = ref.STATE[spec.topic]
+            want = formula(position + origin, rotation) if kind == "pose" else formula(velocity, angular)
+            assert np.abs(first - want[0]).max() < 1e-12 and np.abs(second - want[1]).max() < 1e-12, spec.topic
+            seen.add(spec.topic)
+    assert seen == set(ref.STATE)
