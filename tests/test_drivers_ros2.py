@@ -24,6 +24,7 @@ import driver_reference as ref
 from phantom_pin import Phantom, closed_form, profiles
 from phantom_pin.exceptions import MissingDataError
 from phantom_pin.ros2 import message_type
+from test_ros2 import _stop as stop
 
 
 def _installed(name: str) -> bool:
@@ -83,14 +84,8 @@ def _wait_for(process: subprocess.Popen, text: str, timeout: float = 60.0, watch
 
 
 def _stop(process: subprocess.Popen) -> tuple[int, str]:
-    process.send_signal(signal.SIGTERM)
-    try:
-        _, err = process.communicate(timeout=20)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        _, err = process.communicate()
-        raise AssertionError(f"{process.args} did not stop on SIGTERM: {err}") from None
-    return process.returncode, err
+    """SIGTERM, then the exit code and the log (test_ros2's, which fails on a process that stays)."""
+    return stop(process, signal.SIGTERM)
 
 
 class Watcher:
