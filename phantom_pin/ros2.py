@@ -92,6 +92,15 @@ class Output:
     model_positions: np.ndarray
 
 
+def _box(phantom: Phantom) -> tuple[np.ndarray, np.ndarray]:
+    """The box a message's angles must lie in (rad): the stops, and the gimbal's ranges where the
+    model has one, BEYOND wider on each side."""
+    stops, gimbal = phantom.config.limits.stops, phantom.config.gimbal
+    lower = np.array([*stops.lower, *(gimbal.lower if gimbal else ())]) - BEYOND
+    upper = np.array([*stops.upper, *(gimbal.upper if gimbal else ())]) + BEYOND
+    return lower, upper
+
+
 class DriverBridge:
     """The force path's computation, without ROS: a driver's joint_states (its profile's names,
     each with the description's prefix, exactly once; its conventions) to theta and g, a user's
@@ -105,10 +114,8 @@ class DriverBridge:
         self.frames = Frames(phantom)
         prefix = phantom.description.prefix
         self.names = tuple(prefix + n for n in profile.joint_states.names)
-        stops = phantom.config.limits.stops
         self.gimbal = phantom.config.gimbal
-        self.lower = np.array([*stops.lower, *(self.gimbal.lower if self.gimbal else ())]) - BEYOND
-        self.upper = np.array([*stops.upper, *(self.gimbal.upper if self.gimbal else ())]) + BEYOND
+        self.lower, self.upper = _box(phantom)
 
     def state(self, names: Sequence[str], positions: Sequence[float],
               velocity: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray | None]:
@@ -163,16 +170,13 @@ class Bridge:
             raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
         self.phantom = phantom
         self.prefix = prefix = phantom.description.prefix
-        config = phantom.config
-        self.gimbal = config.gimbal
+        self.gimbal = phantom.config.gimbal
         self.driver_names = tuple(prefix + n for n in drivers.JOINT_STATE_NAMES)
         self.driver_gimbal = tuple(prefix + n for n in drivers.GIMBAL_STATE_NAMES)
         self.model_arm = tuple(prefix + n for n in JOINTS)
         self.model_gimbal = tuple(prefix + n for n in GIMBAL_JOINTS)
         # box of each input angle: the stops a turn wide on each side (theta; the gimbal's ranges)
-        stops = config.limits.stops
-        self.lower = np.array([*stops.lower, *(self.gimbal.lower if self.gimbal else ())]) - BEYOND
-        self.upper = np.array([*stops.upper, *(self.gimbal.upper if self.gimbal else ())]) + BEYOND
+        self.lower, self.upper = _box(phantom)
         self.frames = Frames(phantom)   # every joint of the URDF, the gimbal free; frame s in base_link
         self.full, self.base_from_s = self.frames.full, self.frames.base_from_s
         self.model_names = tuple(self.full.tree.names[1:])
