@@ -53,7 +53,7 @@ error (%, signed) of the estimate (the projection's physical values, per joint) 
 written model, viscous / Coulomb, against the device's per joint; the delay (ms, estimated); the
 estimated torque gain of joint 2 relative to joint 1 +- its standard deviation, and whether
 identify corrected it (the device's is 1.02 under the torque constant's error); what identify
-does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), Fit.timing_warning(),
+does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), result.timing_warning(),
 each listed under the table); and whether the issue's goal (held-out <= 0.5 %, written friction
 within 10 %) is met. Progress goes to stderr.
 """
@@ -80,7 +80,8 @@ from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation
 from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.estimation import MIN_SPEED
+from phantom_pin.identification.filtering import MIN_SPEED
+from phantom_pin.identification.result import gain_warning, timing_warning
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
 #: The report-structured devices: each report parameter (parameterization.SYMBOLS) times its
@@ -397,7 +398,7 @@ def judge(figures: Figures, fit: Fit, row: Row, condition: Condition) -> None:
     # conditions: the log's torques times 1.02 are the applied ones, the gain to find)
     values, sigma = fit.gains_estimated
     row.gain = f"{values[1]:.4f} ± {sigma[1]:.1g}" + (" (corrected)" if fit.gains[1] != 1 else "")
-    warnings = [*fit.prediction.warnings(), *(w for w in (fit.timing_warning(), fit.gain_warning()) if w)]
+    warnings = [*fit.prediction.warnings(), *(w for w in (timing_warning(fit), gain_warning(fit)) if w)]
     if fit.problems:
         row.verdict, row.messages = "refused", fit.problems + tuple(warnings)
     elif warnings:

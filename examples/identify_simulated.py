@@ -19,6 +19,7 @@ import common
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.identification import estimate, optimise, simulation
 from phantom_pin.identification.overlays import overlay
+from phantom_pin.identification.result import recommendation
 
 #: The simulated device's friction (N m s/rad, N m) and torque noise (N m, 1 sigma).
 VISCOUS, COULOMB, NOISE = 6e-4, 0.012, 0.002
@@ -48,7 +49,7 @@ def main(argv: list[str] | None) -> None:
     for structure, fit in fits.items():
         print(f"{structure}: residual RMS per joint [N m] " + " ".join(f"{r:.3g}" for r in fit.rms)
               + "".join(f"; problem: {p}" for p in fit.problems))
-    print(fits["general"].recommendation() or "the report's structure suffices")
+    print(recommendation(fits["general"]) or "the report's structure suffices")
     # the held-out motion: each model's inverse dynamics and friction against the device's
     t = np.arange(5001) / 1000
     theta, dtheta, ddtheta = optimise(model, iterations=1, restarts=1, seed=7).trajectory(t)

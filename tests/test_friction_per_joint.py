@@ -25,7 +25,7 @@ from phantom_pin.config.types import JOINTS, Friction
 from phantom_pin.description.build import describe, driver_urdf
 from phantom_pin.device.plant import Plant
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
-from phantom_pin.identification import constants, estimation, overlay, write_overlay
+from phantom_pin.identification import Identification, constants, estimation, overlay
 from phantom_pin.identification import io as logs
 from phantom_pin.identification.structures import General, Report
 
@@ -273,7 +273,7 @@ def test_the_overlay_writes_each_joints_friction_and_reads_back(fit, tmp_path):
                                                 "per joint"]
     assert all(n.count("+-") == 3 and "joint3" in n for n in notes)
     path = tmp_path / "id.yaml"
-    write_overlay(path, fit, "exact", keys, notes)
+    Identification(fit, keys, notes, "exact", 1000.0, fit.samples, 20.0).write(path)
     assert describe(overrides=config.read_overrides(path)).config.actuation.friction == expected
 
 

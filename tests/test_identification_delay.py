@@ -15,7 +15,7 @@ from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import estimation, io, simulation
+from phantom_pin.identification import estimation, filtering, io, result, simulation
 from test_identification_end_to_end import COULOMB, VISCOUS, truth_overrides
 from test_identification_prior import PRIOR, error, sum_of_sines, truth_log
 
@@ -97,9 +97,9 @@ def test_the_timing_that_fits_better_is_recognised(device, held_log):
         print(kind, residual, residual[other] / residual[kind])
         # each fit reads both timings in joint 1's torque scale with its own gains: the same within 1 %
         assert min(residual, key=residual.get) == kind and residual == pytest.approx(wrong.timing_residual, rel=0.01)
-        assert right.timing_warning() is None
-        assert wrong.timing_warning().startswith(f"--torque-timing {other} fits the log worse than {kind} ")
-        assert f"torque timing: {kind} fits the log better with the given 0 ms delay" in right.timing_lines()[1]
+        assert result.timing_warning(right) is None
+        assert result.timing_warning(wrong).startswith(f"--torque-timing {other} fits the log worse than {kind} ")
+        assert f"torque timing: {kind} fits the log better with the given 0 ms delay" in result.timing_lines(right)[1]
 
 
 @pytest.mark.parametrize("value", [-0.006, float("nan"), float("inf"), "1ms", True, 0.2])
@@ -155,11 +155,11 @@ def test_min_speed_leaves_out_a_stribeck_peak(device):
     log = simulation.track(dev, t, theta, dtheta, tau, seed=1, disturbance=stribeck)
     states = random_states(CONFIG.limits, 500, 7)
     errors = {}
-    for speed in (estimation.MIN_SPEED, 0.05):
+    for speed in (filtering.MIN_SPEED, 0.05):
         fit = estimation.estimate(log, PRIOR, min_speed=speed)
         errors[speed] = (fit.x[-6:] / TRUE_FRICTION - 1, error(fit.written, truth, states))
         print(f"min_speed {speed}: friction errors {errors[speed][0]}, held-out {errors[speed][1]}")
-    assert np.abs(errors[estimation.MIN_SPEED][0][:3]).max() > 0.15 and errors[estimation.MIN_SPEED][1].max() > 0.01
+    assert np.abs(errors[filtering.MIN_SPEED][0][:3]).max() > 0.15 and errors[filtering.MIN_SPEED][1].max() > 0.01
     assert np.abs(errors[0.05][0][:3]).max() < 0.05 and np.abs(errors[0.05][0][3:]).max() < 0.01
     assert errors[0.05][1].max() < 5e-3
     for value in (0.0, -0.05, float("nan"), "fast", True):

@@ -155,7 +155,7 @@ BAD_LOGS = {
     "unrelated torques": (lambda r: _bad(r, tau=np.random.default_rng(0).permutation(r.log.tau)),
                           "the torques do not follow the motion"),
     "degrees": (lambda r: _bad(r, theta=np.degrees(r.log.theta)), "are they in degrees"),
-    "mN m": (lambda r: _bad(r, tau=1000 * r.log.tau), "are they in another unit"),
+    "mN m": (lambda r: _bad(r, tau=1000 * r.log.tau), "times the model's prediction along the motion: in mN m?"),
     # before: NumPy's overflow warnings and "SVD did not converge", naming nothing
     "angles scaled by 1e300": (lambda r: _bad(r, theta=1e300 * r.log.theta), "rad beyond the stops, more than a turn"),
     "torques scaled by 1e300": (lambda r: _bad(r, tau=1e300 * r.log.tau), "N m, more than 1000 N m: not joint torques"),
@@ -174,6 +174,34 @@ def test_a_bad_log_is_refused_in_one_line_and_nothing_is_written(run, case, tmp_
     code, out, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml")
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert not (tmp_path / "id.yaml").exists()
+
+
+#: The bad logs whose torques' size or sign shows against the prior's prediction without any fit.
+BEFORE_ANY_FIT = ("signs flipped", "one amplifier flipped", "mN m", "tau2 in another unit")
+
+
+@pytest.mark.parametrize("case", BEFORE_ANY_FIT)
+def test_a_wrong_unit_or_sign_is_refused_before_any_fit(run, case, monkeypatch):
+    """Fail fast (issue 39, 5): a log in mN m, with flipped signs or one joint in another unit is
+    refused by identify() with the same first line as the full pipeline's verdict, before the
+    timing, gains and fit stages run (they are replaced by a failure here); with accept=True the
+    pipeline runs and lists the same problem (the physical reason, independent of the stage)."""
+    from phantom_pin.identification import RefusedError, identify
+
+    make, message = BAD_LOGS[case]
+    log = make(run)
+
+    def unreachable(*args, **kwargs):
+        raise AssertionError("a costly stage ran before the refusal")
+
+    with monkeypatch.context() as patched:
+        patched.setattr(estimation, "solve_gains", unreachable)
+        patched.setattr(estimation, "estimate_delay", unreachable)
+        with pytest.raises(RefusedError) as refused:
+            identify(log, Phantom(), delay=None)        # identify's prior: the default model's
+    assert message in refused.value.problems[0], refused.value.problems
+    accepted = estimation.estimate(log, Phantom())
+    assert any(message in problem for problem in accepted.problems), accepted.problems
 
 
 def gains(output: str) -> np.ndarray:

@@ -16,7 +16,7 @@ import pytest
 from helpers import CONFIG
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import random_states
-from phantom_pin.identification import estimation, excitation, io, prediction, simulation
+from phantom_pin.identification import estimation, excitation, io, least_squares, prediction, simulation
 from phantom_pin.identification.structures import General
 from test_identification_end_to_end import COULOMB, VISCOUS, truth_overrides
 
@@ -230,7 +230,7 @@ def test_the_cad_device_identified_on_the_report_model_is_never_worse_than_the_p
 
 
 def test_the_estimate_with_the_prior_is_the_gauss_markov_formula():
-    """estimation._fit with a prior (beta_0, P) against the textbook formula on a seeded problem,
+    """least_squares.fit with a prior (beta_0, P) against the textbook formula on a seeded problem,
     beta = (A + P^-1)^-1 (Phi_w^T y_w / s^2 + P^-1 beta_0), covariance (A + P^-1)^-1, A the log's
     information (its own output, checked as Phi_w^T Phi_w / s^2 by the log alone's covariance):
     within 1e-9; a prior 1e6 times looser gives the log alone's beta within 1e-6 of its standard
@@ -241,33 +241,33 @@ def test_the_estimate_with_the_prior_is_the_gauss_markov_formula():
     y = phi @ truth + rng.normal(size=(200, 3)) * [0.1, 0.2, 0.05]
     root = rng.normal(size=(5, 5))
     spread, beta0 = root @ root.T * 0.01, truth + rng.normal(size=5) * 0.3
-    beta, covariance, _, weight, information, alone = estimation._fit(phi, y, prior=(beta0, spread))
+    beta, covariance, _, weight, information, alone = least_squares.fit(phi, y, prior=(beta0, spread))
     inverse = np.linalg.inv(spread)
-    log_covariance = estimation._fit(phi, y)[1]
+    log_covariance = least_squares.fit(phi, y)[1]
     np.testing.assert_allclose(np.linalg.inv(log_covariance), information, rtol=1e-9)
     expected = np.linalg.solve(information + inverse, information @ alone + inverse @ beta0)
     np.testing.assert_allclose(beta, expected, rtol=1e-9)
     np.testing.assert_allclose(covariance, np.linalg.inv(information + inverse), rtol=1e-9, atol=1e-15)
     sigma = np.sqrt(np.diag(log_covariance))
-    loose = estimation._fit(phi, y, prior=(beta0, spread * 1e12))[0]
+    loose = least_squares.fit(phi, y, prior=(beta0, spread * 1e12))[0]
     assert (np.abs(loose - alone) < 1e-6 * sigma).all()
-    tight = estimation._fit(phi, y, prior=(beta0, spread * 1e-12))[0]
+    tight = least_squares.fit(phi, y, prior=(beta0, spread * 1e-12))[0]
     np.testing.assert_allclose(tight, beta0, rtol=1e-6)
 
 
 def test_the_log_alones_covariance_is_infinite_where_it_sees_nothing():
-    """estimation.inverse_information: the inverse of a nonsingular information (units 1e-12 to
+    """least_squares.inverse_information: the inverse of a nonsingular information (units 1e-12 to
     1e6 apart) within 1e-9, in the units that balance its diagonal; a singular one gives inf on
     the variance of each parameter its null direction (a + b) involves, the inverse elsewhere."""
     rng = np.random.default_rng(4)
     root = rng.normal(size=(3, 3)) * [1e3, 1.0, 1e-6]
     information = root.T @ root
     d = np.sqrt(np.diag(information))                  # compared in the units that balance it
-    scaled = (estimation.inverse_information(information) * np.outer(d, d)) @ (information / np.outer(d, d))
+    scaled = (least_squares.inverse_information(information) * np.outer(d, d)) @ (information / np.outer(d, d))
     np.testing.assert_allclose(scaled, np.eye(3), atol=1e-9)
     v = np.array([[1, 1, 0], [1, -1, 0], [0, 0, np.sqrt(2)]]) / np.sqrt(2)
     singular = v.T @ np.diag([0.0, 4.0, 100.0]) @ v
-    variance = np.diag(estimation.inverse_information(singular))
+    variance = np.diag(least_squares.inverse_information(singular))
     assert np.isinf(variance[:2]).all() and variance[2] == pytest.approx(0.01, rel=1e-12)
 
 

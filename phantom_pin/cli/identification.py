@@ -14,8 +14,8 @@ from phantom_pin.cli.common import Once, description, overrides, warn
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import estimation, excitation, io, prior
-from phantom_pin.identification.overlays import overlay, write_overlay
+from phantom_pin.identification import excitation, filtering, io, prior, timing
+from phantom_pin.identification.result import RefusedError, identify, refusal
 from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
@@ -55,14 +55,14 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
 
 
 def _delay(text: str | None) -> float | None:
-    """--delay's seconds (None: estimate it), checked by estimation.delay_argument."""
+    """--delay's seconds (None: estimate it), checked by timing.delay_argument."""
     if text is None:
         return None
     try:
         value = float(text)
     except ValueError:
         raise PhantomPinError(f"--delay: expected seconds (a number such as 0.001), got {text!r}") from None
-    return estimation.delay_argument(value)
+    return timing.delay_argument(value)
 
 
 def add_parsers(sub: argparse._SubParsersAction) -> None:
@@ -93,9 +93,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "
                                "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
-    identify.add_argument("--min-speed", type=float, default=estimation.MIN_SPEED, metavar="RAD_PER_S",
+    identify.add_argument("--min-speed", type=float, default=filtering.MIN_SPEED, metavar="RAD_PER_S",
                           help="fit a joint's torques only where its rate stays above this over the filter's span "
-                               f"(default {estimation.MIN_SPEED:g} rad/s: near rest a joint sticks); 0.05 for a "
+                               f"(default {filtering.MIN_SPEED:g} rad/s: near rest a joint sticks); 0.05 for a "
                                "friction with a Stribeck peak after breakaway (docs/identification.md, step 4)")
     identify.add_argument("--fixed-gains", action="store_true",
                           help="take the log's torques as they are (default: estimate each joint's torque gain "
@@ -197,47 +197,19 @@ def identify_command(args: argparse.Namespace) -> int:
     log = io.read_log(args.log, args.convention)
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
-        fit = estimation.estimate(log, phantom, args.cutoff, args.structure, progress=bar.update,
-                                  timing=args.torque_timing, prior_spread=args.prior_spread, delay=delay,
-                                  gains=not args.fixed_gains, min_speed=args.min_speed)
+        result = identify(log, phantom, cutoff=args.cutoff, structure=args.structure, timing=args.torque_timing,
+                          prior_spread=args.prior_spread, delay=delay, gains=not args.fixed_gains,
+                          min_speed=args.min_speed, accept=args.accept, given=given, source=args.log.name,
+                          progress=bar.update)
+    except RefusedError as error:
+        raise PhantomPinError(f"{refusal(error.problems)}; nothing written (--accept writes it anyway)") from None
     finally:
         bar.close()
-    if fit.problems and not args.accept:
-        more = f" (and {len(fit.problems) - 1} more)" if len(fit.problems) > 1 else ""
-        raise PhantomPinError(f"{fit.problems[0]}{more}; nothing written (--accept writes it anyway)")
-    keys, notes = overlay(fit, given, phantom.config)  # checked: a physical model, or nothing written
-    print(f"{log.t.size} samples at {log.rate:.6g} Hz, {fit.samples} used (filtered at {args.cutoff:g} Hz); "
-          f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
-          "(a diagnostic: the fit is judged by its predicted torques)")
-    for line in fit.timing_lines() + fit.gain_lines():
+    for line in result.report():
         print(line)
-    for line in fit.prediction.lines():
-        print(line)
-    print("residual RMS per joint [N m]: " + ", ".join(
-        f"{r:.3g} ({100 * r / s:.2f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms))
-          + "; of the written parameters: " + ", ".join(f"{r:.3g}" for r in fit.written_rms))
-    if fit.comparison is not None:
-        name, rms = fit.comparison
-        print(f"the {name} structure leaves " + ", ".join(f"{r:.3g}" for r in rms) + " N m RMS ("
-              + ", ".join(f"{100 * r / s:.2f} %" for r, s in zip(rms, fit.torque_rms)) + ")")
-    recommendation = fit.recommendation()
-    if recommendation:
-        print(f"recommendation: {recommendation}")
-    elif fit.comparison is not None:
-        print(f"the report's structure suffices for this log (within {estimation.NEEDS_GENERAL} times the general "
-              "model's residual on every joint)")
-    print(f"{'':6} {'estimate':>12} {'std dev':>10} {'written':>12} {'log alone':>12} {'prior':>12}  {'unit':9} "
-          "base parameter")
-    for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
-        print(f"beta{k + 1:<2} {fit.beta[k]:12.5g} {fit.sigma[k]:10.2g} {fit.written[k]:12.5g} {fit.log_beta[k]:12.5g} "
-              f"{fit.prior_beta[k]:12.5g}  {unit:9} {name}")
-    for note in notes:
-        print(note)
-    for warning in fit.prediction.warnings() + [w for w in (fit.timing_warning(), fit.gain_warning()) if w]:
+    for warning in result.warnings():
         warn(warning)              # on stderr, as every command's (and in the overlay's header)
-    for problem in fit.problems:
-        warn(f"(written with --accept) {problem}")
-    write_overlay(args.output, fit, args.log.name, keys, notes)
+    result.write(args.output, force=True)     # --output checked above, before any work
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
     print(f"wrote {args.output} (phantom-pin {chosen}urdf --params {args.output} -o my_phantom.urdf)")

@@ -1,18 +1,15 @@
 """A Fit (estimation.estimate) as a --params overlay: the keys of the identified bodies, each
-joint's friction, and what the fit is only valid with (its model and lengths),
-written as a YAML file with the fit in comments (docs/identification.md, step 9)."""
+joint's friction, and what the fit is only valid with (its model and lengths); result.py
+writes them as a YAML file with the fit in comments (docs/identification.md, step 9)."""
 
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
-
-import numpy as np
 
 from phantom_pin.config import MODEL_KEY, MODELS, REPORT_SEGMENTS, Config, section
 from phantom_pin.description.build import describe
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
-from phantom_pin.identification.estimation import Fit
+from phantom_pin.identification.fit import Fit
 
 
 def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
@@ -70,31 +67,3 @@ def _friction_key(key: object) -> bool:
     """Whether an override key names actuation.yaml's friction (any of its forms)."""
     parts = str(key).split(".")
     return parts[1 if parts[0] == "actuation" else 0:][:1] == ["friction"]
-
-
-def write_overlay(path: Path | str, fit: Fit, source: str, keys: dict[str, object], notes: list[str]) -> None:
-    """Write an identification (estimation.Fit) as a --params YAML file (dotted keys, SI units):
-    the ``keys`` and ``notes`` that ``overlay`` gave, with the fit in comments; ``source``
-    names the log."""
-    lines = [f"# Identified by phantom-pin identify from {source} ({fit.structure} structure): a --params",
-             "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
-             "# (docs/identification.md). SI units.",
-             f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
-             "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms)]
-    lines += [f"# {line}" for line in fit.timing_lines()]
-    lines += [f"# {line}" for line in fit.gain_lines()]
-    lines += [f"# warning: {w}" for w in (fit.timing_warning(), fit.gain_warning()) if w is not None]
-    lines += [f"# {line}" for line in fit.prediction.lines()]
-    lines += [f"# warning: {line}" for line in fit.prediction.warnings()]
-    lines += ["# base parameters (estimate with the prior +- standard deviation; of the written parameters; "
-              "of the log alone; the prior's):"]
-    for k, (name, unit) in enumerate(zip(fit.names, fit.units)):
-        lines.append(f"#   beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written "
-                     f"{fit.written[k]:.6g}; log alone {fit.log_beta[k]:.6g}; prior {fit.prior_beta[k]:.6g}: {name}")
-    lines += [f"# {note}" for note in notes]
-    lines += [f"# problem, written with --accept: {problem}" for problem in fit.problems]
-    lines += ["# What the log does not excite comes from the model's values (the prior, within its stated "
-              f"{100 * fit.prediction.spread:.0f} % spread)." if np.isfinite(fit.prediction.spread) else
-              "# Directions the torques do not determine are kept near the model's values (the prior)."]
-    lines += [f"{key}: {value!r}" for key, value in keys.items()]
-    Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
