@@ -9,12 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import drivers
+from phantom_pin import drivers, profiles
 from phantom_pin.cli.common import Once, description, overrides, warn
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import excitation, filtering, io, prior, timing
+from phantom_pin.identification import bags, excitation, filtering, io, prior, timing
 from phantom_pin.identification.result import RefusedError, identify, refusal
 from phantom_pin.progress import Progress
 
@@ -54,6 +54,32 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
                               argument="--output")
 
 
+def _recording(args: argparse.Namespace) -> bags.Recording | None:
+    """The bag LOG names (its driver profile's JointState: bags.read_bag), or None for a CSV log."""
+    if not bags.is_bag(args.log):
+        if args.driver is not None or args.topic is not None:
+            raise PhantomPinError(f"{args.log} is a CSV log, not a rosbag2 recording: --driver and --topic read bags",
+                                  argument="--driver" if args.driver is not None else "--topic")
+        return None
+    if args.convention != "report":
+        raise PhantomPinError("a bag's conventions are its driver profile's (--driver)", argument="--convention")
+    return bags.read_bag(args.log, args.driver, args.topic)
+
+
+def _held_stylus(gimbal: np.ndarray) -> dict[str, float]:
+    """The overrides that put the model's stylus at a recording's gimbal angles (rad, (N, 3)):
+    their median, where the stylus is held still (bags.STYLUS_SPREAD); PhantomPinError where it
+    swings further (its load then moves with it, which a locked stylus does not model)."""
+    middle = np.median(gimbal, axis=0)
+    spread = np.abs(gimbal - middle).max(axis=0)
+    if (spread > bags.STYLUS_SPREAD).any():
+        j = int(np.argmax(spread))
+        raise PhantomPinError(f"the stylus's gimbal angle {j + 1} swings {spread[j]:.3g} rad about its median in the "
+                              f"bag (at most {bags.STYLUS_SPREAD:g} rad): identify with the stylus held still (taped "
+                              "or docked), its load is modelled locked", argument="LOG")
+    return {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(middle)}
+
+
 def _delay(text: str | None) -> float | None:
     """--delay's seconds (None: estimate it), checked by timing.delay_argument."""
     if text is None:
@@ -87,7 +113,12 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
                                                          "prior_spread": "--prior-spread", "delay": "--delay",
                                                          "min_speed": "--min-speed"})
-    identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3")
+    identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3, or a "
+                                                 "driver's rosbag2 recording (a folder, or its .mcap/.db3 file)")
+    identify.add_argument("--driver", choices=profiles.names(), default=None,
+                          help="the driver profile that recorded the bag (default: recognised by its joint names)")
+    identify.add_argument("--topic", default=None,
+                          help="the bag's sensor_msgs/JointState topic (default: the driver's, or the bag's only one)")
     identify.add_argument("--output", "-o", required=True, type=Path, action=Once)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
@@ -185,8 +216,13 @@ def identify_command(args: argparse.Namespace) -> int:
     _refuse(args.output, args.force)
     _writable(args.output)
     _suffix(args.output, (".yaml", ".yml"), "a YAML overlay")
+    recording = _recording(args)
     given = overrides(args)
-    phantom = Phantom(description(args, given))
+    made = description(args, given)
+    if recording is not None and made.config.gimbal is not None:
+        given = {**given, **_held_stylus(recording.gimbal)}    # the stylus's load at the bag's gimbal angles
+        made = description(args, given)
+    phantom = Phantom(made)
     if args.structure == "report" and phantom.config.report is None:
         how = " with its --params/--set overrides" if given else ""
         raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name}{how} "
@@ -194,7 +230,9 @@ def identify_command(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.cutoff) and args.cutoff > 0):
         raise PhantomPinError(f"--cutoff: expected a finite positive frequency (Hz), got {args.cutoff!r}")
     delay = _delay(args.delay)
-    log = io.read_log(args.log, args.convention)
+    log = io.read_log(args.log, args.convention) if recording is None else recording.log
+    for line in [] if recording is None else recording.lines():
+        print(line)
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
     try:
         result = identify(log, phantom, cutoff=args.cutoff, structure=args.structure, timing=args.torque_timing,
