@@ -9,13 +9,14 @@ import shutil
 import subprocess
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from phantom_pin import Device, Phantom, describe, simulate
 from phantom_pin.cli import main
 from phantom_pin.codegen import header, write_header
 from phantom_pin.codegen.generate import committed_header
-from phantom_pin.config import models
+from phantom_pin.config import MODELS, models
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 
@@ -46,6 +47,8 @@ LOOP(jacobian_transpose_force, phantom_jacobian_transpose_force(a + 3 * k, b + 3
 LOOP(theta_from_openhaptics, phantom_theta_from_openhaptics(a + 3 * k, out + 3 * k))
 LOOP(openhaptics_torque_from_tau, phantom_openhaptics_torque_from_tau(a + 3 * k, out + 3 * k))
 """
+#: The header of a model with a stylus gimbal: its pose, (p, R) as 12 numbers per state.
+STYLUS_SHIM = "LOOP(stylus_pose, phantom_stylus_pose(a + 3 * k, b + 3 * k, out + 12 * k, out + 12 * k + 3))\n"
 
 
 @functools.cache
@@ -59,14 +62,14 @@ def generated(name, prefix="phantom", overrides=None):
     return _generated(name, prefix, tuple(sorted((overrides or {}).items())))
 
 
-def build(text, folder):
-    """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the shim as a
+def build(text, folder, shim=SHIM):
+    """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the ``shim`` as a
     shared library (-O2); returns the ctypes library. Fails in one line without gcc and g++."""
     if not (shutil.which("gcc") and shutil.which("g++")):
         pytest.fail("gcc and g++ compile the header: apt-get install g++ (.ci/run installs it)", pytrace=False)
     (folder / "model.h").write_text(text)
-    (folder / "shim.c").write_text(SHIM)
-    (folder / "shim.cpp").write_text(SHIM)
+    (folder / "shim.c").write_text(shim)
+    (folder / "shim.cpp").write_text(shim)
     subprocess.run([*STRICT_C, "-O2", "-fPIC", "-shared", "shim.c", "-o", "libmodel.so", "-lm"],
                    cwd=folder, check=True, capture_output=True, text=True)
     subprocess.run([*STRICT_CXX, "-O2", "-c", "shim.cpp", "-o", "shim_cpp.o"], cwd=folder, check=True,
@@ -119,6 +122,40 @@ def test_every_function_matches_pinocchio(name, overlay, tmp_path):
     assert max(errors.values()) <= TOLERANCE, errors
     mass = call(library, "mass_matrix", 9, theta).reshape(-1, 3, 3)
     assert np.array_equal(mass, mass.transpose(0, 2, 1))  # symmetric by construction
+
+
+def test_the_stylus_pose_matches_phantom_and_pinocchio_on_the_touch_urdf(tmp_path):
+    """The Touch header's stylus_pose, compiled with -Werror as C99 and C++17, equals
+    Phantom.stylus_pose and, independently of Phantom's model rooted at frame s, Pinocchio's
+    placement of the URDF frame stylus relative to report_s (oMf, the committed Touch URDF with
+    its mimic joints) to 1e-12 (m and rotation entries) over 1000 seeded states, theta inside
+    the stops and the gimbal inside its ranges; R is a rotation. The headers of the models
+    without a gimbal have no such function."""
+    description = describe("touch")
+    library = build(generated("touch"), tmp_path, SHIM + STYLUS_SHIM)
+    theta = random_states(description.config.limits, N_STATES, seed=32)[0]
+    gimbal_range = description.config.gimbal
+    gimbal = np.random.default_rng(33).uniform(gimbal_range.lower, gimbal_range.upper, (N_STATES, 3))
+    out = call(library, "stylus_pose", 12, theta, gimbal)
+    position, rotation = out[:, :3], out[:, 3:].reshape(-1, 3, 3)
+    phantom = Phantom(description).stylus_pose(theta, gimbal)
+    model = pin.buildModelFromXML(MODELS["touch"].urdf.read_text(), mimic=True)
+    data = model.createData()
+    index = [model.joints[model.getJointId(f"joint{j}")].idx_q for j in range(1, 7)]
+    s, stylus = model.getFrameId("report_s"), model.getFrameId("stylus")
+    urdf = np.empty((N_STATES, 4, 4))
+    for k, angles in enumerate(np.hstack([theta, gimbal])):
+        q = pin.neutral(model)
+        q[index] = angles
+        pin.framesForwardKinematics(model, data, q)
+        urdf[k] = (data.oMf[s].inverse() * data.oMf[stylus]).homogeneous
+    for reference in (phantom, urdf):
+        assert np.abs(position - reference[:, :3, 3]).max() <= TOLERANCE
+        assert np.abs(rotation - reference[:, :3, :3]).max() <= TOLERANCE
+    assert np.abs(rotation @ rotation.transpose(0, 2, 1) - np.eye(3)).max() < 1e-14
+    assert np.abs(np.linalg.det(rotation) - 1).max() < 1e-14
+    for name in ("premium_1_5", "premium_1_5_cad"):
+        assert "_stylus_pose" not in generated(name)
 
 
 def test_openhaptics_helpers_follow_the_published_conventions(tmp_path):

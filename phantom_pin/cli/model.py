@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import os
 import webbrowser
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,16 +22,23 @@ from phantom_pin.cli.common import (
     positive_integer,
     show,
     vector,
+    warn,
     warn_limits,
     write_text,
 )
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.exceptions import LogError, PhantomPinError
+from phantom_pin.identification import io
 from phantom_pin.progress import Progress
+from phantom_pin.validation import within_box
 
 THREE = {"nargs": 3, "type": float}
+#: The columns show --trajectory reads (s, rad: the report's theta), and a stylus gimbal's
+#: (rad, OpenHaptics' raw gimbal angles), optional.
+MOTION_COLUMNS = ("t", "theta1", "theta2", "theta3")
+GIMBAL_COLUMNS = ("gimbal1", "gimbal2", "gimbal3")
 def info(args: argparse.Namespace) -> int:
     """Joints, links, rotor and device data of the model, with their sources."""
     given = overrides(args)
@@ -153,13 +161,69 @@ def write(args: argparse.Namespace) -> int:
     return 0
 
 
+def _read_motion(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """(t (N,) s, theta (N, 3) rad, gimbal (N, 3) rad or None) of show's --trajectory file: a
+    CSV in the dialects identify reads, with the columns MOTION_COLUMNS and, optionally, all of
+    GIMBAL_COLUMNS; PhantomPinError naming --trajectory otherwise (some gimbal columns but not
+    all, times not strictly increasing, fewer than two rows)."""
+    try:
+        try:
+            _, column = io._read_table(path, MOTION_COLUMNS + GIMBAL_COLUMNS)
+            gimbal = np.column_stack([column[name] for name in GIMBAL_COLUMNS])
+        except LogError as error:
+            lines, column = io._read_table(path, MOTION_COLUMNS)  # the file's own error, if it has one
+            if "gimbal" in lines[0][1].lower():
+                raise error from None  # some of the gimbal's columns, not all, or one twice
+            gimbal = None
+    except LogError as error:
+        raise PhantomPinError(error.detail, argument="--trajectory") from None
+    t = column["t"]
+    if len(t) < 2 or not (np.diff(t) > 0).all():
+        raise PhantomPinError(f"{path}: expected two rows or more, times t (s) strictly increasing",
+                              argument="--trajectory")
+    return t, np.column_stack([column[name] for name in MOTION_COLUMNS[1:]]), gimbal
+
+
+def _warn_motion(t: np.ndarray, angles: np.ndarray, lower: np.ndarray, upper: np.ndarray, what: str) -> None:
+    """One warning line on stderr if some of ``angles`` (N, 3) rad at ``t`` (s) are outside
+    the box limits: how many, and the first."""
+    outside = np.flatnonzero(~within_box(angles, lower, upper))
+    if outside.size:
+        first = outside[0]
+        warn(f"--trajectory: {what} is outside the joint limits {vector(lower, '{:.6g}')}..{vector(upper, '{:.6g}')}"
+             f" rad at {outside.size} of {len(t)} samples, first at t = {t[first]:.6g} s: "
+             f"{vector(angles[first], '{:.6g}')} rad (shown anyway)")
+
+
+def _motion(args: argparse.Namespace, robot: Any) -> tuple[np.ndarray, np.ndarray, object]:
+    """(times, theta, gimbal) that show plays for --trajectory: the file's gimbal columns, or
+    --gimbal held throughout (None: zero); samples outside the limits warned about."""
+    if args.theta is not None:
+        raise PhantomPinError("--trajectory gives the postures; give one or the other", argument="--theta")
+    t, theta, gimbal = _read_motion(args.trajectory)
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit  # the arm's, then a gimbal's
+    _warn_motion(t, theta, lower[:3], upper[:3], "theta")
+    if gimbal is None:
+        return t, theta, args.gimbal
+    if robot.model.nq == 3:
+        raise PhantomPinError(f"{args.trajectory} has gimbal columns, but this model has no stylus gimbal",
+                              argument="--trajectory")
+    if args.gimbal is not None:
+        raise PhantomPinError("the --trajectory file's gimbal columns give the gimbal's angles; give one or the other",
+                              argument="--gimbal")
+    _warn_motion(t, gimbal, lower[3:], upper[3:], "gimbal")
+    return t, theta, gimbal
+
+
 def show_command(args: argparse.Namespace) -> int:
-    """The arm in meshcat: a live viewer on 127.0.0.1 until Ctrl-C, or --html FILE."""
+    """The arm in meshcat: a live viewer on 127.0.0.1 until Ctrl-C, or --html FILE; a posture,
+    or the motion of --trajectory."""
     from phantom_pin.viewer import Viewer  # meshcat is only needed here
 
     if args.html is not None:
         output(args, "--html")
     robot = load(description(args))
+    motion = None if args.trajectory is None else _motion(args, robot)
     lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit  # the arm's, then a gimbal's
     if args.theta is not None:
         warn_limits(args.theta, lower[:3], upper[:3])
@@ -168,7 +232,11 @@ def show_command(args: argparse.Namespace) -> int:
     with Viewer(robot) as viewer:
         if args.tip_force is not None:
             viewer.set_force(args.tip_force)
-        viewer.show(robot.q0[:3] if args.theta is None else args.theta, args.gimbal)
+        if motion is None:
+            viewer.show(robot.q0[:3] if args.theta is None else args.theta, args.gimbal)
+        else:
+            times, theta, gimbal = motion
+            viewer.animate(times, theta, gimbal=gimbal)
         if args.html is not None:
             print(f"wrote {viewer.export_html(args.html, force=args.force)}")
             return 0
@@ -232,6 +300,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                          **THREE)
     command.add_argument("--gimbal", metavar="G", help="a stylus gimbal's angles (rad, OpenHaptics' raw "
                                                        "gimbal angles; the Touch; default 0)", **THREE)
+    command.add_argument("--trajectory", type=Path, metavar="FILE",
+                         help="play a motion: a CSV with the columns t, theta1, theta2, theta3 (s, rad; "
+                              "simulate's output, a log and excite's trajectory have them) and, for a stylus "
+                              "gimbal, gimbal1, gimbal2, gimbal3 (rad, OpenHaptics' raw gimbal angles; "
+                              "without them, --gimbal is held)")
     command.add_argument("--html", help="write a self-contained HTML file instead of serving")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --html file")
     command.add_argument("--open", action="store_true", help="open the live viewer in a browser")

@@ -8,7 +8,9 @@ returns to the primary joint times the multiplier (tau = G^T tau_tree). Gravity 
 at zero rates, the mass matrix the passes at unit accelerations without gravity (plus the
 rotors' armature on the diagonal), the Coriolis vector the pass at zero accelerations without
 gravity. The tip's position in the report's frame s is the product of the joint transforms,
-its Jacobian the exact derivative. SymPy's common-subexpression elimination and C printer
+its Jacobian the exact derivative; a model with a stylus gimbal also gets the stylus frame's
+pose in frame s, the product of the transforms with the gimbal's joints free (the dynamics
+hold them at locked_at). SymPy's common-subexpression elimination and C printer
 write each function as straight-line double arithmetic (literals with 17 significant digits).
 """
 
@@ -23,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from phantom_pin.config import MODELS
+from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.description.gimbal import locked
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
@@ -36,8 +39,9 @@ except ImportError:  # pragma: no cover - the codegen extra
 
 #: The independent joints the header covers: the arm's three (the report's theta1..theta3).
 ARM_JOINTS = ("joint1", "joint2", "joint3")
-#: The URDF links of the report's frame s and of the tip (the gimbal's centre).
-FRAME_S, TIP = "report_s", "tip"
+#: The URDF links of the report's frame s, of the tip (the gimbal's centre) and of the stylus
+#: frame (a model with a stylus gimbal; Phantom.stylus_pose's).
+FRAME_S, TIP, STYLUS = "report_s", "tip", "stylus"
 
 
 def committed_header(name: str) -> Path:
@@ -98,8 +102,10 @@ def _floats(text: str) -> tuple[float, float, float]:
     return x, y, z
 
 
-def _read_urdf(urdf: str, prefix: str) -> tuple[str, list[_Joint], dict[str, _Link]]:
-    """(root link, joints in topological order, links with an inertial) of a URDF text."""
+def _read_urdf(urdf: str, prefix: str, independent: tuple[str, ...] = ARM_JOINTS
+               ) -> tuple[str, list[_Joint], dict[str, _Link]]:
+    """(root link, joints in topological order, links with an inertial) of a URDF text; the
+    joints ``independent`` (without ``prefix``) are the coordinates, in that order."""
     root = ET.fromstring(urdf)
     links: dict[str, _Link] = {}
     for link in root.findall("link"):
@@ -110,7 +116,7 @@ def _read_urdf(urdf: str, prefix: str) -> tuple[str, list[_Joint], dict[str, _Li
             links[_get(link, "", "name")] = _Link(
                 float(_get(inertial, "mass", "value")), _floats(_get(inertial, "origin", "xyz", "0 0 0")),
                 _floats(_get(inertial, "origin", "rpy", "0 0 0")), (ixx, ixy, ixz, iyy, iyz, izz))
-    arm = [prefix + name for name in ARM_JOINTS]
+    arm = [prefix + name for name in independent]
     joints = []
     for joint in root.findall("joint"):
         name, kind = _get(joint, "", "name"), _get(joint, "", "type")
@@ -127,7 +133,7 @@ def _read_urdf(urdf: str, prefix: str) -> tuple[str, list[_Joint], dict[str, _Li
         multiplier = float(_get(joint, "mimic", "multiplier", "1"))
         offset = float(_get(joint, "mimic", "offset", "0"))
         if primary not in arm:
-            raise ParameterFileError(f"joint {name}: codegen covers the arm's joints {', '.join(arm)} "
+            raise ParameterFileError(f"joint {name}: codegen covers the joints {', '.join(arm)} "
                                      f"(and joints that mimic them), not {primary}")
         joints.append(_Joint(name, parent, child, xyz, rpy, (x / norm, y / norm, z / norm), arm.index(primary),
                              multiplier, offset))
@@ -152,14 +158,18 @@ def _num(value: float) -> Any:
     return sp.Float(value, 17)
 
 
-def _rpy(rpy: tuple[float, float, float]) -> Any:
-    """URDF's fixed-axis roll-pitch-yaw rotation Rz(y) Ry(p) Rx(r), numeric."""
+def _rpy(rpy: tuple[float, float, float], exact: bool = False) -> Any:
+    """URDF's fixed-axis roll-pitch-yaw rotation Rz(y) Ry(p) Rx(r), numeric; ``exact``: entries
+    within 1e-15 of 0 or +-1 (the URDF's 1.5707963267948966 is pi/2 to 6e-17) taken as
+    exactly that, so that they drop out of the products instead of adding terms of 6e-17."""
     r, p, y = rpy
     cr, sr, cp, sp_, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
     rows = ((cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr),
             (sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr),
             (-sp_, cp * sr, cp * cr))
-    return sp.Matrix([[_num(v) for v in row] for row in rows])
+    def snapped(v: float) -> float:
+        return float(round(v)) if exact and abs(v - round(v)) < 1e-15 else v
+    return sp.Matrix([[_num(snapped(v)) for v in row] for row in rows])
 
 
 def _rotation(axis: tuple[float, float, float], angle: Any) -> Any:
@@ -175,12 +185,17 @@ def _cross(a: Any, b: Any) -> Any:
 
 
 class _Model:
-    """The URDF's tree with its constants as SymPy matrices, for the symbolic passes."""
+    """The URDF's tree with its constants as SymPy matrices, for the symbolic passes; a stylus
+    gimbal held at locked_at, as Phantom holds it, or, ``free``, its joints coordinates 3..5
+    (for the stylus's pose only: rnea covers the arm's three). ``exact``: the joints' fixed
+    rotations by multiples of pi/2 exact (_rpy's)."""
 
-    def __init__(self, description: Description) -> None:
-        gimbal = description.config.gimbal  # a stylus gimbal: held at locked_at, as Phantom holds it
-        urdf = description.urdf if gimbal is None else locked(description.urdf, description.prefix, gimbal.locked_at)
-        self.root, self.joints, links = _read_urdf(urdf, description.prefix)
+    def __init__(self, description: Description, free: bool = False, exact: bool = False) -> None:
+        gimbal = description.config.gimbal
+        urdf = description.urdf if gimbal is None or free else \
+            locked(description.urdf, description.prefix, gimbal.locked_at)
+        self.root, self.joints, links = _read_urdf(urdf, description.prefix,
+                                                   ARM_JOINTS + GIMBAL_JOINTS if free else ARM_JOINTS)
         self.gravity = _num(description.config.gravity)
         self.armature = [_num(a) for a in description.config.actuation.armature]
         self.links = {}
@@ -190,16 +205,21 @@ class _Model:
             inertia = sp.Matrix([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]).applyfunc(_num)
             self.links[name] = (_num(link.mass), sp.Matrix([_num(v) for v in link.com]),
                                 rotation * inertia * rotation.T)
-        self.placements = {j.name: (_rpy(j.rpy), sp.Matrix([_num(v) for v in j.xyz])) for j in self.joints}
+        self.placements = {j.name: (_rpy(j.rpy, exact), sp.Matrix([_num(v) for v in j.xyz])) for j in self.joints}
+
+    @staticmethod
+    def angle(joint: _Joint, theta: list[Any]) -> Any:
+        """A joint's angle (rad): multiplier * its coordinate + offset (0 for a fixed joint)."""
+        if joint.coordinate is None:
+            return sp.Integer(0)
+        return _num(joint.multiplier) * theta[joint.coordinate] + _num(joint.offset)
 
     def rotation(self, joint: _Joint, theta: list[Any]) -> Any:
         """The child frame's orientation in the parent's (parent -> child rotation)."""
         fixed = self.placements[joint.name][0]
         if joint.axis is None:
             return fixed
-        assert joint.coordinate is not None
-        angle = _num(joint.multiplier) * theta[joint.coordinate] + _num(joint.offset)
-        return fixed * _rotation(joint.axis, angle)
+        return fixed * _rotation(joint.axis, self.angle(joint, theta))
 
     def rnea(self, theta: list[Any], dtheta: list[Any], ddtheta: list[Any], gravity: bool) -> list[Any]:
         """Joint torques (N m) on theta of the tree with every mimic joint following its
@@ -256,6 +276,28 @@ class _Model:
             rotation, origin = r * rotation, r * origin + t
             link = joint.parent
         return rotation, origin
+
+    def merged_pose(self, link: str, theta: list[Any]) -> tuple[Any, Any]:
+        """pose(link, theta) with the rotations of consecutive joints about one axis (and no
+        fixed rotation between them) merged into one rotation by the sum of their angles: the
+        parallelogram's mimic joints then cancel (-theta3 + theta2 - theta2 + theta3) instead
+        of leaving sums of sin^2 and cos^2. The same transform in far fewer operations (the
+        committed headers' tip position keeps pose()'s product, whose text they are)."""
+        by_child = {j.child: j for j in self.joints}
+        chain = []
+        while link != self.root:
+            chain.append(by_child[link])
+            link = chain[-1].parent
+        fixed, axis, angle, origin = sp.eye(3), None, sp.Integer(0), sp.zeros(3, 1)
+        for joint in reversed(chain):  # root outwards: x_root = R x_child + origin
+            placement, t = self.placements[joint.name]
+            rotation = fixed if axis is None else fixed * _rotation(axis, angle)
+            origin = origin + rotation * t
+            if placement == sp.eye(3) and joint.axis in (None, axis):  # one more turn about axis
+                angle = angle + self.angle(joint, theta)
+            else:
+                fixed, axis, angle = rotation * placement, joint.axis, self.angle(joint, theta)
+        return (fixed if axis is None else fixed * _rotation(axis, angle)), origin
 
 
 def _leaner(exprs: list[Any]) -> list[Any]:
@@ -373,28 +415,12 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
     _, p_tip = model.pose(TIP, theta)
     position = r_s.T * (p_tip - p_s)
     jacobian = [[sp.diff(position[i], theta[j]) for j in range(3)] for i in range(3)]
-    name = description.config.name
     T, D, A = ("theta", theta), ("dtheta", dtheta), ("ddtheta", ddtheta)
     guard = f"{prefix.upper()}_MODEL_H"
     units = ("theta: the report's joint angles theta1..theta3 (rad); dtheta (rad/s); ddtheta (rad/s^2);\n"
              "torques in N m on theta. " + _ASSUMES)
     parts = [
-        f"/* {prefix}: the dynamics and kinematics of the PHANToM model {name}, generated by\n"
-        f" * phantom-pin codegen (phantom_pin.codegen) from its configuration. Do not edit: regenerate.\n"
-        f" *\n"
-        f" * Model: {name} (URDF robot {ET.fromstring(description.urdf).get('name')})\n"
-        f" * Configuration: {origin}\n"
-        f" * Overlay: {_wrapped(overlay)}\n"
-        f" * Gravity: {description.config.gravity!r} m/s^2 along base_link's -z; armature (kg m^2): "
-        f"{', '.join(repr(a) for a in description.config.actuation.armature)}\n"
-        f" *\n"
-        f" * The arm's three joints (the report's theta1..theta3, the URDF's joint1..joint3, the\n"
-        f" * parallelogram's mimic joints following them); the tip is the gimbal's centre. A\n"
-        f" * stylus gimbal, where the device has one, is not part of this header.\n"
-        f" * C99 and C++, double precision, only <math.h>: static inline functions, no allocation,\n"
-        f" * no global state, every function re-entrant. Arrays are row-major. Every function\n"
-        f" * assumes finite input and does not check it.\n"
-        f" */\n"
+        _banner(description, prefix, origin, overlay) +
         f"#ifndef {guard}\n#define {guard}\n\n#include <math.h>\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n",
         _function(f"Gravity torques tau = N(theta) (N m) at rest.\n{units}",
                   f"{prefix}_gravity(const double theta[3], double tau[3])",
@@ -423,10 +449,63 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
                   f"{prefix}_jacobian_transpose_force(const double theta[3], const double f[3], double tau[3])",
                   _body([(f"tau[{j}]", sum(jacobian[i][j] * f[i] for i in range(3))) for j in range(3)],
                         [T, ("f", f)])),
+        *([] if description.config.gimbal is None else [_stylus(description, prefix)]),
         _openhaptics(prefix),
         f"#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {guard} */\n",
     ]
     return "\n".join(parts)
+
+
+def _banner(description: Description, prefix: str, origin: str, overlay: str) -> str:
+    """The header's opening comment: the model, the configuration's source, the overlay, the
+    gravity and armature, and what the header covers."""
+    name, gimbal = description.config.name, description.config.gimbal
+    if gimbal is None:
+        covers = (" * parallelogram's mimic joints following them); the tip is the gimbal's centre. A\n"
+                  " * stylus gimbal, where the device has one, is not part of this header.\n")
+    else:
+        covers = (" * parallelogram's mimic joints following them); the tip is the gimbal's centre. The\n"
+                  " * dynamics carry the stylus gimbal held at its locked_at angles "
+                  f"({', '.join(repr(a) for a in gimbal.locked_at)} rad);\n"
+                  f" * {prefix}_stylus_pose takes its angles (OpenHaptics' raw gimbal angles).\n")
+    return (f"/* {prefix}: the dynamics and kinematics of the PHANToM model {name}, generated by\n"
+            f" * phantom-pin codegen (phantom_pin.codegen) from its configuration. Do not edit: regenerate.\n"
+            f" *\n"
+            f" * Model: {name} (URDF robot {ET.fromstring(description.urdf).get('name')})\n"
+            f" * Configuration: {origin}\n"
+            f" * Overlay: {_wrapped(overlay)}\n"
+            f" * Gravity: {description.config.gravity!r} m/s^2 along base_link's -z; armature (kg m^2): "
+            f"{', '.join(repr(a) for a in description.config.actuation.armature)}\n"
+            f" *\n"
+            f" * The arm's three joints (the report's theta1..theta3, the URDF's joint1..joint3, the\n"
+            f"{covers}"
+            f" * C99 and C++, double precision, only <math.h>: static inline functions, no allocation,\n"
+            f" * no global state, every function re-entrant. Arrays are row-major. Every function\n"
+            f" * assumes finite input and does not check it.\n"
+            f" */\n")
+
+
+def _stylus(description: Description, prefix: str) -> str:
+    """The stylus frame's pose in frame s (Phantom.stylus_pose): the product of the joint
+    transforms with the gimbal's joints free, frame s's inverse first; the URDF's quarter turns
+    exact (a change of 6e-17 against Pinocchio's, which leaves the result's rounding)."""
+    model = _Model(description, free=True, exact=True)
+    theta = list(sp.symbols("q0:3", real=True))
+    gimbal = list(sp.symbols("g0:3", real=True))
+    r_s, p_s = model.merged_pose(FRAME_S, theta + gimbal)
+    r_stylus, p_stylus = model.merged_pose(STYLUS, theta + gimbal)
+    position, rotation = r_s.T * (p_stylus - p_s), r_s.T * r_stylus
+    pose = _leaner([*position, *(rotation[i, j] for i in range(3) for j in range(3))])
+    outputs = [(f"p[{i}]", pose[i]) for i in range(3)] + [(f"R[{k}]", pose[3 + k]) for k in range(9)]
+    return _function(
+        "Pose of the stylus frame in the report's frame s (x left, y up, z forward), as\n"
+        "phantom_pin.Phantom.stylus_pose: its origin p (m) is the gimbal's centre (the tip); its\n"
+        "rotation R, row-major R[3*i + j], has the stylus frame's x, y, z axes in frame s as its\n"
+        "columns, +z along the stylus towards its back end. theta: the report's theta1..theta3\n"
+        "(rad); gimbal: OpenHaptics' raw gimbal angles g1..g3 (rad, the URDF's joint4..joint6).\n"
+        f"{_ASSUMES}",
+        f"{prefix}_stylus_pose(const double theta[3], const double gimbal[3], double p[3], double R[9])",
+        _body(outputs, [("theta", theta), ("gimbal", gimbal)]))
 
 
 def _openhaptics(prefix: str) -> str:

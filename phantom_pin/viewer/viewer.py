@@ -1,4 +1,5 @@
-"""Viewer: the arm in meshcat (postures, animations, tip frame, tip force, HTML export)."""
+"""Viewer: the arm in meshcat (postures, animations of the arm and a stylus gimbal, tip frame,
+tip force, HTML export)."""
 
 from __future__ import annotations
 
@@ -76,9 +77,9 @@ class Viewer:
     by leaving a ``with`` block, or at interpreter exit), loads ``phantom_pin.load()``
     (or the RobotWrapper you pass), frames the arm with the camera and shows the
     robot's q0. Joint vectors are the report's theta1..theta3 (rad); a model with a stylus
-    gimbal (the Touch) draws the stylus at the ``gimbal`` angles given to show() (OpenHaptics'
-    raw gimbal angles, rad; default zero). The scene's world frame is ``base_link`` (x forward,
-    z up). ``url`` is the page to open.
+    gimbal (the Touch) draws the stylus at the ``gimbal`` angles given to show() and animate()
+    (OpenHaptics' raw gimbal angles g1..g3, rad, the URDF's joint4..joint6; default zero). The
+    scene's world frame is ``base_link`` (x forward, z up). ``url`` is the page to open.
     """
 
     def __init__(self, robot: pin.RobotWrapper | None = None) -> None:
@@ -136,6 +137,27 @@ class Viewer:
             return q
         return np.concatenate([q, np.zeros(3) if gimbal is None else as_state(gimbal, "gimbal")])
 
+    def _motion(self, times: object, theta: object, gimbal: object) -> tuple[np.ndarray, np.ndarray]:
+        """(times (N,) s, the robot's q (N, nq)) of animate()'s arguments, checked: theta
+        (N, 3) rad; ``gimbal`` (N, 3) or (3,) rad held throughout, None for zero, a model with a
+        stylus gimbal only (InvalidInputError naming ``gimbal`` otherwise)."""
+        t = np.asarray(times, dtype=float)
+        q, _ = as_states(theta, "theta")
+        if t.ndim != 1 or q.shape != (t.size, 3) or t.size < 2:
+            raise InvalidInputError(f"times, theta: expected shapes (N,) and (N, 3) with N >= 2, "
+                                    f"got {t.shape} and {q.shape}")
+        if not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
+            raise InvalidInputError("times: expected finite, strictly increasing seconds")
+        if self.robot.model.nq == 3:
+            if gimbal is not None:
+                raise InvalidInputError("this model has no stylus gimbal", argument="gimbal")
+            return t, q
+        g, batch = (np.zeros(3), False) if gimbal is None else as_states(gimbal, "gimbal")
+        if batch and g.shape != (t.size, 3):
+            raise InvalidInputError(f"expected shape (3,) or (N, 3) with N = {t.size} times, got {g.shape}",
+                                    argument="gimbal")
+        return t, np.hstack([q, np.broadcast_to(g, (t.size, 3))])
+
     def show(self, theta: object, gimbal: object = None) -> None:
         """Place the arm, its tip frame and the force arrow at ``theta`` (3,) (rad), and the
         stylus (a model with a gimbal) at ``gimbal`` (3,) (rad; default zero)."""
@@ -180,31 +202,28 @@ class Viewer:
         if self._force.any():
             self.scene[_FORCE_PATH].set_transform(self._force_pose())
 
-    def animate(self, times: object, theta: object, repetitions: int = 1) -> None:
+    def animate(self, times: object, theta: object, repetitions: int = 1, gimbal: object = None) -> None:
         """Play theta(t) in the browser: ``times`` (N,) strictly increasing (s) and
         ``theta`` (N, 3) (rad), interpolated linearly in time and resampled at 30 key
         frames per second. The clip lives in the scene, so export_html() keeps it; it
-        plays ``repetitions`` times on page load, then the scene shows the last posture."""
-        t = np.asarray(times, dtype=float)
-        q, _ = as_states(theta, "theta")
-        if t.ndim != 1 or q.shape != (t.size, 3) or t.size < 2:
-            raise InvalidInputError(f"times, theta: expected shapes (N,) and (N, 3) with N >= 2, "
-                                    f"got {t.shape} and {q.shape}")
-        if not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
-            raise InvalidInputError("times: expected finite, strictly increasing seconds")
+        plays ``repetitions`` times on page load, then the scene shows the last posture.
+        ``gimbal`` (a model with a stylus gimbal): OpenHaptics' raw gimbal angles (rad),
+        (N, 3) one row per time (interpolated as theta) or (3,) held throughout; default
+        zero. InvalidInputError naming ``gimbal`` for a model without one or a wrong shape."""
+        t, q = self._motion(times, theta, gimbal)
         if not (isinstance(repetitions, int) and repetitions >= 1):
             raise InvalidInputError(f"repetitions: expected a positive integer, got {repetitions!r}")
-        # Resample theta(t) at the frame rate so that every key frame is a true posture
+        # Resample q(t) at the frame rate so that every key frame is a true posture
         # (the browser interpolates each link's pose between key frames).
         samples = np.append(np.arange(0.0, t[-1] - t[0], 1.0 / _FPS), t[-1] - t[0])
-        postures = np.stack([np.interp(samples, t - t[0], q[:, j]) for j in range(3)], axis=1)
+        postures = np.stack([np.interp(samples, t - t[0], q[:, j]) for j in range(q.shape[1])], axis=1)
         animation = Animation(default_framerate=_FPS)
         model, data, geometry = self.robot.model, self.visualizer.data, self.robot.visual_model
         geometry_data = self.visualizer.visual_data
         frame_node = f"{self.visualizer.viewerFramesGroupName}/{model.frames[self._tip].name}"
         for instant, posture in zip(samples, postures):
             with animation.at_frame(self.scene, instant * _FPS) as frame:
-                pin.forwardKinematics(model, data, self._configuration(posture))  # a stylus at zero
+                pin.forwardKinematics(model, data, posture)
                 pin.updateGeometryPlacements(model, data, geometry, geometry_data)
                 for k, obj in enumerate(geometry.geometryObjects):
                     name = self.visualizer.getViewerNodeName(obj, pin.GeometryType.VISUAL)
@@ -214,7 +233,8 @@ class Viewer:
                 if self._force.any():
                     frame[_FORCE_PATH].set_transform(self._force_pose())
         self.scene.set_animation(animation, play=True, repetitions=repetitions)
-        self.show(q[-1])  # the scene's own state: the last posture, shown when the clip ends
+        # the scene's own state: the last posture, shown when the clip ends
+        self.show(q[-1, :3], q[-1, 3:] if q.shape[1] > 3 else None)
 
     def export_html(self, path: Path | str, force: bool = False) -> Path:
         """Write the scene (with its camera and animation) as one self-contained HTML

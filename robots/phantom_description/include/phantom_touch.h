@@ -7,8 +7,9 @@
  * Gravity: 9.80665 m/s^2 along base_link's -z; armature (kg m^2): 0.0, 0.0, 0.0
  *
  * The arm's three joints (the report's theta1..theta3, the URDF's joint1..joint3, the
- * parallelogram's mimic joints following them); the tip is the gimbal's centre. A
- * stylus gimbal, where the device has one, is not part of this header.
+ * parallelogram's mimic joints following them); the tip is the gimbal's centre. The
+ * dynamics carry the stylus gimbal held at its locked_at angles (0, 0, 0 rad);
+ * phantom_stylus_pose takes its angles (OpenHaptics' raw gimbal angles).
  * C99 and C++, double precision, only <math.h>: static inline functions, no allocation,
  * no global state, every function re-entrant. Arrays are row-major. Every function
  * assumes finite input and does not check it.
@@ -375,6 +376,62 @@ static inline void phantom_jacobian_transpose_force(const double theta[3], const
     tau[0] = f0*(x19*x20 - x23) + f1*(x23 + 3.749399456654644e-33*x24) + f2*(-x22 - 6.123233995736766e-17*x24);
     tau[1] = f0*(x31 + x33) + f1*(3.749399456654644e-33*x31 - x33 + x34 + x35) + f2*(-6.123233995736766e-17*x31 + x32 + 6.123233995736766e-17*x34 + 6.123233995736766e-17*x35);
     tau[2] = f0*(x42 + x44) + f1*(x19 + 3.749399456654644e-33*x42 - x44 + x45 + x46) + f2*(6.123233995736766e-17*x15 - 6.123233995736766e-17*x18 - 6.123233995736766e-17*x42 + x43 + 6.123233995736766e-17*x45 + 6.123233995736766e-17*x46);
+}
+
+/*
+ * Pose of the stylus frame in the report's frame s (x left, y up, z forward), as
+ * phantom_pin.Phantom.stylus_pose: its origin p (m) is the gimbal's centre (the tip); its
+ * rotation R, row-major R[3*i + j], has the stylus frame's x, y, z axes in frame s as its
+ * columns, +z along the stylus towards its back end. theta: the report's theta1..theta3
+ * (rad); gimbal: OpenHaptics' raw gimbal angles g1..g3 (rad, the URDF's joint4..joint6).
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_stylus_pose(const double theta[3], const double gimbal[3], double p[3], double R[9])
+{
+    const double q0 = theta[0];
+    const double q1 = theta[1];
+    const double q2 = theta[2];
+    const double g0 = gimbal[0];
+    const double g1 = gimbal[1];
+    const double g2 = gimbal[2];
+    const double x0 = sin(q0);
+    const double x1 = 0.13335*cos(q1);
+    const double x2 = sin(q2);
+    const double x3 = 0.13334999999999999*x2;
+    const double x4 = cos(q2);
+    const double x5 = cos(q0);
+    const double x6 = sin(g0);
+    const double x7 = x5*x6;
+    const double x8 = cos(g0);
+    const double x9 = x0*x8;
+    const double x10 = x4*x9 + x7;
+    const double x11 = sin(g1);
+    const double x12 = cos(g1);
+    const double x13 = x0*x2;
+    const double x14 = -x10*x11 - x12*x13;
+    const double x15 = sin(g2);
+    const double x16 = x0*x6;
+    const double x17 = -x16*x4 + x5*x8;
+    const double x18 = cos(g2);
+    const double x19 = x2*x8;
+    const double x20 = -x11*x19 + x12*x4;
+    const double x21 = x2*x6;
+    const double x22 = -x16 + x4*x5*x8;
+    const double x23 = x2*x5;
+    const double x24 = -x11*x22 - x12*x23;
+    const double x25 = -x4*x7 - x9;
+    p[0] = x0*x1 + x0*x3;
+    p[1] = -0.13334999999999999*x4 + 0.13335*sin(q1) + 0.13335;
+    p[2] = x1*x5 + x3*x5 - 0.13335;
+    R[0] = -x14*x15 + x17*x18;
+    R[1] = x14*x18 + x15*x17;
+    R[2] = x10*x12 - x11*x13;
+    R[3] = -x15*x20 - x18*x21;
+    R[4] = -x15*x21 + x18*x20;
+    R[5] = x11*x4 + x12*x19;
+    R[6] = -x15*x24 + x18*x25;
+    R[7] = x15*x25 + x18*x24;
+    R[8] = -x11*x23 + x12*x22;
 }
 
 /*
