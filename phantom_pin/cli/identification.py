@@ -14,8 +14,10 @@ from phantom_pin.cli.common import Once, description, overrides, warn
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import bags, excitation, filtering, io, prior, timing
-from phantom_pin.identification.result import RefusedError, identify, refusal
+from phantom_pin.identification import bags, excitation, filtering, io, prior, static, timing
+from phantom_pin.identification.overlays import identified_keys
+from phantom_pin.identification.result import RefusedError, identify, refusal, write_yaml
+from phantom_pin.identification.structures import General
 from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
@@ -52,6 +54,37 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
     if path.suffix.lower() not in suffixes:
         raise PhantomPinError(f"{path}: this command writes {kind}; name a {' or '.join(suffixes)} file",
                               argument="--output")
+
+
+#: The options of the trajectory fit, which rest postures do not take (dest, option, default).
+TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
+                   ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", "held"),
+                   ("min_speed", "--min-speed", filtering.MIN_SPEED), ("cutoff", "--cutoff", 20.0),
+                   ("accept", "--accept", False))
+
+
+def _static_command(args: argparse.Namespace, phantom: Phantom, recording: bags.Recording | None,
+                    given: dict[str, object]) -> int:
+    """identify --static: gravity from rest postures (static.py), written as an overlay of the
+    rigid body (friction as given: rest says nothing of it)."""
+    for dest, option, default in TRAJECTORY_ONLY:
+        if getattr(args, dest) != default:
+            raise PhantomPinError("fits a trajectory: --static fits rest postures (gravity) only", argument=option)
+    if recording is not None:
+        rest = static.rest_of(recording.log)
+    else:
+        table = io.read_postures(args.log)
+        rest = static.rest_of(io.read_log(args.log, args.convention)) if table is None else static.Rest(*table)
+    gravity = static.estimate_gravity(rest, phantom, args.prior_spread)
+    keys = identified_keys(General(phantom).overrides(gravity.x), given, phantom.config, None)
+    lines = [*([] if recording is None else recording.lines()), *gravity.lines(len(rest.theta))]
+    for line in lines:
+        print(line)
+    write_yaml(args.output, [f"Identified by phantom-pin identify --static from {args.log.name}: a --params overlay "
+                             "of the rigid body (gravity from rest postures; friction as given). SI units.",
+                             *lines], keys, force=True)
+    print(f"wrote {args.output}")
+    return 0
 
 
 def _recording(args: argparse.Namespace) -> bags.Recording | None:
@@ -145,6 +178,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--accept", action="store_true",
                           help="write the result even where the checks refuse it, each check's reason as a warning "
                                "and a comment in the file")
+    identify.add_argument("--static", action="store_true",
+                          help="gravity from rest: the log's or bag's stretches held still (0.5 s or more), or a "
+                               "CSV of postures (theta1..3 rad, tau1..3 N m, no t column); the prior holds the rest")
     identify.add_argument("--convention", choices=CONVENTIONS, default="report",
                           help="the log's theta and tau columns: the report's theta (rad) and N m (default), "
                                "or OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad) and joint torques (mN m)")
@@ -223,6 +259,8 @@ def identify_command(args: argparse.Namespace) -> int:
         given = {**given, **_held_stylus(recording.gimbal)}    # the stylus's load at the bag's gimbal angles
         made = description(args, given)
     phantom = Phantom(made)
+    if args.static:
+        return _static_command(args, phantom, recording, given)
     if args.structure == "report" and phantom.config.report is None:
         how = " with its --params/--set overrides" if given else ""
         raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name}{how} "

@@ -131,6 +131,18 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, s
     return lines, {name: table[:, header.index(name)] for name in columns}
 
 
+def read_postures(path: Path | str) -> tuple[np.ndarray, np.ndarray] | None:
+    """(theta (N, 3) rad, tau (N, 3) N m) of a CSV of rest postures and their holding torques
+    (header theta1,theta2,theta3,tau1,tau2,tau3 in the report's convention, no t column), or None
+    where its header names a time column t (a log: read_log)."""
+    lines, column = _read_table(Path(path), ("theta1", "theta2", "theta3", "tau1", "tau2", "tau3"))
+    separator = max((",", ";", "\t"), key=lines[0][1].count)
+    if "t" in [_column_name(name) for name in lines[0][1].split(separator)]:
+        return None
+    return (np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)]),
+            np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)]))
+
+
 def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
     """(t, theta, dtheta, ddtheta, tau) of an excitation trajectory (excite's CSV, the report's
     convention: s, rad, rad/s, rad/s^2, N m), each (N,) or (N, 3), at a fixed rate."""

@@ -27,30 +27,39 @@ def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -
     of every link): ParameterFileError otherwise, before anything is written."""
     if not isinstance(fit, Fit):
         raise InvalidInputError(f"fit: expected a phantom_pin.identification.Fit (estimate), got {fit!r}")
+    keys = identified_keys(fit.overrides, given, config, friction_keys(fit))
+    notes = []
+    values, sigma = fit.friction
+    for kind, part in (("viscous", slice(0, 3)), ("coulomb", slice(3, 6))):
+        listed = ", ".join(f"joint{j} {v:.4g} +- {s:.2g}" for j, v, s in zip((1, 2, 3), values[part], sigma[part]))
+        notes.append(f"friction.{kind} estimated per joint: {listed}; written per joint, the physical values "
+                     "(0 or more)")
+    return keys, notes
+
+
+def identified_keys(bodies: dict[str, float], given: dict | None, config: Config | None,
+                    friction: dict[str, float] | None) -> dict[str, object]:
+    """The overlay's keys: what the fit is valid with (``config``'s name and lengths), the
+    overrides ``given`` except the identified ``bodies``' and (where ``friction`` is identified)
+    friction's, then ``bodies`` and ``friction``; checked to give a physical model of ``config``
+    (describe() and its check of every link): ParameterFileError otherwise."""
     if given is not None and not isinstance(given, dict):
         raise InvalidInputError(f"given: expected a dict of --params keys or None, got {given!r}")
-    bodies = REPORT_SEGMENTS + ("links",)
     keys: dict[str, object] = {}
     if config is not None:
         if config.name in MODELS:
             keys[MODEL_KEY] = config.name
         keys.update(dataclasses.asdict(config.kinematics))
     keys.update({key: value for key, value in (given or {}).items()
-                 if section(key) not in bodies and not _friction_key(key)})
-    keys.update(fit.overrides)
-    notes = []
-    keys.update(friction_keys(fit))
-    values, sigma = fit.friction
-    for kind, part in (("viscous", slice(0, 3)), ("coulomb", slice(3, 6))):
-        listed = ", ".join(f"joint{j} {v:.4g} +- {s:.2g}" for j, v, s in zip((1, 2, 3), values[part], sigma[part]))
-        notes.append(f"friction.{kind} estimated per joint: {listed}; written per joint, the physical values "
-                     "(0 or more)")
+                 if section(key) not in REPORT_SEGMENTS + ("links",) and not (friction and _friction_key(key))})
+    keys.update(bodies)
+    keys.update(friction or {})
     if config is not None:  # the overlay must give a physical URDF (description.physical.check_urdf)
         try:
             describe(config.folder, overrides=keys)
         except PhantomPinError as error:
             raise ParameterFileError(f"identified parameters not physically valid: {error}") from None
-    return keys, notes
+    return keys
 
 
 #: The overlay's friction keys in fit.x[-6:]'s order: viscous1..3 (N m s/rad), coulomb1..3 (N m).

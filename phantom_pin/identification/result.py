@@ -77,9 +77,6 @@ class Identification:
     def write(self, path: Path | str, force: bool = False) -> None:
         """Write the overlay (dotted --params keys, SI units) with the fit in comments to ``path``
         (YAML); an existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
-        path = Path(path)
-        if path.exists() and not force:
-            raise InvalidInputError(f"{path} exists; force=True overwrites it", argument="path")
         fit = self.fit
         lines = [f"# Identified by phantom-pin identify from {self.source} ({fit.structure} structure): a --params",
                  "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
@@ -100,8 +97,17 @@ class Identification:
         lines += ["# What the log does not excite comes from the model's values (the prior, within its stated "
                   f"{100 * fit.prediction.spread:.0f} % spread)." if np.isfinite(fit.prediction.spread) else
                   "# Directions the torques do not determine are kept near the model's values (the prior)."]
-        lines += [f"{key}: {value!r}" for key, value in self.keys.items()]
-        path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        write_yaml(path, [line[2:] for line in lines], self.keys, force=force)
+
+
+def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], force: bool = False) -> None:
+    """An overlay file at ``path``: the ``comments`` (one ``# `` line each), then the ``keys`` as
+    YAML; an existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
+    path = Path(path)
+    if path.exists() and not force:
+        raise InvalidInputError(f"{path} exists; force=True overwrites it", argument="path")
+    lines = [f"# {line}" for line in comments] + [f"{key}: {value!r}" for key, value in keys.items()]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str = "general",
