@@ -34,6 +34,9 @@ _IK_SEEDS = {"report": ((0.35, 0.3), (0.9, 1.0)), "other": ((-0.35, -2.8), (0.9,
 
 
 _ONE = (3,)
+#: eigenpy converts boolean arrays, which as_states refuses: the fast paths that check only
+#: shapes send them to the checked path (a builtin dtype is one object)
+_BOOL = np.dtype(bool)
 _isfinite = math.isfinite
 
 
@@ -45,7 +48,8 @@ def _finite(array: np.ndarray) -> bool:
 
 def _one(value: object) -> TypeGuard[np.ndarray]:
     """The fast paths' check, written once: True if ``value`` is a finite vector of shape (3,)
-    (an array; the dtype is left to eigenpy).
+    (an array; the dtype is left to eigenpy, but for booleans, which eigenpy would take: their
+    tolist() gives bools, sent to the checked path, which refuses them by name).
 
     ``a, b, c = value.tolist() if value.size == 3 else ()`` then ``isfinite(a + b + c)`` is the
     cheapest check (0.16 us, against 0.33 us for a shape comparison and sum()): a batch fails
@@ -56,7 +60,7 @@ def _one(value: object) -> TypeGuard[np.ndarray]:
     theta; where rates enter, whose products can overflow, the caller checks the result too."""
     try:
         a, b, c = value.tolist() if value.size == 3 else ()  # type: ignore[attr-defined,misc]
-        return _isfinite(a + b + c)
+        return a.__class__ is not bool and _isfinite(a + b + c)
     except (AttributeError, TypeError, ValueError):
         return False
 
@@ -130,11 +134,12 @@ class Phantom:
     joint1..joint3; rates in rad/s, accelerations in rad/s^2, torques in N m. Poses
     are in the report's kinematic frame s (URDF frame ``report_s``: x left, y up,
     z forward); the tool frame t is ``tip``. Every method takes one state, shape (3,),
-    or a batch, shape (N, 3), and returns fresh arrays.
+    or a batch, shape (..., 3) (any number of leading axes, which each result keeps), of real
+    numbers (booleans are refused), and returns fresh arrays.
 
     The stylus gimbal (a model with one: the Touch, ``config.gimbal``): its joints
     ``gimbal_joints`` (the URDF's joint4..joint6) are passive and their angles g, shape (3,)
-    or (N, 3), are OpenHaptics' raw gimbal angles (rad). The arm's dynamics (every method of
+    or (..., 3), are OpenHaptics' raw gimbal angles (rad). The arm's dynamics (every method of
     theta alone) carry the gimbal and stylus as a rigid load held at ``config.gimbal.locked_at``
     (gravity(theta, gimbal) takes other angles); stylus_pose, stylus_tip_pose and
     stylus_jacobian use all six angles.
@@ -495,12 +500,14 @@ class Phantom:
     def inverse_dynamics(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
         """Joint torques tau = M ddtheta + C dtheta + N (eq. 80): (..., 3), N m.
 
-        One state: pinocchio.rnea on the mimic model. A batch (N, 3):
+        One state: pinocchio.rnea on the mimic model. A batch (..., 3):
         pinocchio.rneaInParallel over ``threads`` OpenMP threads.
         """
         q: Any = theta  # any object: its shape is asked, not assumed (lists have none)
         try:  # the fast path: one state (3,); eigenpy refuses (TypeError) complex and object
-            if q.shape == dtheta.shape == ddtheta.shape == _ONE:  # type: ignore[attr-defined]
+            if (q.shape == dtheta.shape == ddtheta.shape == _ONE  # type: ignore[attr-defined]
+                    and _BOOL is not q.dtype and _BOOL is not dtheta.dtype  # type: ignore[attr-defined]
+                    and _BOOL is not ddtheta.dtype):  # type: ignore[attr-defined]
                 tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
                 # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
                 # only then are the inputs inspected, to name the bad one.
@@ -541,7 +548,7 @@ class Phantom:
         if _one(theta):
             try:
                 t0, t1, t2 = torques.tolist()
-                if rates.shape == _ONE:
+                if rates.shape == _ONE and t0.__class__ is not bool and rates.dtype is not _BOOL:
                     model, data = self.model, self.data
                     bias = pin.nonLinearEffects(model, data, theta, dtheta).tolist()
                     acc = solve_spd(pin.crba(model, data, theta).tolist(),
