@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
+import stat
 import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -138,10 +141,48 @@ def output(args: argparse.Namespace, option: str = "--output") -> Path:
 
 def write_text(path: Path, text: str, option: str = "--output") -> None:
     """``text`` into the file ``path``; PhantomPinError naming ``option`` if it cannot be written."""
+    write_texts([(path, text, option)])
+
+
+def _unwritable(path: Path, error: OSError, option: str) -> PhantomPinError:
+    return PhantomPinError(f"cannot write {path} ({error.strerror})", argument=option)
+
+
+def write_texts(files: list[tuple[Path, str, str]]) -> None:
+    """Each (path, text, option) written, or none (PhantomPinError naming the option of the
+    first that cannot be): each text goes first into a temporary file beside its path (which
+    tries the folder's permissions and space), then every one is renamed into place. A path
+    that exists and is no regular file (a device such as /dev/null or /dev/full, a pipe) is
+    not renamed over: it is written in place once the others are staged (a second such path
+    after a first written is the one case where something stays written)."""
+    staged: list[tuple[str, Path]] = []
+    mask = os.umask(0)
+    os.umask(mask)
     try:
-        path.write_text(text)
-    except OSError as error:
-        raise PhantomPinError(f"cannot write {path} ({error.strerror})", argument=option) from None
+        for path, text, option in files:
+            if path.exists() and not path.is_file():
+                continue
+            handle, temporary = tempfile.mkstemp(dir=path.resolve().parent, prefix=f".{path.name}.", suffix=".tmp")
+            staged.append((temporary, path))
+            mode = stat.S_IMODE(path.stat().st_mode) if path.exists() else 0o666 & ~mask
+            try:
+                with os.fdopen(handle, "w", encoding="utf-8") as stream:
+                    stream.write(text)
+                os.chmod(temporary, mode)
+            except OSError as error:
+                raise _unwritable(path, error, option) from None
+        for path, text, option in files:
+            if path.exists() and not path.is_file():
+                try:
+                    path.write_text(text, encoding="utf-8")
+                except OSError as error:
+                    raise _unwritable(path, error, option) from None
+    except BaseException:
+        for temporary, _ in staged:
+            Path(temporary).unlink(missing_ok=True)
+        raise
+    for temporary, path in staged:
+        os.replace(temporary, path)
 
 
 def show(args: argparse.Namespace, data: dict, text: str) -> None:

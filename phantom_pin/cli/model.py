@@ -23,6 +23,7 @@ from phantom_pin.cli.common import (
     vector,
     warn_limits,
     write_text,
+    write_texts,
 )
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
@@ -145,10 +146,10 @@ def write(args: argparse.Namespace) -> int:
         print(f"wrote {target}")
         return 0
     texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
-    write_text(target, texts[args.kind])
+    # both files or neither (a scene that cannot be written leaves no model behind)
+    write_texts([(target, texts[args.kind], "--output")] + ([] if scene is None else [(scene, made.scene, "--scene")]))
     print(f"wrote {target}")
     if scene is not None:
-        write_text(scene, made.scene, "--scene")
         print(f"wrote {scene}")
     return 0
 
