@@ -222,6 +222,19 @@ def warn_limits(theta: Any, lower: Any, upper: Any, what: str = "theta") -> None
              f"{vector(upper, '{:.6g}')} rad (computed anyway)")
 
 
+def add_gimbal(command: argparse.ArgumentParser, what: str) -> None:
+    """The option --gimbal G1 G2 G3 (rad) of a command: ``what`` the angles do."""
+    command.add_argument("--gimbal", metavar="G", nargs=3, type=float,
+                         help=f"the stylus gimbal's angles (rad, OpenHaptics' raw gimbal angles; a model with a "
+                              f"gimbal, the Touch): {what}")
+
+
+def warn_gimbal(gimbal: Any, robot: Phantom) -> None:
+    """A warning when --gimbal's angles lie outside the gimbal's range (as warn_limits' for theta)."""
+    if gimbal is not None and robot.config.gimbal is not None:
+        warn_limits(gimbal, robot.config.gimbal.lower, robot.config.gimbal.upper, "gimbal")
+
+
 def positive_integer(text: str) -> int:
     """A count such as 1000 or 1e6 (a whole number >= 1)."""
     try:
