@@ -265,3 +265,79 @@ def test_simulate_with_the_gimbal_held_and_its_gravity_compensated_stays_at_rest
         patch.setattr("phantom_pin.device.simulation.held", lambda description, gimbal: description)
         moved = json.loads(cli(*common, "--gimbal", *HELD)[1])
     assert np.abs(np.array(moved["theta"]) - theta0).max() > 1e-3
+
+
+# -- L12: the model and convention a trajectory or log was written for ----------------------------
+def _trajectory(path, record=None, model="touch"):
+    """A 2.5 s trajectory at 1 kHz in the report's convention (sines about a posture inside the
+    stops, exact derivatives, the model's torques), written here with ``record`` as its second
+    line (None: none, as files before 0.5.0)."""
+    t = np.arange(2501) / 1000
+    w = 2 * np.pi * np.array([0.4, 0.6, 0.5])
+    theta = np.array([0.0, 0.3, 0.5]) + 0.1 * np.sin(np.outer(t, w))
+    dtheta, ddtheta = 0.1 * w * np.cos(np.outer(t, w)), -0.1 * w**2 * np.sin(np.outer(t, w))
+    tau = Phantom(model).inverse_dynamics(theta, dtheta, ddtheta)
+    lines = ["t,theta1,theta2,theta3,dtheta1,dtheta2,dtheta3,ddtheta1,ddtheta2,ddtheta3,tau1,tau2,tau3"]
+    lines += [] if record is None else [record]
+    lines += [",".join(map(repr, row)) for row in np.column_stack([t, theta, dtheta, ddtheta, tau]).tolist()]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_excite_and_simulate_record_the_model_and_the_convention(tmp_path, cli):
+    """L12: the files carried neither. excite's trajectory and simulate's log name the model and
+    the convention of their columns on their second line (a # comment, which the readers and
+    numpy.loadtxt skip); simulate's log is in the report's convention whatever its input's."""
+    code, _, err = cli("--model", "touch", "excite", "-o", tmp_path / "t.csv", "--duration", "5", "--iterations", "1",
+                       "--restarts", "1", "--convention", "openhaptics", "-q")
+    assert (code, err) == (0, "")
+    lines = (tmp_path / "t.csv").read_text().splitlines()
+    assert lines[0].startswith("t,theta1,") and lines[1] == "# phantom-pin: model touch, convention openhaptics"
+    assert np.loadtxt(tmp_path / "t.csv", delimiter=",", skiprows=1).shape == (5001, 13)
+    code, _, err = cli("--model", "touch", "simulate", "--trajectory", tmp_path / "t.csv", "--convention",
+                       "openhaptics", "-o", tmp_path / "log.csv", "-q")
+    assert (code, err) == (0, "")
+    assert (tmp_path / "log.csv").read_text().splitlines()[1] == "# phantom-pin: model touch, convention report"
+
+
+@pytest.mark.parametrize("given, written", [(("--model", "touch"), ("premium_1_5", "report")),
+                                            (("--model", "touch", "--convention", "openhaptics"), ("touch", "report")),
+                                            ((), ("touch", "report"))])
+def test_a_trajectory_for_another_model_or_convention_is_refused_naming_both(tmp_path, cli, given, written):
+    """L12: a trajectory written for another model or convention ran silently. Refused before the
+    run in one line naming both, nothing written."""
+    path = _trajectory(tmp_path / "t.csv", f"# phantom-pin: model {written[0]}, convention {written[1]}")
+    code, out, err = cli("simulate", "--trajectory", path, "-o", tmp_path / "log.csv", *given)
+    model = "touch" if "touch" in given else "premium_1_5"
+    convention = "openhaptics" if "openhaptics" in given else "report"
+    assert (code, out) == (2, "") and err == (
+        f"phantom-pin: error: --trajectory: {path} was written for the model {written[0]} in the {written[1]} "
+        f"convention, read here for the model {model} in the {convention} convention (give --model and "
+        "--convention as written, or delete its '# phantom-pin' line)\n")
+    assert not (tmp_path / "log.csv").exists()
+
+
+def test_a_log_for_another_model_is_refused_by_identify_before_any_fit(tmp_path, cli):
+    path = _trajectory(tmp_path / "log.csv", "# phantom-pin: model touch, convention report")
+    code, out, err = cli("identify", path, "-o", tmp_path / "id.yaml")
+    assert (code, out) == (2, "") and err.startswith(
+        f"phantom-pin: error: LOG: {path} was written for the model touch in the report convention, read here for "
+        "the model premium_1_5 in the report convention")
+    assert not (tmp_path / "id.yaml").exists()
+
+
+@pytest.mark.parametrize("record", [None, "# phantom-pin: model touch, convention report", "# a comment of one's own"])
+def test_a_trajectory_without_the_record_or_with_the_right_one_is_read(tmp_path, cli, record):
+    """Files without the record (before 0.5.0, other tools) read as before; so do matching ones:
+    the run tracks the trajectory (its start is the file's first state)."""
+    path = _trajectory(tmp_path / "t.csv", record)
+    code, out, err = cli("--model", "touch", "simulate", "--trajectory", path, "--format", "json", "-q")
+    assert (code, err) == (0, "")
+    np.testing.assert_allclose(json.loads(out)["theta"][0], [0.0, 0.3, 0.5], rtol=0, atol=1e-15)
+
+
+def test_a_malformed_record_is_refused(tmp_path, cli):
+    path = _trajectory(tmp_path / "t.csv", "# phantom-pin: touch, report")
+    code, _, err = cli("--model", "touch", "simulate", "--trajectory", path)
+    assert code == 2 and err == (f"phantom-pin: error: --trajectory: {path}: its line '# phantom-pin: touch, report' "
+                                 "is not '# phantom-pin: model NAME, convention NAME'\n")

@@ -5,6 +5,7 @@ printing and warnings."""
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import re
@@ -183,6 +184,45 @@ def write_texts(files: list[tuple[Path, str, str]]) -> None:
         raise
     for temporary, path in staged:
         os.replace(temporary, path)
+
+
+#: The comment line, second in a trajectory or log the command line writes, that records the model
+#: (config.name: a model's name or a folder's path) and the convention of its columns.
+RECORD = re.compile(r"#\s*phantom-pin:\s*model (?P<model>.+), convention (?P<convention>\w+)\s*")
+
+
+def csv_text(header: list[str], table: Any, model: str, convention: str) -> str:
+    """A trajectory's or log's CSV: the ``header`` line, the record of ``model`` and ``convention``
+    (RECORD; phantom_pin.identification.io skips # lines, as numpy.loadtxt does; pandas with
+    comment="#"), then the rows of ``table`` (N, len(header)) in their shortest exact decimals."""
+    rows = (",".join(map(repr, row)) for row in table.tolist())
+    return "\n".join([",".join(header), f"# phantom-pin: model {model}, convention {convention}", *rows]) + "\n"
+
+
+def check_record(path: Path, model: str, convention: str, option: str) -> None:
+    """PhantomPinError naming ``option`` if the file at ``path`` records (RECORD, before its first
+    row of data) another model or convention than ``model`` and ``convention``, the ones given;
+    a file without the record (written before 0.5.0, or by other tools) is read as it is. A file
+    that cannot be read is left to its reader's error."""
+    try:
+        with open(path, encoding="utf-8-sig") as stream:
+            lines = [line.strip() for line in itertools.islice(stream, 64)]
+    except (OSError, UnicodeDecodeError):
+        return
+    data = [i for i, line in enumerate(lines) if line and not line.startswith("#")]
+    for line in lines[:data[1] if len(data) > 1 else len(lines)]:
+        if not line.startswith("#") or "phantom-pin" not in line:
+            continue
+        found = RECORD.fullmatch(line)
+        if found is None:
+            raise PhantomPinError(f"{path}: its line {line[:60]!r} is not '# phantom-pin: model NAME, convention "
+                                  "NAME'", argument=option)
+        if (found["model"], found["convention"]) != (model, convention):
+            raise PhantomPinError(f"{path} was written for the model {found['model']} in the {found['convention']} "
+                                  f"convention, read here for the model {model} in the {convention} convention (give "
+                                  "--model and --convention as written, or delete its '# phantom-pin' line)",
+                                  argument=option)
+        return
 
 
 def show(args: argparse.Namespace, data: dict, text: str) -> None:

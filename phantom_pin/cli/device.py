@@ -12,7 +12,18 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import Once, add_gimbal, emit, output, phantom, warn, warn_gimbal, write_text
+from phantom_pin.cli.common import (
+    Once,
+    add_gimbal,
+    check_record,
+    csv_text,
+    emit,
+    output,
+    phantom,
+    warn,
+    warn_gimbal,
+    write_text,
+)
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
@@ -141,6 +152,8 @@ def simulate_command(args: argparse.Namespace) -> int:
     form = _format(args)
     robot = phantom(args)
     device = Device(robot)
+    if args.trajectory is not None:
+        check_record(args.trajectory, robot.config.name, args.convention or "report", "--trajectory")
     run = _tracking(args) if args.trajectory is not None else _free(args, robot)
     bar = Progress("simulate", 1.0, enabled=False if args.quiet else None)
     try:
@@ -169,7 +182,8 @@ def simulate_command(args: argparse.Namespace) -> int:
     settings["saturation"] = False if args.no_saturation else args.saturation or device.config.actuation.saturation
     settings["substeps"] = result.substeps
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
-    text = _json(result, settings) if form == "json" else _csv(result)
+    settings["model"] = robot.config.name
+    text = _json(result, settings) if form == "json" else _csv(result, robot.config.name)
     if target is None:
         emit(text)
         return 0
@@ -191,15 +205,15 @@ def _json(result: SimulationResult, settings: dict) -> str:
     return json.dumps(data) + "\n"
 
 
-def _csv(result: SimulationResult) -> str:
+def _csv(result: SimulationResult, model: str) -> str:
+    """The run as a log that identify reads: the report's convention, the model recorded."""
     header, columns = [], []
     for name, unit in _columns(result).items():
         values = getattr(result, name).reshape(len(result.t), -1)
         suffixes = [""] if values.shape[1] == 1 else (["_x", "_y", "_z"] if name == "tip" else ["1", "2", "3"])
         header += [f"{name}{s} [{unit.split(' (')[0]}]" for s in suffixes]
         columns.append(values)
-    rows = (",".join(map(repr, row)) for row in np.hstack(columns).tolist())  # shortest exact decimals
-    return "\n".join([",".join(header), *rows]) + "\n"
+    return csv_text(header, np.hstack(columns), model, "report")
 
 
 def info(phantom: Phantom) -> tuple[dict, list[str]]:
