@@ -45,6 +45,10 @@ def test_written_files_take_the_umask_and_an_overwritten_file_keeps_its_mode(tmp
     assert stat.S_IMODE((tmp_path / "m.xml").stat().st_mode) == 0o640
     assert stat.S_IMODE((tmp_path / "s.xml").stat().st_mode) == 0o600
     assert "m.xml" in (tmp_path / "s.xml").read_text()
+    (tmp_path / "link.xml").symlink_to(tmp_path / "m.xml")  # written through, as open() would
+    (tmp_path / "m.xml").write_text("old\n")
+    assert cli("mjcf", "-o", tmp_path / "link.xml", "--force")[0] == 0
+    assert (tmp_path / "link.xml").is_symlink() and "<mujoco" in (tmp_path / "m.xml").read_text()
 
 
 # -- the stylus gimbal held at given angles ---------------------------------------------------

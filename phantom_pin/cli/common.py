@@ -155,7 +155,8 @@ def write_texts(files: list[tuple[Path, str, str]]) -> None:
     tries the folder's permissions and space), then every one is renamed into place. A path
     that exists and is no regular file (a device such as /dev/null or /dev/full, a pipe) is
     not renamed over: it is written in place once the others are staged (a second such path
-    after a first written is the one case where something stays written)."""
+    after a first written is the one case where something stays written). A symbolic link is
+    followed: its target is replaced, the link kept."""
     staged: list[tuple[str, Path]] = []
     mask = os.umask(0)
     os.umask(mask)
@@ -163,8 +164,9 @@ def write_texts(files: list[tuple[Path, str, str]]) -> None:
         for path, text, option in files:
             if path.exists() and not path.is_file():
                 continue
-            handle, temporary = tempfile.mkstemp(dir=path.resolve().parent, prefix=f".{path.name}.", suffix=".tmp")
-            staged.append((temporary, path))
+            real = path.resolve()
+            handle, temporary = tempfile.mkstemp(dir=real.parent, prefix=f".{real.name}.", suffix=".tmp")
+            staged.append((temporary, real))
             mode = stat.S_IMODE(path.stat().st_mode) if path.exists() else 0o666 & ~mask
             try:
                 with os.fdopen(handle, "w", encoding="utf-8") as stream:
