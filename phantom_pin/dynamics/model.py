@@ -158,8 +158,9 @@ class Phantom:
     ``gimbal_joints`` (the URDF's joint4..joint6) are passive and their angles g, shape (3,)
     or (..., 3), are OpenHaptics' raw gimbal angles (rad). The arm's dynamics (every method of
     theta alone) carry the gimbal and stylus as a rigid load held at ``config.gimbal.locked_at``
-    (gravity(theta, gimbal) takes other angles); stylus_pose, stylus_tip_pose and
-    stylus_jacobian use all six angles.
+    (gravity, mass_matrix, coriolis_matrix, inverse_dynamics and forward_dynamics take
+    ``gimbal=`` to hold it at other angles); stylus_pose, stylus_tip_pose and stylus_jacobian
+    use all six angles. The gimbal's angles broadcast against theta (one gimbal over a batch).
 
     Attributes: ``description`` (the Description it was built from), ``config`` (its
     typed configuration), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's
