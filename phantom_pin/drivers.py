@@ -50,7 +50,7 @@ using-GeoMagic-Touch-Haptic-Device) reach no posture inside the stops with that,
 them with the estimate (tests/test_hardening5_ros.py). Check it on your device: the gimbal
 centre's HD_CURRENT_POSITION at a known posture gives it.
 
-Arrays: one vector (3,) or a batch (N, 3), as the rest of phantom_pin.
+Arrays: one vector (3,) or a batch (..., 3), as the rest of phantom_pin.
 """
 
 from __future__ import annotations
@@ -155,7 +155,7 @@ def gimbal_from_joint_state(names: object, position: object, prefix: str = "", c
 def joint_state_from_gimbal(gimbal: object, prefix: str = "", convention: str = "raw",
                             rates: bool = False) -> tuple[list[str], np.ndarray]:
     """(names, position) of the drivers' gimbal joint_states (GIMBAL_STATE_NAMES with
-    ``prefix``) for OpenHaptics' raw gimbal angles ``gimbal`` (rad), (3,) or (N, 3), in the
+    ``prefix``) for OpenHaptics' raw gimbal angles ``gimbal`` (rad), (3,) or (..., 3), in the
     driver's ``convention``; ``rates``: velocities (rad/s), without the offsets."""
     signs, offsets = _convention(convention)
     g, _ = as_states(gimbal, "gimbal")
@@ -257,7 +257,7 @@ def theta_from_joint_state(names: object, position: object, prefix: str = "") ->
 
 def joint_state_from_theta(theta: object, prefix: str = "") -> tuple[list[str], np.ndarray]:
     """(names, position) of the drivers' joint_states for the report's theta (rad):
-    ([prefix + waist, shoulder, elbow], (theta1, theta2, theta3 - theta2)), (3,) or (N, 3)."""
+    ([prefix + waist, shoulder, elbow], (theta1, theta2, theta3 - theta2)), (3,) or (..., 3)."""
     t, _ = as_states(theta, "theta")
     names = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
     with np.errstate(over="ignore"):  # reported by finite_result, naming theta

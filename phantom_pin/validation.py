@@ -12,17 +12,21 @@ from phantom_pin.exceptions import InvalidInputError
 
 
 def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, bool]:
-    """Return ``value`` as a float array of shape (width,) or (..., width).
+    """Return ``value`` as a float array of shape (width,) or (..., width): one state, or a
+    batch with any number of leading axes (each result keeps them).
 
     The second result is True when ``value`` carried leading (batch) axes.
-    Raises InvalidInputError naming ``name`` on a wrong or ragged shape, a non-numeric
-    or complex value, NaN or inf.
+    Raises InvalidInputError naming ``name`` on a wrong or ragged shape, a non-numeric,
+    boolean or complex value, NaN or inf.
     """
     try:
         array = np.asarray(value)
         if array.dtype.kind == "c":
             raise InvalidInputError("expected real numbers, got complex values", argument=name)
-        if array.dtype.kind not in "biufO":  # strings, bytes, dates
+        if array.dtype.kind == "b" or (array.dtype.kind == "O" and any(isinstance(x, (bool, np.bool_))
+                                                                        for x in array.flat)):
+            raise InvalidInputError("expected real numbers, got booleans", argument=name)
+        if array.dtype.kind not in "iufO":  # strings, bytes, dates
             raise TypeError(array.dtype)
         array = array.astype(float, copy=False)
     except (TypeError, ValueError) as error:
@@ -30,7 +34,7 @@ def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, boo
             raise
         raise InvalidInputError(f"expected numbers, got {value!r}", argument=name) from error
     if array.ndim == 0 or array.shape[-1] != width:
-        raise InvalidInputError(f"expected shape ({width},) or (N, {width}), got {array.shape}", argument=name)
+        raise InvalidInputError(f"expected shape ({width},) or (..., {width}), got {array.shape}", argument=name)
     if array.size == 0:
         raise InvalidInputError(f"expected at least one state, got shape {array.shape}", argument=name)
     if not np.isfinite(array).all():

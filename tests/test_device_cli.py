@@ -31,6 +31,7 @@ def test_simulate_csv_on_stdout_with_gravity_compensation_holds_still(cli):
     code, out, _ = cli("simulate", "--theta0", *START, "--duration", "0.02", "--controller", "gravity",
                        "--format", "csv")
     rows = list(csv.reader(out.splitlines()))
+    assert rows.pop(1) == ["# phantom-pin: model premium_1_5", " convention report"]  # L12's record, a comment
     assert code == 0 and rows[0][:4] == ["t [s]", "theta1 [rad]", "theta2 [rad]", "theta3 [rad]"] and len(rows) == 22
     table = np.array(rows[1:], dtype=float)
     np.testing.assert_allclose(table[:, 1:4], np.tile([0.3, 0.8, 0.4], (21, 1)), atol=1e-12)

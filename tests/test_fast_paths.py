@@ -8,7 +8,7 @@ import pinocchio as pin
 import pytest
 
 from helpers import REPORT, URDF_PATH, relative_error
-from phantom_pin import InvalidInputError
+from phantom_pin import Device, InvalidInputError, drivers
 from phantom_pin import closed_form as cf
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.model import solve_spd
@@ -74,7 +74,7 @@ def test_single_state_inputs_other_than_float64_give_the_same_numbers(phantom):
         expected = function(theta.astype(float))
         for value in (theta, theta.tolist(), tuple(theta), theta.astype(np.float32)):
             np.testing.assert_array_equal(function(value), expected)
-        with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(N, 3\)"):
+        with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(\.\.\., 3\)"):
             function(theta.astype(float)[:, None])
 
 
@@ -200,16 +200,84 @@ def test_fast_paths_return_fresh_arrays(phantom, method, count):
                                            ("forward_kinematics", None), ("spatial_jacobian", None),
                                            ("body_jacobian", None)])
 def test_shape_only_fast_paths_take_what_the_checked_path_takes(phantom, method, third):
-    """These fast paths check shapes and let eigenpy convert: int, bool, float32 and object
-    arrays of numbers give the numbers of the checked path; complex and (3, 1) are refused by name."""
+    """These fast paths check shapes and let eigenpy convert: int, float32 and object
+    arrays of numbers give the numbers of the checked path; complex and (3, 1) are refused by
+    name, and booleans (which eigenpy would take, L9) in every argument, below."""
     function = getattr(phantom, method)
     count = 1 if third is None else 3
     theta = np.array([0, 1, -1])
-    for value in (theta, theta.astype(np.float32), theta.astype(object), theta.tolist(),
-                  np.array([True, False, True])):
+    for value in (theta, theta.astype(np.float32), theta.astype(object), theta.tolist()):
         expected = function(*[np.asarray(value).astype(float)] * count)
         np.testing.assert_array_equal(function(*[value] * count), expected)
-    with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(N, 3\)"):
+    with pytest.raises(InvalidInputError, match=r"^theta: expected shape \(3,\) or \(\.\.\., 3\)"):
         function(theta[:, None], *[theta] * (count - 1))
     with pytest.raises(InvalidInputError, match=f"^{third or 'theta'}: expected real numbers"):
         function(*[theta] * (count - 1), theta + 1j)
+
+
+DEVICE = Device()
+BOOLEANS = [np.array([True, False, True]), [True, False, True], np.array([True, False, True], dtype=object),
+            np.array([[True, False, True]] * 2), np.array([[[True, False, True]]] * 2)]
+
+
+@pytest.mark.parametrize("method, count", METHODS)
+@pytest.mark.parametrize("booleans", range(len(BOOLEANS)))
+def test_booleans_in_any_argument_are_refused_by_name(phantom, method, count, booleans):
+    """L9: gravity([True, False, True]) computed at (1, 0, 1) rad. Booleans are no angles,
+    rates or torques: each argument in turn (the others fine, of the same batch shape), as an
+    array, a list, an object array, a batch and a batch of batches, single (the fast paths,
+    where eigenpy takes booleans) and batched, is refused naming that argument."""
+    value = BOOLEANS[booleans]
+    names = ("theta", "dtheta", "tau" if method == "forward_dynamics" else "ddtheta")
+    fine = np.full(np.shape(value), 0.3)
+    for argument in range(count):
+        values = [fine] * count
+        values[argument] = value
+        with pytest.raises(InvalidInputError, match=f"^{names[argument]}: expected real numbers, got booleans"):
+            getattr(phantom, method)(*values)
+        getattr(phantom, method)(*[v.astype(float) if isinstance(v, np.ndarray) else np.array(v, float)
+                                   for v in values])  # the same numbers as floats are taken
+
+
+@pytest.mark.parametrize("function, count", [("forward_kinematics", 1), ("mass_matrix", 1), ("gravity", 1),
+                                             ("coriolis_matrix", 2), ("inverse_dynamics", 3),
+                                             ("inverse_kinematics", 1)])
+def test_closed_form_refuses_booleans_by_name(function, count):
+    """L9 in the closed form too (it validates through the same as_states)."""
+    names = ("position",) if function == "inverse_kinematics" else ("theta", "dtheta", "ddtheta")
+    for argument in range(count):
+        values = [np.array([0.01, 0.2, 0.1])] * count
+        values[argument] = np.array([True, False, True])
+        with pytest.raises(InvalidInputError, match=f"^{names[argument]}: expected real numbers, got booleans"):
+            getattr(cf, function)(*values, REPORT)
+
+
+@pytest.mark.parametrize("call, name", [(lambda d, b: d.friction(b), "dtheta"),
+                                        (lambda d, b: d.motor_currents(b), "tau"),
+                                        (lambda d, b: d.stop_torque(b, np.zeros(3)), "theta"),
+                                        (lambda d, b: drivers.joint_state_from_theta(b), "theta"),
+                                        (lambda d, b: drivers.openhaptics_torque_from_tau(b), "tau")])
+def test_the_device_and_the_drivers_refuse_booleans_by_name(call, name):
+    """L9 beyond the dynamics: the Device and the drivers' conversions."""
+    with pytest.raises(InvalidInputError, match=f"^{name}: expected real numbers, got booleans"):
+        call(DEVICE, np.array([True, False, True]))
+
+
+@pytest.mark.parametrize("method, count", METHODS)
+def test_batches_with_several_leading_axes_keep_them(phantom, states, method, count):
+    """L9: a batch may have any number of leading axes (..., 3), as the docs now say: each
+    result keeps them, and equals the single states' results row by row (against the closed
+    form where it has the method, to 1e-9 relative)."""
+    values = [v[:24].reshape(2, 3, 4, 3) for v in _arguments(states, method, count)]
+    result = getattr(phantom, method)(*values)
+    for one in (result if isinstance(result, tuple) else (result,)):
+        assert one.shape[:3] == (2, 3, 4)
+    index = (1, 2, 3)
+    single = _stacked(getattr(phantom, method)(*(v[index] for v in values)))
+    np.testing.assert_allclose(_stacked(result)[(slice(None),) * isinstance(result, tuple) + index], single,
+                               rtol=1e-12, atol=1e-15)
+    if hasattr(cf, method):
+        reference = getattr(cf, method)(*values, REPORT)
+        assert reference.shape == np.shape(result)
+        if method != "potential_energy":
+            assert relative_error(result, reference) < 1e-9

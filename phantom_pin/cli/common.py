@@ -5,9 +5,13 @@ printing and warnings."""
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
+import os
 import re
+import stat
 import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -138,10 +142,89 @@ def output(args: argparse.Namespace, option: str = "--output") -> Path:
 
 def write_text(path: Path, text: str, option: str = "--output") -> None:
     """``text`` into the file ``path``; PhantomPinError naming ``option`` if it cannot be written."""
+    write_texts([(path, text, option)])
+
+
+def _unwritable(path: Path, error: OSError, option: str) -> PhantomPinError:
+    return PhantomPinError(f"cannot write {path} ({error.strerror})", argument=option)
+
+
+def write_texts(files: list[tuple[Path, str, str]]) -> None:
+    """Each (path, text, option) written, or none (PhantomPinError naming the option of the
+    first that cannot be): each text goes first into a temporary file beside its path (which
+    tries the folder's permissions and space), then every one is renamed into place. A path
+    that exists and is no regular file (a device such as /dev/null or /dev/full, a pipe) is
+    not renamed over: it is written in place once the others are staged (a second such path
+    after a first written is the one case where something stays written). A symbolic link is
+    followed: its target is replaced, the link kept."""
+    staged: list[tuple[str, Path]] = []
+    mask = os.umask(0)
+    os.umask(mask)
     try:
-        path.write_text(text)
-    except OSError as error:
-        raise PhantomPinError(f"cannot write {path} ({error.strerror})", argument=option) from None
+        for path, text, option in files:
+            if path.exists() and not path.is_file():
+                continue
+            real = path.resolve()
+            handle, temporary = tempfile.mkstemp(dir=real.parent, prefix=f".{real.name}.", suffix=".tmp")
+            staged.append((temporary, real))
+            mode = stat.S_IMODE(path.stat().st_mode) if path.exists() else 0o666 & ~mask
+            try:
+                with os.fdopen(handle, "w", encoding="utf-8") as stream:
+                    stream.write(text)
+                os.chmod(temporary, mode)
+            except OSError as error:
+                raise _unwritable(path, error, option) from None
+        for path, text, option in files:
+            if path.exists() and not path.is_file():
+                try:
+                    path.write_text(text, encoding="utf-8")
+                except OSError as error:
+                    raise _unwritable(path, error, option) from None
+    except BaseException:
+        for temporary, _ in staged:
+            Path(temporary).unlink(missing_ok=True)
+        raise
+    for temporary, path in staged:
+        os.replace(temporary, path)
+
+
+#: The comment line, second in a trajectory or log the command line writes, that records the model
+#: (config.name: a model's name or a folder's path) and the convention of its columns.
+RECORD = re.compile(r"#\s*phantom-pin:\s*model (?P<model>.+), convention (?P<convention>\w+)\s*")
+
+
+def csv_text(header: list[str], table: Any, model: str, convention: str) -> str:
+    """A trajectory's or log's CSV: the ``header`` line, the record of ``model`` and ``convention``
+    (RECORD; phantom_pin.identification.io skips # lines, as numpy.loadtxt does; pandas with
+    comment="#"), then the rows of ``table`` (N, len(header)) in their shortest exact decimals."""
+    rows = (",".join(map(repr, row)) for row in table.tolist())
+    return "\n".join([",".join(header), f"# phantom-pin: model {model}, convention {convention}", *rows]) + "\n"
+
+
+def check_record(path: Path, model: str, convention: str, option: str) -> None:
+    """PhantomPinError naming ``option`` if the file at ``path`` records (RECORD, before its first
+    row of data) another model or convention than ``model`` and ``convention``, the ones given;
+    a file without the record (written before 0.5.0, or by other tools) is read as it is. A file
+    that cannot be read is left to its reader's error."""
+    try:
+        with open(path, encoding="utf-8-sig") as stream:
+            lines = [line.strip() for line in itertools.islice(stream, 64)]
+    except (OSError, UnicodeDecodeError):
+        return
+    data = [i for i, line in enumerate(lines) if line and not line.startswith("#")]
+    for line in lines[:data[1] if len(data) > 1 else len(lines)]:
+        if not line.startswith("#") or "phantom-pin" not in line:
+            continue
+        found = RECORD.fullmatch(line)
+        if found is None:
+            raise PhantomPinError(f"{path}: its line {line[:60]!r} is not '# phantom-pin: model NAME, convention "
+                                  "NAME'", argument=option)
+        if (found["model"], found["convention"]) != (model, convention):
+            raise PhantomPinError(f"{path} was written for the model {found['model']} in the {found['convention']} "
+                                  f"convention, read here for the model {model} in the {convention} convention (give "
+                                  "--model and --convention as written, or delete its '# phantom-pin' line)",
+                                  argument=option)
+        return
 
 
 def show(args: argparse.Namespace, data: dict, text: str) -> None:
@@ -179,6 +262,19 @@ def warn_limits(theta: Any, lower: Any, upper: Any, what: str = "theta") -> None
     if not within_box(theta, lower, upper):
         warn(f"{what} {vector(theta, '{:.6g}')} rad is outside the joint limits {vector(lower, '{:.6g}')}.."
              f"{vector(upper, '{:.6g}')} rad (computed anyway)")
+
+
+def add_gimbal(command: argparse.ArgumentParser, what: str) -> None:
+    """The option --gimbal G1 G2 G3 (rad) of a command: ``what`` the angles do."""
+    command.add_argument("--gimbal", metavar="G", nargs=3, type=float,
+                         help=f"the stylus gimbal's angles (rad, OpenHaptics' raw gimbal angles; a model with a "
+                              f"gimbal, the Touch): {what}")
+
+
+def warn_gimbal(gimbal: Any, robot: Phantom) -> None:
+    """A warning when --gimbal's angles lie outside the gimbal's range (as warn_limits' for theta)."""
+    if gimbal is not None and robot.config.gimbal is not None:
+        warn_limits(gimbal, robot.config.gimbal.lower, robot.config.gimbal.upper, "gimbal")
 
 
 def positive_integer(text: str) -> int:

@@ -12,7 +12,18 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
-from phantom_pin.cli.common import Once, emit, output, phantom, warn, write_text
+from phantom_pin.cli.common import (
+    Once,
+    add_gimbal,
+    check_record,
+    csv_text,
+    emit,
+    output,
+    phantom,
+    warn,
+    warn_gimbal,
+    write_text,
+)
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
@@ -22,7 +33,7 @@ from phantom_pin.identification import io
 from phantom_pin.progress import Progress
 
 #: simulate()'s arguments that are options of the command (its errors name them).
-OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization")} | {
+OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization", "gimbal")} | {
     "device": "the model (--model, --config, --params, --set)", "path": "--trajectory"}
 #: Columns of the result, with their units, as written to JSON and CSV.
 UNITS = {"t": "s", "theta": "rad", "dtheta": "rad/s", "tau": "N m (applied, held until the next sample)",
@@ -65,6 +76,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     clip.add_argument("--saturation", choices=("continuous", "peak"),
                       help="clip commands at the motors' continuous or peak torque (default: actuation.yaml's "
                            "saturation, as the MJCF)")
+    add_gimbal(command, "held there during the run (default: the configuration's locked_at)")
     command.add_argument("--quantization", action="store_true",
                          help="the controller sees the angles rounded to encoder counts (rad) and their backward "
                               "difference")
@@ -129,7 +141,7 @@ def _free(args: argparse.Namespace, robot: Phantom) -> _Run:
     controller = None
     if args.controller == "gravity":
         def controller(t: float, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
-            return robot.gravity(theta)
+            return robot.gravity(theta, args.gimbal)
     return _Run(args.theta0, [0.0, 0.0, 0.0] if args.dtheta0 is None else args.dtheta0, args.duration,
                 1000.0 if args.rate is None else args.rate, controller)
 
@@ -140,13 +152,15 @@ def simulate_command(args: argparse.Namespace) -> int:
     form = _format(args)
     robot = phantom(args)
     device = Device(robot)
+    if args.trajectory is not None:
+        check_record(args.trajectory, robot.config.name, args.convention or "report", "--trajectory")
     run = _tracking(args) if args.trajectory is not None else _free(args, robot)
     bar = Progress("simulate", 1.0, enabled=False if args.quiet else None)
     try:
         result = simulate(run.theta0, run.duration, run.controller, dtheta0=run.dtheta0, rate=run.rate,
                           friction=not args.no_friction, hard_stops=not args.no_hard_stops,
                           saturation=False if args.no_saturation else args.saturation or True,
-                          quantization=args.quantization, device=device, progress=bar.update)
+                          quantization=args.quantization, device=device, progress=bar.update, gimbal=args.gimbal)
     except PhantomPinError as error:  # what --trajectory sets is the file's, not an option's
         if args.trajectory is None or error.argument not in TRAJECTORY_SETS:
             raise
@@ -159,15 +173,17 @@ def simulate_command(args: argparse.Namespace) -> int:
         hint = (" (is the file in OpenHaptics' mN m? --convention openhaptics)"
                 if args.trajectory is not None and args.convention is None else "")
         warn(f"{100 * saturated:.1f} % of the commanded torques exceeded the saturation and were clipped{hint}")
+    warn_gimbal(args.gimbal, robot)
     if not args.no_hard_stops and not device.within_limits(run.theta0):  # after the run: a refused one alone
         warn(f"--theta0 {run.theta0} rad starts beyond the stops, which push it back")
     settings = dataclasses.asdict(run) | {key: getattr(args, key) for key in (
-        "controller", "no_friction", "no_hard_stops", "no_saturation", "saturation", "quantization")}
+        "controller", "no_friction", "no_hard_stops", "no_saturation", "saturation", "quantization", "gimbal")}
     settings["controller"] = args.controller or "none"
     settings["saturation"] = False if args.no_saturation else args.saturation or device.config.actuation.saturation
     settings["substeps"] = result.substeps
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
-    text = _json(result, settings) if form == "json" else _csv(result)
+    settings["model"] = robot.config.name
+    text = _json(result, settings) if form == "json" else _csv(result, robot.config.name)
     if target is None:
         emit(text)
         return 0
@@ -189,15 +205,15 @@ def _json(result: SimulationResult, settings: dict) -> str:
     return json.dumps(data) + "\n"
 
 
-def _csv(result: SimulationResult) -> str:
+def _csv(result: SimulationResult, model: str) -> str:
+    """The run as a log that identify reads: the report's convention, the model recorded."""
     header, columns = [], []
     for name, unit in _columns(result).items():
         values = getattr(result, name).reshape(len(result.t), -1)
         suffixes = [""] if values.shape[1] == 1 else (["_x", "_y", "_z"] if name == "tip" else ["1", "2", "3"])
         header += [f"{name}{s} [{unit.split(' (')[0]}]" for s in suffixes]
         columns.append(values)
-    rows = (",".join(map(repr, row)) for row in np.hstack(columns).tolist())  # shortest exact decimals
-    return "\n".join([",".join(header), *rows]) + "\n"
+    return csv_text(header, np.hstack(columns), model, "report")
 
 
 def info(phantom: Phantom) -> tuple[dict, list[str]]:

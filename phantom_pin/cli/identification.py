@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers, profiles
-from phantom_pin.cli.common import Once, description, overrides, warn
+from phantom_pin.cli.common import Once, check_record, csv_text, description, overrides, warn, write_text
 from phantom_pin.config import DEFAULT
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -233,7 +233,8 @@ def excite_command(args: argparse.Namespace) -> int:
     if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
         theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
         tau = drivers.openhaptics_torque_from_tau(tau)
-    io.write_csv(args.output, io.TRAJECTORY_COLUMNS, np.column_stack([t, theta, dtheta, ddtheta, tau]))
+    write_text(args.output, csv_text(list(io.TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
+                                     made.config.name, args.convention))
     effort = excitation.continuous_effort(made)
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
           f"{args.harmonics} harmonics per joint" + (", in OpenHaptics' joint angles (rad) and joint torques "
@@ -268,6 +269,8 @@ def identify_command(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.cutoff) and args.cutoff > 0):
         raise PhantomPinError(f"--cutoff: expected a finite positive frequency (Hz), got {args.cutoff!r}")
     delay = _delay(args.delay)
+    if recording is None:
+        check_record(args.log, phantom.config.name, args.convention, "LOG")
     log = io.read_log(args.log, args.convention) if recording is None else recording.log
     for line in [] if recording is None else recording.lines():
         print(line)

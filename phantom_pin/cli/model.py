@@ -15,6 +15,7 @@ from phantom_pin import verification
 from phantom_pin.cli import device
 from phantom_pin.cli.common import (
     Once,
+    add_gimbal,
     description,
     output,
     overrides,
@@ -23,8 +24,10 @@ from phantom_pin.cli.common import (
     show,
     vector,
     warn,
+    warn_gimbal,
     warn_limits,
     write_text,
+    write_texts,
 )
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
@@ -104,13 +107,20 @@ def check(args: argparse.Namespace) -> int:
 
 
 def fk(args: argparse.Namespace) -> int:
-    """g_st at --theta, with a warning outside the joint limits."""
+    """g_st at --theta, with a warning outside the joint limits; with --gimbal the stylus's pose
+    and its tip's too."""
     robot = phantom(args)
-    g = robot.forward_kinematics(args.theta)
+    poses = {"g_st": robot.forward_kinematics(args.theta)}
+    if args.gimbal is not None:
+        poses |= {"stylus": robot.stylus_pose(args.theta, args.gimbal),
+                  "stylus_tip": robot.stylus_tip_pose(args.theta, args.gimbal)}
     warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-    show(args, {"g_st": g.tolist()},
-         f"tip position in s [m]: {np.array2string(g[:3, 3], precision=6)}\n"
-         f"g_st =\n{np.array2string(g, precision=6, suppress_small=True)}")
+    warn_gimbal(args.gimbal, robot)
+    names = {"g_st": "tip", "stylus": "stylus frame (the gimbal centre)", "stylus_tip": "stylus tip"}
+    show(args, {k: g.tolist() for k, g in poses.items()},
+         "\n".join(f"{names[k]} position in s [m]: {np.array2string(g[:3, 3], precision=6)}\n"
+                   f"{'g_st' if k == 'g_st' else 'g_s,' + k} =\n{np.array2string(g, precision=6, suppress_small=True)}"
+                   for k, g in poses.items()))
     return 0
 
 
@@ -124,13 +134,14 @@ def ik(args: argparse.Namespace) -> int:
 
 
 def dynamics(args: argparse.Namespace) -> int:
-    """M, C, N and tau at one state."""
+    """M, C, N and tau at one state (the gimbal held at --gimbal's angles, or at locked_at)."""
     robot = phantom(args)
-    results = {"M": robot.mass_matrix(args.theta),
-               "C": robot.coriolis_matrix(args.theta, args.dtheta),
-               "N": robot.gravity(args.theta),
-               "tau": robot.inverse_dynamics(args.theta, args.dtheta, args.ddtheta)}
+    results = {"M": robot.mass_matrix(args.theta, args.gimbal),
+               "C": robot.coriolis_matrix(args.theta, args.dtheta, args.gimbal),
+               "N": robot.gravity(args.theta, args.gimbal),
+               "tau": robot.inverse_dynamics(args.theta, args.dtheta, args.ddtheta, args.gimbal)}
     warn_limits(args.theta, robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+    warn_gimbal(args.gimbal, robot)
     text = "\n".join(f"{k} =\n{np.array2string(v, precision=6)}" for k, v in results.items())
     show(args, {k: v.tolist() for k, v in results.items()}, text)
     return 0
@@ -153,10 +164,10 @@ def write(args: argparse.Namespace) -> int:
         print(f"wrote {target}")
         return 0
     texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
-    write_text(target, texts[args.kind])
+    # both files or neither (a scene that cannot be written leaves no model behind)
+    write_texts([(target, texts[args.kind], "--output")] + ([] if scene is None else [(scene, made.scene, "--scene")]))
     print(f"wrote {target}")
     if scene is not None:
-        write_text(scene, made.scene, "--scene")
         print(f"wrote {scene}")
     return 0
 
@@ -266,8 +277,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.set_defaults(run=check, options={"states": "-n", "phantom": "--model"})
     command = sub.add_parser("fk", help="g_st (eq. 10) at theta (rad)")
     command.add_argument("theta", metavar="T", **THREE)
+    add_gimbal(command, "also the stylus frame's pose and its tip's")
     command.add_argument("--json", action="store_true", help="print JSON")
-    command.set_defaults(run=fk)
+    command.set_defaults(run=fk, options={"gimbal": "--gimbal"})
     command = sub.add_parser("ik", help="theta (rad) that puts the tip at X Y Z (m, frame s)")
     command.add_argument("position", metavar="P", **THREE)
     command.add_argument("--branch", choices=["report", "other"], default="report")
@@ -277,8 +289,9 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--theta", required=True, **THREE)
     command.add_argument("--dtheta", default=[0.0, 0.0, 0.0], **THREE)
     command.add_argument("--ddtheta", default=[0.0, 0.0, 0.0], **THREE)
+    add_gimbal(command, "held there (default: the configuration's locked_at)")
     command.add_argument("--json", action="store_true", help="print JSON")
-    command.set_defaults(run=dynamics)
+    command.set_defaults(run=dynamics, options={"gimbal": "--gimbal"})
     for kind in ("urdf", "srdf", "mjcf", "links"):
         command = sub.add_parser(kind, help=f"write the {kind.upper()} generated from --model or --config"
                                  if kind != "links" else "write the links in full (mass, COM, inertia; the "

@@ -128,7 +128,7 @@ class Friction:
         another shape; one joint's law: ``joint``."""
         rates = np.asarray(dtheta, dtype=float)
         if rates.shape[-1:] != (3,):
-            raise InvalidInputError(f"expected rates of shape (3,) or (N, 3) (rad/s), got shape {rates.shape}",
+            raise InvalidInputError(f"expected rates of shape (3,) or (..., 3) (rad/s), got shape {rates.shape}",
                                     argument="dtheta")
         return np.asarray(self.viscous) * rates + np.asarray(self.coulomb) * np.sign(rates)
 

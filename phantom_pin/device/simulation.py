@@ -11,9 +11,11 @@ from collections.abc import Callable
 import numpy as np
 
 from phantom_pin.config.types import SATURATIONS
+from phantom_pin.description.build import held
 from phantom_pin.device.device import Device
 from phantom_pin.device.plant import MAX_STEP, Diverged, Plant, contact_substeps
 from phantom_pin.device.run import MAX_STEPS, Controller, SimulationResult, arguments, command, default_device
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 
 __all__ = ["SimulationResult", "default_device", "simulate"]
@@ -23,7 +25,7 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
              dtheta0: object = None, rate: float = 1000.0, friction: bool = True,
              hard_stops: bool = True, saturation: bool | str = True, quantization: bool = False,
              device: Device | None = None, substeps: int | None = None,
-             progress: Callable[[float], None] | None = None) -> SimulationResult:
+             progress: Callable[[float], None] | None = None, gimbal: object = None) -> SimulationResult:
     """Run ``controller`` against the device from rest (or ``dtheta0``) at ``theta0``.
 
     ``controller(t, theta, dtheta) -> tau`` (s, rad, rad/s -> three joint torques, N m) is
@@ -49,13 +51,18 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
     or MAX_STEPS RK4 steps, counted as if every period were spent on a stop.
 
     ``device``: the Device to simulate (default: the shipped one, built once). ``progress``:
-    called with the share of the samples done (0..1), for a progress bar.
+    called with the share of the samples done (0..1), for a progress bar. ``gimbal`` (rad,
+    OpenHaptics' raw gimbal angles, (3,); a model with a stylus gimbal, the Touch): the gimbal
+    held at these angles during the run instead of at ``config.gimbal.locked_at`` (the device
+    of description.build.held; Phantom's methods with ``gimbal=`` give the same dynamics).
     Raises InvalidInputError naming the bad argument, or the controller's bad return;
     MissingDataError for ``quantization`` on a model without public encoder data.
     """
     saturation = _options(friction, hard_stops, quantization, saturation)
     theta, velocity, duration, rate, device, samples = arguments(theta0, dtheta0, duration, rate, controller,
                                                                  device)
+    if gimbal is not None:
+        device = Device(Phantom(held(device.phantom.description, gimbal)))
     if quantization:
         device.require("encoder", "quantization")
     if progress is not None and not callable(progress):

@@ -34,6 +34,9 @@ _IK_SEEDS = {"report": ((0.35, 0.3), (0.9, 1.0)), "other": ((-0.35, -2.8), (0.9,
 
 
 _ONE = (3,)
+#: eigenpy converts boolean arrays, which as_states refuses: the fast paths that check only
+#: shapes send them to the checked path (a builtin dtype is one object)
+_BOOL = np.dtype(bool)
 _isfinite = math.isfinite
 
 
@@ -45,7 +48,8 @@ def _finite(array: np.ndarray) -> bool:
 
 def _one(value: object) -> TypeGuard[np.ndarray]:
     """The fast paths' check, written once: True if ``value`` is a finite vector of shape (3,)
-    (an array; the dtype is left to eigenpy).
+    (an array; the dtype is left to eigenpy, but for booleans, which eigenpy would take: their
+    tolist() gives bools, sent to the checked path, which refuses them by name).
 
     ``a, b, c = value.tolist() if value.size == 3 else ()`` then ``isfinite(a + b + c)`` is the
     cheapest check (0.16 us, against 0.33 us for a shape comparison and sum()): a batch fails
@@ -56,7 +60,7 @@ def _one(value: object) -> TypeGuard[np.ndarray]:
     theta; where rates enter, whose products can overflow, the caller checks the result too."""
     try:
         a, b, c = value.tolist() if value.size == 3 else ()  # type: ignore[attr-defined,misc]
-        return _isfinite(a + b + c)
+        return a.__class__ is not bool and _isfinite(a + b + c)
     except (AttributeError, TypeError, ValueError):
         return False
 
@@ -83,6 +87,23 @@ def solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, f
     return ((cof_a * r0 + cof_b * r1 + cof_c * r2) / det,
             (cof_b * r0 + cof_d * r1 + cof_e * r2) / det,
             (cof_c * r0 + cof_e * r1 + minor2 * r2) / det)
+
+
+def _accelerations(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x with ``mass`` x = ``rhs`` (a symmetric (3, 3) M and (3,) torques): solve_spd, or where M
+    is not positive definite (or not finite) Cholesky, which decides, as ever (LinAlgError)."""
+    acc = solve_spd(mass.tolist(), rhs.tolist())
+    if acc is None:
+        factor = np.linalg.cholesky(mass)
+        return np.linalg.solve(factor.T, np.linalg.solve(factor, rhs))
+    return np.array(acc)
+
+
+def _coriolis(coupling: Coupling, tree_data: pin.Data, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The Coriolis matrix of ``coupling``'s reduced model at (q, v): Pinocchio's is silently wrong
+    on mimic models (DEVELOPERS.md), so the tree's, projected: C = G^T C_tree G."""
+    return coupling.project(pin.computeCoriolisMatrix(coupling.tree, tree_data, coupling.configuration(q),
+                                                      coupling.tangent(v)))
 
 
 def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Callable[..., np.ndarray]:
@@ -130,14 +151,16 @@ class Phantom:
     joint1..joint3; rates in rad/s, accelerations in rad/s^2, torques in N m. Poses
     are in the report's kinematic frame s (URDF frame ``report_s``: x left, y up,
     z forward); the tool frame t is ``tip``. Every method takes one state, shape (3,),
-    or a batch, shape (N, 3), and returns fresh arrays.
+    or a batch, shape (..., 3) (any number of leading axes, which each result keeps), of real
+    numbers (booleans are refused), and returns fresh arrays.
 
     The stylus gimbal (a model with one: the Touch, ``config.gimbal``): its joints
     ``gimbal_joints`` (the URDF's joint4..joint6) are passive and their angles g, shape (3,)
-    or (N, 3), are OpenHaptics' raw gimbal angles (rad). The arm's dynamics (every method of
+    or (..., 3), are OpenHaptics' raw gimbal angles (rad). The arm's dynamics (every method of
     theta alone) carry the gimbal and stylus as a rigid load held at ``config.gimbal.locked_at``
-    (gravity(theta, gimbal) takes other angles); stylus_pose, stylus_tip_pose and
-    stylus_jacobian use all six angles.
+    (gravity, mass_matrix, coriolis_matrix, inverse_dynamics and forward_dynamics take
+    ``gimbal=`` to hold it at other angles); stylus_pose, stylus_tip_pose and stylus_jacobian
+    use all six angles. The gimbal's angles broadcast against theta (one gimbal over a batch).
 
     Attributes: ``description`` (the Description it was built from), ``config`` (its
     typed configuration), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's
@@ -178,15 +201,23 @@ class Phantom:
         self.stylus_model: pin.Model | None = None
         self._frame_stylus = self._frame_stylus_tip = -1
         if gimbal is not None:  # the six-joint model, rooted at frame s as _kinematics
-            six = pin.buildModelFromXML(description.urdf, mimic=True)
+            #: the six joints' mimic model and its tree (the Coriolis matrix of the gimbal held, see
+            #: coriolis_matrix), from the URDF with the gimbal free
+            self._stylus_coupling = Coupling(description.urdf)
+            self._stylus_tree_data = self._stylus_coupling.tree.createData()
+            six = self._stylus_coupling.reduced
             six.gravity = gravity_of(self.config)
             six_data = six.createData()
             pin.framesForwardKinematics(six, six_data, pin.neutral(six))
             self.stylus_model = _rooted_at(six, six_data.oMf[six.getFrameId(prefix + "report_s")].inverse())
-            self._stylus_data = self.stylus_model.createData()
             names = (*(f"{prefix}joint{j}" for j in (1, 2, 3)), *self.gimbal_joints)
-            #: the six-joint model's q of (theta, g): q[order] = (theta1..3, g1..3)
+            #: the six-joint model's q (and, every joint revolute, v) of (theta, g): q[order] = (theta1..3, g1..3)
             self._order = np.array([self.stylus_model.joints[self.stylus_model.getJointId(n)].idx_q for n in names])
+            self._arm, self._arm_block = self._order[:3], np.ix_(self._order[:3], self._order[:3])
+            armature = self.stylus_model.armature.copy()
+            armature[self._arm] = self.model.armature  # the rotors, as the arm's model has them
+            self.stylus_model.armature = armature
+            self._stylus_data = self.stylus_model.createData()
             self._frame_stylus = self.stylus_model.getFrameId(f"{prefix}stylus")
             self._frame_stylus_tip = self.stylus_model.getFrameId(f"{prefix}stylus_tip")
 
@@ -358,20 +389,71 @@ class Phantom:
                                     "only a model whose gimbal is public, the Touch, has one)", argument="gimbal")
         return self.stylus_model, self._stylus_data
 
-    def _six(self, theta: object, gimbal: object) -> np.ndarray:
-        """The six-joint model's configurations (..., 6) of checked theta and gimbal angles (rad)."""
+    def _six(self, names: tuple[str, ...], gimbal: object, *values: object) -> list[np.ndarray]:
+        """The six-joint model's arrays (..., 6) of the arm's ``values`` (named ``names``, of one
+        shape; the first theta (rad), with the gimbal angles ``gimbal`` (rad); the others, rates,
+        accelerations or torques, with the gimbal's zero), checked, over the batch shape that
+        theta's and the gimbal's broadcast to (NumPy's rules: one gimbal over a batch of theta)."""
         self._stylus()
-        t, g = self._states(("theta", "gimbal"), theta, gimbal)
-        t, g = np.broadcast_arrays(t, g)
-        q = np.empty(t.shape[:-1] + (6,))
-        q[..., self._order[:3]], q[..., self._order[3:]] = t, g
+        arm = self._states(names, *values)
+        g, _ = as_states(gimbal, "gimbal")
+        try:
+            shape = np.broadcast_shapes(arm[0].shape[:-1], g.shape[:-1])
+        except ValueError:
+            raise InvalidInputError(f"shape {g.shape} does not broadcast against {names[0]}'s {arm[0].shape}",
+                                    argument="gimbal") from None
+        six = [np.zeros(shape + (6,)) for _ in arm]
+        for out, value in zip(six, arm):
+            out[..., self._arm] = value
+        six[0][..., self._order[3:]] = g
+        return six
+
+    def _one_six(self, theta: np.ndarray, gimbal: np.ndarray | None) -> np.ndarray:
+        """The six-joint model's q of one finite (theta, gimbal) (the fast paths); with ``gimbal``
+        None, a rate's, acceleration's or torque's (the gimbal's zero)."""
+        q = np.zeros(6)
+        q[self._arm] = theta
+        if gimbal is not None:
+            q[self._order[3:]] = gimbal
         return q
 
-    def _one_six(self, theta: np.ndarray, gimbal: np.ndarray) -> np.ndarray:
-        """The six-joint model's q of one finite (theta, gimbal) (the fast paths)."""
-        q = np.empty(6)
-        q[self._order[:3]], q[self._order[3:]] = theta, gimbal
-        return q
+    def _held(self, one: Callable[..., np.ndarray], names: tuple[str, ...], gimbal: object,
+              *values: object) -> np.ndarray:
+        """The arm's dynamics with the stylus gimbal held at ``gimbal`` (rad; its rates and
+        accelerations zero), every method's one path: ``one(q, *others)`` of the six-joint
+        model's arrays of theta (``values[0]``) with the gimbal and of the arm's other ``values``
+        (_six), one state or over the broadcast batch; InvalidInputError naming ``names`` and
+        ``gimbal`` for a bad argument or a result that is not finite."""
+        arm: Any = values  # finite vectors (3,) once _one says so
+        if self.stylus_model is not None and _one(gimbal) and all(map(_one, arm)):  # the fast path
+            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
+                out = one(self._one_six(arm[0], gimbal), *(self._one_six(v, None) for v in arm[1:]))
+                if _finite(out):  # rates can overflow
+                    return out
+            except TypeError:
+                pass
+        arrays = self._six(names, gimbal, *values)
+        with np.errstate(invalid="ignore", over="ignore"):  # reported by finite_result
+            out = _rows(one, *(a.reshape(-1, 6) for a in arrays))
+        return finite_result(out.reshape(arrays[0].shape[:-1] + out.shape[1:]), ", ".join((*names, "gimbal")))
+
+    # the arm's rows (and columns) of the six-joint model's dynamics at one state, for _held
+    def _held_gravity(self, q: np.ndarray) -> np.ndarray:
+        return pin.computeGeneralizedGravity(self.stylus_model, self._stylus_data, q)[self._arm]
+
+    def _held_mass(self, q: np.ndarray) -> np.ndarray:
+        return pin.crba(self.stylus_model, self._stylus_data, q)[self._arm_block]  # the full matrix, as mass_matrix's
+
+    def _held_coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return _coriolis(self._stylus_coupling, self._stylus_tree_data, q, v)[self._arm_block]
+
+    def _held_torques(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
+        return pin.rnea(self.stylus_model, self._stylus_data, q, v, a)[self._arm]
+
+    def _held_forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        model, data, arm = self.stylus_model, self._stylus_data, self._arm
+        return _accelerations(pin.crba(model, data, q)[self._arm_block],
+                              tau[arm] - pin.nonLinearEffects(model, data, q, v)[arm])
 
     def _stylus_frame(self, frame: int, theta: object, gimbal: object, jacobian: bool = False) -> np.ndarray:
         model = self.stylus_model
@@ -381,7 +463,7 @@ class Phantom:
                 return pin.updateFramePlacement(model, self._stylus_data, frame).homogeneous
             except TypeError:
                 pass
-        q = self._six(theta, gimbal)
+        (q,) = self._six(("theta",), gimbal, theta)
         model, data = self._stylus()
 
         def one(configuration: np.ndarray) -> np.ndarray:
@@ -421,8 +503,12 @@ class Phantom:
         twist (v, omega) in the tool frame t.""")
 
     # -- dynamics --------------------------------------------------------------------
-    def mass_matrix(self, theta: object) -> np.ndarray:
-        """Joint-space inertia M(theta) (eqs 81-85), with the rotors' armature: (..., 3, 3)."""
+    def mass_matrix(self, theta: object, gimbal: object = None) -> np.ndarray:
+        """Joint-space inertia M(theta) (eqs 81-85), with the rotors' armature: (..., 3, 3),
+        kg m^2. ``gimbal`` (rad, a model with a gimbal only): held at those angles instead of at
+        ``locked_at``, as in gravity."""
+        if gimbal is not None:
+            return self._held(self._held_mass, ("theta",), gimbal, theta)
         if _one(theta):  # the fast path
             try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 return pin.crba(self.model, self.data, theta)
@@ -431,20 +517,19 @@ class Phantom:
         # the binding of crba returns the full symmetric matrix (DEVELOPERS.md), not data.M
         return self._each(pin.crba, ("theta",), theta, before=(self.model, self.data))
 
-    def _coriolis(self, theta: np.ndarray, dtheta: np.ndarray) -> np.ndarray:
-        coupling = self.coupling
-        return coupling.project(pin.computeCoriolisMatrix(
-            coupling.tree, self._tree_data, coupling.configuration(theta), coupling.tangent(dtheta)))
-
-    def coriolis_matrix(self, theta: object, dtheta: object) -> np.ndarray:
+    def coriolis_matrix(self, theta: object, dtheta: object, gimbal: object = None) -> np.ndarray:
         """Coriolis matrix C(theta, dtheta) (eqs 86-92): (..., 3, 3), N m s/rad.
 
         Pinocchio's computeCoriolisMatrix is silently wrong on mimic models, so it runs
-        on the tree model and is projected: C = G^T C_tree G.
+        on the tree model and is projected: C = G^T C_tree G. ``gimbal`` (rad): held at those
+        angles, as in gravity: the arm's block of the six-joint model's C at zero gimbal rates
+        (its Christoffel symbols over the arm's coordinates: those of the arm locked there).
         """
+        if gimbal is not None:
+            return self._held(self._held_coriolis, ("theta", "dtheta"), gimbal, theta, dtheta)
         if _one(theta) and _one(dtheta):  # the fast path; rates can overflow C
             try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                out = self._coriolis(theta, dtheta)
+                out = _coriolis(self.coupling, self._tree_data, theta, dtheta)
                 if _finite(out):
                     return out
             except TypeError:
@@ -457,21 +542,15 @@ class Phantom:
         """Gravity torque N(theta) (eqs 93-94): (..., 3), N m.
 
         A batch: rnea at zero rates and accelerations, by rneaInParallel. ``gimbal`` (rad,
-        (3,) or (..., 3), a model with a gimbal only): the torques that hold the arm with the
-        stylus at those gimbal angles (the arm's rows of the six-joint model's gravity: the
-        passive gimbal's own torques are the hand's), instead of at ``locked_at``.
+        (3,) or (..., 3), broadcast against theta; a model with a gimbal only, else
+        InvalidInputError naming it): the torques that hold the arm with the stylus at those
+        gimbal angles (the arm's rows of the six-joint model's gravity: the passive gimbal's own
+        torques are the hand's), instead of at ``locked_at``. mass_matrix, coriolis_matrix,
+        inverse_dynamics and forward_dynamics take ``gimbal`` alike (the gimbal held at those
+        angles: its rates and accelerations zero), each through one path (_held).
         """
         if gimbal is not None:
-            if _one(theta) and _one(gimbal) and self.stylus_model is not None:  # the fast path
-                try:
-                    return pin.computeGeneralizedGravity(self.stylus_model, self._stylus_data,
-                                                         self._one_six(theta, gimbal))[self._order[:3]]
-                except TypeError:
-                    pass
-            q = self._six(theta, gimbal)
-            model, data = self._stylus()
-            out = _rows(pin.computeGeneralizedGravity, q.reshape(-1, 6), before=(model, data))
-            return finite_result(out[:, self._order[:3]].reshape(q.shape[:-1] + (3,)), "theta, gimbal")
+            return self._held(self._held_gravity, ("theta",), gimbal, theta)
         if _one(theta):  # the fast path
             try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 return pin.computeGeneralizedGravity(self.model, self.data, theta)
@@ -492,15 +571,20 @@ class Phantom:
                        before=(self.coupling.tree, self._tree_data))
         return energy.reshape(q.shape[:-1])  # finite: V is a sum of masses times heights
 
-    def inverse_dynamics(self, theta: object, dtheta: object, ddtheta: object) -> np.ndarray:
+    def inverse_dynamics(self, theta: object, dtheta: object, ddtheta: object, gimbal: object = None) -> np.ndarray:
         """Joint torques tau = M ddtheta + C dtheta + N (eq. 80): (..., 3), N m.
 
-        One state: pinocchio.rnea on the mimic model. A batch (N, 3):
-        pinocchio.rneaInParallel over ``threads`` OpenMP threads.
+        One state: pinocchio.rnea on the mimic model. A batch (..., 3):
+        pinocchio.rneaInParallel over ``threads`` OpenMP threads. ``gimbal`` (rad): held at
+        those angles, as in gravity (the arm's rows of the six-joint model's rnea).
         """
+        if gimbal is not None:
+            return self._held(self._held_torques, ("theta", "dtheta", "ddtheta"), gimbal, theta, dtheta, ddtheta)
         q: Any = theta  # any object: its shape is asked, not assumed (lists have none)
         try:  # the fast path: one state (3,); eigenpy refuses (TypeError) complex and object
-            if q.shape == dtheta.shape == ddtheta.shape == _ONE:  # type: ignore[attr-defined]
+            if (q.shape == dtheta.shape == ddtheta.shape == _ONE  # type: ignore[attr-defined]
+                    and _BOOL is not q.dtype and _BOOL is not dtheta.dtype  # type: ignore[attr-defined]
+                    and _BOOL is not ddtheta.dtype):  # type: ignore[attr-defined]
                 tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
                 # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
                 # only then are the inputs inspected, to name the bad one.
@@ -516,22 +600,21 @@ class Phantom:
         return finite_result(self._batched(q, v, a), ", ".join(names))
 
     def _forward(self, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        bias = pin.nonLinearEffects(self.model, self.data, theta, dtheta).tolist()
-        mass = pin.crba(self.model, self.data, theta)
-        acc = solve_spd(mass.tolist(), [t - b for t, b in zip(tau.tolist(), bias)])
-        if acc is None:  # M not positive definite (or not finite): Cholesky decides, as ever
-            factor = np.linalg.cholesky(mass)
-            return np.linalg.solve(factor.T, np.linalg.solve(factor, tau - bias))
-        return np.array(acc)
+        return _accelerations(pin.crba(self.model, self.data, theta),
+                              tau - pin.nonLinearEffects(self.model, self.data, theta, dtheta))
 
-    def forward_dynamics(self, theta: object, dtheta: object, tau: object) -> np.ndarray:
+    def forward_dynamics(self, theta: object, dtheta: object, tau: object, gimbal: object = None) -> np.ndarray:
         """Joint accelerations (rad/s^2) under torques ``tau`` (N m): M^-1 (tau - C dtheta - N).
 
         pinocchio.aba refuses mimic models, so M (crba) and the bias torques
         (nonLinearEffects) come from Pinocchio and the symmetric 3x3 system is solved by
         its adjugate; np.linalg.cholesky raises LinAlgError if M is not positive definite.
         A batch: the bias torques by rneaInParallel, M per state, one batched solve.
+        ``gimbal`` (rad): held at those angles, as in gravity (the arm's block of the six-joint
+        model's M and its rows of the bias torques), one state at a time.
         """
+        if gimbal is not None:
+            return self._held(self._held_forward, ("theta", "dtheta", "tau"), gimbal, theta, dtheta, tau)
         rates: Any = dtheta  # any object: its shape is asked, not assumed
         torques: Any = tau
         # the fast path: NaN/inf in dtheta or tau reaches every acceleration (0 * NaN is NaN),
@@ -541,7 +624,7 @@ class Phantom:
         if _one(theta):
             try:
                 t0, t1, t2 = torques.tolist()
-                if rates.shape == _ONE:
+                if rates.shape == _ONE and t0.__class__ is not bool and rates.dtype is not _BOOL:
                     model, data = self.model, self.data
                     bias = pin.nonLinearEffects(model, data, theta, dtheta).tolist()
                     acc = solve_spd(pin.crba(model, data, theta).tolist(),
