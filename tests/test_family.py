@@ -32,11 +32,12 @@ def _tool(name: str) -> str:
 @pytest.mark.parametrize("prefix", PREFIXES)
 @pytest.mark.parametrize("name", models())
 def test_plain_xacro_of_every_model_passes_check_urdf(name, prefix, tmp_path):
-    """xacro on the committed top-level xacro (its default parameter files), then check_urdf."""
+    """xacro on the committed top-level xacro with model:=NAME (its default parameter files),
+    then check_urdf."""
     model = MODELS[name]
     urdf = tmp_path / f"{name}.urdf"
     arguments = [f"prefix:={prefix}"] if prefix else []
-    result = subprocess.run([_tool("xacro"), str(model.urdf_xacro), *arguments, "-o", str(urdf)],
+    result = subprocess.run([_tool("xacro"), str(model.urdf_xacro), *model.xacro_args, *arguments, "-o", str(urdf)],
                             capture_output=True, text=True, cwd=model.urdf_xacro.parent)
     assert result.returncode == 0, result.stderr
     result = subprocess.run([_tool("check_urdf"), str(urdf)], capture_output=True, text=True)
@@ -48,6 +49,32 @@ def test_plain_xacro_of_every_model_passes_check_urdf(name, prefix, tmp_path):
     gimbal = (model.config / "gimbal.yaml").exists()
     assert len(children) == 12 + 5 * gimbal and all(child.startswith(prefix) for child in children), children
     assert {child[len(prefix):] for child in children} >= {"turret_link", "forearm_link", "tip", "report_s"}
+
+
+def test_the_package_readme_xacro_commands_give_the_committed_files(tmp_path):
+    """Each `xacro ...` line of robots/phantom_description/README.md, run as written from urdf/
+    (its -o sent to a temporary folder): a file named as a committed one equals it (comments
+    aside), and the prefixed one names every joint with its prefix."""
+    import xml.etree.ElementTree as ET
+
+    folder = MODELS["premium_1_5"].urdf_xacro.parent
+    readme = (folder.parent / "README.md").read_text()
+    lines = [line.split(None, 1)[1] for line in readme.splitlines() if line.startswith("    xacro ")]
+    assert len(lines) == 4, lines
+    for line in lines:
+        *arguments, flag, output = line.split("#")[0].split()
+        assert flag == "-o", line
+        result = subprocess.run([_tool("xacro"), *arguments, "-o", str(tmp_path / output)],
+                                capture_output=True, text=True, cwd=folder)
+        assert result.returncode == 0, (line, result.stderr)
+        written = (tmp_path / output).read_text()
+        committed = next((p for p in (folder / output, folder.parent / "srdf" / output) if p.is_file()), None)
+        if committed is not None:
+            assert ET.canonicalize(written, strip_text=True) == \
+                ET.canonicalize(committed.read_text(), strip_text=True), line
+        else:
+            joints = [j.get("name") for j in ET.fromstring(written).iter("joint")]
+            assert joints and all(j.startswith("left_") for j in joints), line
 
 
 @pytest.mark.parametrize("name", models())
