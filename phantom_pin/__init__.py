@@ -12,6 +12,7 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import (
                                     InvalidInputError,
                                     MissingDataError,
+                                    MissingDependencyError,
                                     ParameterFileError,
                                     PhantomPinError,
                                     UnreachableTargetError,
@@ -26,4 +27,5 @@ except PackageNotFoundError:  # a source tree on sys.path, not installed
 
 __all__ = ["__version__", "Phantom", "Device", "simulate", "SimulationResult", "load", "PhantomLoader", "Description",
            "describe", "models", "Config", "ReportParameters", "closed_form", "drivers", "PhantomPinError",
-           "InvalidInputError", "ParameterFileError", "UnreachableTargetError", "MissingDataError"]
+           "InvalidInputError", "ParameterFileError", "UnreachableTargetError", "MissingDataError",
+           "MissingDependencyError"]

@@ -49,3 +49,8 @@ class MissingDataError(InvalidInputError):
 
 class LogError(PhantomPinError, ValueError):
     """A log file is missing, malformed, or not usable for identification."""
+
+
+class MissingDependencyError(PhantomPinError, ImportError):
+    """An optional package a call needs is not installed; the message names the extra that
+    installs it (matplotlib: ``pip install 'phantom_pin[plots]'``)."""

@@ -8,7 +8,9 @@ absolute paths as strings, with no need to know the package's layout.
 Each model (``premium_1_5``, ``premium_1_5_cad``, ``touch``, and the module itself for the
 default) has PACKAGE_PATH (robots/phantom_description, the ROS package), REPOSITORY_PATH (the
 folder holding robots/), URDF_PATH, SRDF_PATH, MJCF_PATH (the arm), SCENE_PATH (the MJCF
-scene: floor, light, table), XACRO_PATH (its top-level xacro) and CONFIG_PATH (its YAML). The
+scene: floor, light, table), XACRO_PATH (the top-level xacro, one for every model) with
+XACRO_ARGS (the xacro arguments that select the model: ``xacro XACRO_PATH *XACRO_ARGS``) and
+CONFIG_PATH (its YAML). The
 Touch, whose ROS drivers publish joint_states in their own convention, also has
 DRIVER_URDF_PATH (urdf/phantom_touch_driver.urdf: the same arm jointed as the drivers' waist,
 shoulder, elbow, yaw, pitch, roll, for robot_state_publisher; phantom-pin urdf --convention
@@ -36,7 +38,7 @@ def _files(name: str, driver: bool = False) -> types.SimpleNamespace:
     files = types.SimpleNamespace(
         PACKAGE_PATH=PACKAGE_PATH, REPOSITORY_PATH=REPOSITORY_PATH, URDF_PATH=str(model.urdf),
         SRDF_PATH=str(model.srdf), MJCF_PATH=str(model.mjcf), SCENE_PATH=str(model.scene),
-        XACRO_PATH=str(model.urdf_xacro), CONFIG_PATH=str(model.config))
+        XACRO_PATH=str(model.urdf_xacro), XACRO_ARGS=list(model.xacro_args), CONFIG_PATH=str(model.config))
     if driver:  # the drivers' convention (description.build.driver_urdf), committed beside the URDF
         files.DRIVER_URDF_PATH = str(model.urdf.with_name(f"{model.robot_name}_driver.urdf"))
     return files
@@ -48,3 +50,4 @@ touch = _files("touch", driver=True)
 _DEFAULT = _files(DEFAULT)
 URDF_PATH, SRDF_PATH, MJCF_PATH = _DEFAULT.URDF_PATH, _DEFAULT.SRDF_PATH, _DEFAULT.MJCF_PATH
 SCENE_PATH, XACRO_PATH, CONFIG_PATH = _DEFAULT.SCENE_PATH, _DEFAULT.XACRO_PATH, _DEFAULT.CONFIG_PATH
+XACRO_ARGS = _DEFAULT.XACRO_ARGS

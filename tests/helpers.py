@@ -3,6 +3,7 @@ poses by Pinocchio, relative errors, and the browser helpers: render an HTML fil
 chromium, project a world point to its pixel with meshcat's camera (75 degrees vertical field of
 view, looking at the world origin, z up, from viewer.CAMERA_POSITION)."""
 
+import json
 import shutil
 import subprocess
 from pathlib import Path
@@ -13,6 +14,7 @@ from PIL import Image
 
 from phantom_pin import config
 from phantom_pin.viewer import CAMERA_POSITION
+from phantom_pin.viewer.screenshot import chromium_command
 
 N_STATES = 1000
 #: The default model's configuration (premium_1_5) and the report's numbers it holds.
@@ -44,16 +46,28 @@ WINDOW = 4
 
 def render(html: Path, png: Path) -> np.ndarray:
     """Screenshot ``html`` in headless chromium (WebGL through SwiftShader): (H, W, 3) ints."""
-    chromium = shutil.which("chromium")
-    assert chromium, "Debian's chromium is required (.ci/run installs it: apt-get install chromium)"
-    profile = png.parent / f"{png.stem}-profile"
-    command = [chromium, "--headless", "--no-sandbox", "--use-gl=swiftshader",
-               "--enable-unsafe-swiftshader", f"--window-size={WIDTH},{HEIGHT}",
-               "--disable-background-networking", "--disable-component-update", "--disable-sync",
-               "--no-first-run", "--disable-quic", f"--user-data-dir={profile}",
-               "--virtual-time-budget=2000", f"--screenshot={png}", html.resolve().as_uri()]
+    assert shutil.which("chromium"), "Debian's chromium is required (.ci/run installs it: apt-get install chromium)"
+    command = chromium_command(html, png, WIDTH, HEIGHT, png.parent / f"{png.stem}-profile")
     subprocess.run(command, check=True, capture_output=True, timeout=120)
     return np.asarray(Image.open(png).convert("RGB")).astype(int)
+
+
+def browse(html: Path, png: Path) -> tuple[np.ndarray, list[str], list[str]]:
+    """Screenshot ``html`` as render() does, with chromium's log and network log: the image, the
+    page's console messages (chromium's "CONSOLE" lines) and the URLs of the requests the page
+    started (its network log's URL_REQUEST_START_JOB events from the file:// page; chromium's
+    own background requests, which it starts from no page, are not the page's)."""
+    assert shutil.which("chromium"), "Debian's chromium is required (.ci/run installs it: apt-get install chromium)"
+    net_log = png.with_suffix(".netlog.json")
+    command = chromium_command(html, png, WIDTH, HEIGHT, png.parent / f"{png.stem}-profile")
+    command[1:1] = ["--enable-logging=stderr", "--v=0", f"--log-net-log={net_log}"]
+    result = subprocess.run(command, check=True, capture_output=True, text=True, timeout=120)
+    console = [line for line in result.stderr.splitlines() if ":CONSOLE" in line]
+    log = json.loads(net_log.read_text())
+    start = log["constants"]["logEventTypes"]["URL_REQUEST_START_JOB"]
+    urls = [event["params"]["url"] for event in log["events"]
+            if event["type"] == start and "file://" in event["params"].get("network_isolation_key", "")]
+    return np.asarray(Image.open(png).convert("RGB")).astype(int), console, urls
 
 
 def project(point: np.ndarray) -> tuple[int, int]:

@@ -57,7 +57,8 @@ def test_the_xacro_alone_reads_the_committed_links(tmp_path):
 
     for name in models():
         model = MODELS[name]
-        plain = xacro.process_file(str(model.urdf_xacro)).documentElement.toprettyxml(indent="  ")
+        plain = xacro.process_file(str(model.urdf_xacro), mappings={"model": name}).documentElement.toprettyxml(
+            indent="  ")
         committed = model.urdf.read_text()
         assert committed[committed.index("<robot"):].strip() == plain.strip(), name
 

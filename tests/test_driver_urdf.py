@@ -95,21 +95,29 @@ def test_no_rounded_elbow_and_check_urdf_passes(tmp_path):
 
 
 def test_plain_xacro_with_convention_driver_gives_the_committed_file(tmp_path):
-    """xacro phantom_touch.urdf.xacro convention:=driver (its default parameter files) is the
-    committed driver URDF (comments aside); another convention is refused."""
+    """xacro phantom.urdf.xacro model:=touch convention:=driver (its default parameter files) is
+    the committed driver URDF (comments aside); another convention, the drivers' convention of a
+    model without a stylus gimbal (no driver publishes it) and an unknown model are refused,
+    each naming what it refuses."""
     top = MODELS["touch"].urdf_xacro
     xacro = Path(sys.executable).parent / "xacro"
-    result = subprocess.run([str(xacro), str(top), "convention:=driver"], capture_output=True, text=True,
-                            cwd=top.parent)
+
+    def run(*arguments: str) -> subprocess.CompletedProcess:
+        return subprocess.run([str(xacro), str(top), *arguments], capture_output=True, text=True, cwd=top.parent)
+
+    result = run("model:=touch", "convention:=driver")
     assert result.returncode == 0, result.stderr
     assert ET.canonicalize(result.stdout, strip_text=True) == ET.canonicalize(DRIVER_URDF.read_text(), strip_text=True)
-    bad = subprocess.run([str(xacro), str(top), "convention:=ros"], capture_output=True, text=True, cwd=top.parent)
-    assert bad.returncode != 0 and "convention must be report or driver" in bad.stderr
+    for arguments, message in ((("model:=touch", "convention:=ros"), "convention must be report or driver"),
+                               (("convention:=driver",), "written for the Touch (model:=touch)"),
+                               (("model:=omni",), "model must be one of premium_1_5, premium_1_5_cad, touch")):
+        bad = run(*arguments)
+        assert bad.returncode != 0 and message in bad.stderr, (arguments, bad.stderr)
 
 
 def test_a_model_whose_drivers_publish_no_convention_is_refused_in_one_line(capsys, tmp_path):
-    """Only the Touch's top-level xacro takes convention:=driver: the Premium's is refused, naming
-    the model, and nothing is written."""
+    """Only the Touch takes convention:=driver: the Premium is refused, naming the model, before
+    xacro runs, and nothing is written."""
     from phantom_pin import InvalidInputError
     from phantom_pin.cli import main
 

@@ -1,6 +1,7 @@
 """Every model of the family (phantom_pin.models()), each as its tool's own test would have it:
 urdfdom's check_urdf on plain xacro with and without a prefix (Universal Robots' description
-test), the MuJoCo scene stepped under random control (mujoco_menagerie's model test), the
+test), every MuJoCo scene stepped under pseudo-random control and the package's layout
+(mujoco_menagerie's model and model-directory tests), the
 joints load() gives (example-robot-data's test), and the tip against eq. 10 written here with
 the model's own lengths, read from its kinematics.yaml."""
 
@@ -18,6 +19,7 @@ import yaml
 from phantom_pin import config, describe, load
 from phantom_pin.config import MODELS, models
 from phantom_pin.config.sampling import sample_postures
+from phantom_pin.paths import DESCRIPTION_DIR
 
 PREFIXES = ("", "left_")
 
@@ -32,11 +34,12 @@ def _tool(name: str) -> str:
 @pytest.mark.parametrize("prefix", PREFIXES)
 @pytest.mark.parametrize("name", models())
 def test_plain_xacro_of_every_model_passes_check_urdf(name, prefix, tmp_path):
-    """xacro on the committed top-level xacro (its default parameter files), then check_urdf."""
+    """xacro on the committed top-level xacro with model:=NAME (its default parameter files),
+    then check_urdf."""
     model = MODELS[name]
     urdf = tmp_path / f"{name}.urdf"
     arguments = [f"prefix:={prefix}"] if prefix else []
-    result = subprocess.run([_tool("xacro"), str(model.urdf_xacro), *arguments, "-o", str(urdf)],
+    result = subprocess.run([_tool("xacro"), str(model.urdf_xacro), *model.xacro_args, *arguments, "-o", str(urdf)],
                             capture_output=True, text=True, cwd=model.urdf_xacro.parent)
     assert result.returncode == 0, result.stderr
     result = subprocess.run([_tool("check_urdf"), str(urdf)], capture_output=True, text=True)
@@ -50,22 +53,86 @@ def test_plain_xacro_of_every_model_passes_check_urdf(name, prefix, tmp_path):
     assert {child[len(prefix):] for child in children} >= {"turret_link", "forearm_link", "tip", "report_s"}
 
 
-@pytest.mark.parametrize("name", models())
-def test_every_scene_steps_one_second_under_random_control_without_a_warning(name):
-    """1000 steps of the model's timestep under seeded control noise of half its range."""
-    model = mujoco.MjModel.from_xml_path(str(MODELS[name].scene))
+def test_the_package_readme_xacro_commands_give_the_committed_files(tmp_path):
+    """Each `xacro ...` line of robots/phantom_description/README.md, run as written from urdf/
+    (its -o sent to a temporary folder): a file named as a committed one equals it (comments
+    aside), and the prefixed one names every joint with its prefix."""
+    import xml.etree.ElementTree as ET
+
+    folder = MODELS["premium_1_5"].urdf_xacro.parent
+    readme = (folder.parent / "README.md").read_text()
+    lines = [line.split(None, 1)[1] for line in readme.splitlines() if line.startswith("    xacro ")]
+    assert len(lines) == 4, lines
+    for line in lines:
+        *arguments, flag, output = line.split("#")[0].split()
+        assert flag == "-o", line
+        result = subprocess.run([_tool("xacro"), *arguments, "-o", str(tmp_path / output)],
+                                capture_output=True, text=True, cwd=folder)
+        assert result.returncode == 0, (line, result.stderr)
+        written = (tmp_path / output).read_text()
+        committed = next((p for p in (folder / output, folder.parent / "srdf" / output) if p.is_file()), None)
+        if committed is not None:
+            assert ET.canonicalize(written, strip_text=True) == \
+                ET.canonicalize(committed.read_text(), strip_text=True), line
+        else:
+            joints = [j.get("name") for j in ET.fromstring(written).iter("joint")]
+            assert joints and all(j.startswith("left_") for j in joints), line
+
+
+SCENES = sorted((DESCRIPTION_DIR / "mjcf").glob("scene*.xml"))
+
+
+def test_the_package_has_what_menagerie_asks_of_each_model():
+    """mujoco_menagerie's layout test (README, LICENSE, CHANGELOG, a scene*.xml), for one package
+    holding three models: LICENSE is the project's and package.xml's licence, every model has its
+    README section naming its config folder and its scene, and every scene*.xml is a model's."""
+    package = DESCRIPTION_DIR
+    root = package.parent.parent
+    assert (package / "LICENSE").read_text() == (root / "LICENSE").read_text()
+    assert (root / "LICENSE").read_text().startswith("BSD 3-Clause License")
+    assert "<license>BSD-3-Clause</license>" in (package / "package.xml").read_text()
+    assert (package / "CHANGELOG.md").read_text().startswith("# Changelog of phantom_description")
+    readme = (package / "README.md").read_text()
+    for name in models():
+        assert f"\n### `{name}`" in readme, f"no README section for {name}"
+        section = readme.split(f"\n### `{name}`")[1].split("\n#")[0]
+        scene = MODELS[name].scene
+        assert scene.is_file() and f"mjcf/{scene.name}" in section, name
+        assert "Numbers:" in section and "plain import" in section, name
+    assert SCENES == sorted(MODELS[name].scene for name in models())
+
+
+def _halton_control(model: mujoco.MjModel, data: mujoco.MjData, step: int) -> None:
+    """mujoco_menagerie's pseudo-random control (test/model_test.py): actuator j at step i is
+    the ctrlrange's centre plus its half-width times 2 h - 1, h the Halton sequence of base j + 2."""
+    for j in range(model.nu):
+        low, high = model.actuator_ctrlrange[j]
+        data.ctrl[j] = 0.5 * (low + high) + 0.5 * (high - low) * (2 * mujoco.mju_Halton(step, j + 2) - 1)
+
+
+@pytest.mark.parametrize("scene", SCENES, ids=lambda path: path.name)
+def test_every_scene_steps_one_second_under_pseudo_random_control_without_a_warning(scene):
+    """mujoco_menagerie's model test on every mjcf/scene*.xml: from the default state, 1 s of the
+    model's timestep under its Halton controls over the full control range (which reach the stops),
+    then again under seeded uniform noise of half the range; no MuJoCo warning counter moves."""
+    model = mujoco.MjModel.from_xml_path(str(scene))
     data = mujoco.MjData(model)
-    assert model.nu == 3 and model.opt.timestep == 0.001
-    mujoco.mj_resetData(model, data)
+    assert model.nu == 3 and model.opt.timestep == 0.001 and model.actuator_ctrllimited.all()
     rng = np.random.default_rng(17)
     low, high = model.actuator_ctrlrange.T
-    for _ in range(1000):
-        data.ctrl[:] = rng.uniform(low, high) * 0.5
-        mujoco.mj_step(model, data)
-    assert data.time == pytest.approx(1.0)
-    assert [data.warning[i].number for i in range(len(data.warning))] == [0] * len(data.warning)
-    assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
-    assert np.abs(data.qvel).max() > 0  # it moved
+    controls = (lambda step: _halton_control(model, data, step),
+                lambda step: data.ctrl.__setitem__(slice(None), rng.uniform(low, high) * 0.5))
+    for control in controls:
+        mujoco.mj_resetData(model, data)
+        step = 0
+        while data.time < 1.0 - 0.5 * model.opt.timestep:
+            control(step)
+            mujoco.mj_step(model, data)
+            step += 1
+        assert step == 1000 and data.time == pytest.approx(1.0)
+        assert [data.warning[i].number for i in range(len(data.warning))] == [0] * len(data.warning)
+        assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
+        assert np.abs(data.qvel).max() > 0  # it moved
 
 
 @pytest.mark.parametrize("name", models())

@@ -100,12 +100,10 @@ def test_plain_xacro_reads_a_mapping_as_well_as_a_number(folder):
     gives each joint its own numbers, as describe() does."""
     import xacro
 
-    top = folder.parent / "top.urdf.xacro"
-    model = config.MODELS["premium_1_5"]
-    text = model.urdf_xacro.read_text().replace("../config/premium_1_5/", f"{folder}/")
-    macro = model.urdf_xacro.parent / "phantom_macro.xacro"
-    top.write_text(text.replace('filename="phantom_macro.xacro"', f'filename="{macro}"'))
-    plain = xacro.process_file(str(top)).documentElement.toprettyxml(indent="  ")
+    top = config.MODELS["premium_1_5"].urdf_xacro
+    files = {f"{kind}_file": str(folder / f"{kind}.yaml")
+             for kind in ("kinematics", "links", "actuation", "joint_limits", "visual_parameters")}
+    plain = xacro.process_file(str(top), mappings=files).documentElement.toprettyxml(indent="  ")
     assert _urdf_dynamics(plain) == list(zip(VISCOUS, COULOMB, strict=True))
 
 

@@ -28,11 +28,16 @@ def test_every_model_has_the_attributes_naming_its_committed_files(name):
     assert Path(files.PACKAGE_PATH, "package.xml").is_file()
     assert Path(files.REPOSITORY_PATH, "robots", "phantom_description") == Path(files.PACKAGE_PATH)
     assert Path(files.URDF_PATH).is_relative_to(files.PACKAGE_PATH)
+    # xacro XACRO_PATH *XACRO_ARGS is this model: the robot its URDF names
+    import xacro
+    document = xacro.process_file(files.XACRO_PATH, mappings=dict(a.split(":=") for a in files.XACRO_ARGS))
+    assert document.documentElement.getAttribute("name") == model.robot_name
 
 
 def test_the_module_itself_is_the_default_model():
     for attribute in ATTRIBUTES:
         assert getattr(robot_descriptions, attribute) == getattr(getattr(robot_descriptions, DEFAULT), attribute)
+    assert robot_descriptions.XACRO_ARGS == getattr(robot_descriptions, DEFAULT).XACRO_ARGS
 
 
 def test_a_loader_without_mimic_opens_the_parallelogram():

@@ -146,14 +146,15 @@ def test_colcon_builds_and_installs_the_package_and_xacro_reproduces_the_urdfs(t
     xacro = Path(sys.executable).parent / "xacro"
     for model in MODELS.values():
         top = share / "urdf" / model.urdf_xacro.name
-        result = subprocess.run([str(xacro), str(top)], capture_output=True, text=True, cwd=top.parent)
+        result = subprocess.run([str(xacro), str(top), *model.xacro_args], capture_output=True, text=True,
+                                cwd=top.parent)
         assert result.returncode == 0, result.stderr
         assert ET.canonicalize(result.stdout, strip_text=True) == \
             ET.canonicalize(model.urdf.read_text(), strip_text=True), model.name
     # the Touch in the drivers' convention, from the installed top-level file
     top = share / "urdf" / MODELS["touch"].urdf_xacro.name
-    result = subprocess.run([str(xacro), str(top), "convention:=driver"], capture_output=True, text=True,
-                            cwd=top.parent)
+    result = subprocess.run([str(xacro), str(top), "model:=touch", "convention:=driver"], capture_output=True,
+                            text=True, cwd=top.parent)
     assert result.returncode == 0, result.stderr
     assert ET.canonicalize(result.stdout, strip_text=True) == \
         ET.canonicalize((share / "urdf" / "phantom_touch_driver.urdf").read_text(), strip_text=True)

@@ -1,10 +1,12 @@
 """One version everywhere: pyproject.toml, the installed distribution, phantom_pin.__version__,
-the description's package.xml and the newest entry of both changelogs."""
+the description's package.xml, the newest entry of both changelogs and CITATION.cff."""
 
 import re
 import xml.etree.ElementTree as ET
 from importlib.metadata import version
 from pathlib import Path
+
+import yaml
 
 import phantom_pin
 from phantom_pin.paths import DESCRIPTION_DIR
@@ -22,5 +24,6 @@ def test_one_version_everywhere():
     found = {"installed": version("phantom_pin"), "__version__": phantom_pin.__version__,
              "package.xml": ET.parse(DESCRIPTION_DIR / "package.xml").getroot().findtext("version"),
              "CHANGELOG.md": _newest(ROOT / "CHANGELOG.md"),
-             "description CHANGELOG.md": _newest(DESCRIPTION_DIR / "CHANGELOG.md")}
+             "description CHANGELOG.md": _newest(DESCRIPTION_DIR / "CHANGELOG.md"),
+             "CITATION.cff": yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))["version"]}
     assert found == dict.fromkeys(found, declared)

@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from phantom_pin import plots
 from phantom_pin.config import DEFAULT, models, read_overrides
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.dynamics.model import Phantom
@@ -286,3 +287,24 @@ def positive_integer(text: str) -> int:
     if not (value >= 1 and value.is_integer()):
         raise argparse.ArgumentTypeError(f"expected a positive whole number, got {text!r}")
     return int(value)
+
+
+def add_plot_option(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--plot FILE``: one self-contained HTML page of ``what`` (phantom_pin.plots)."""
+    parser.add_argument("--plot", type=Path, metavar="FILE.html", action=Once,
+                        help=f"also write {what} as one self-contained HTML page (matplotlib's SVG, no script; "
+                             "needs the plots extra: pip install 'phantom_pin[plots]'); --force overwrites it")
+
+
+def plot_target(args: argparse.Namespace) -> Path | None:
+    """The --plot file checked before any work (an .html name, not --output's, writable as
+    output() checks, matplotlib installed), or None without --plot."""
+    if args.plot is None:
+        return None
+    target = output(args, "--plot")
+    if target.suffix.lower() not in (".html", ".htm"):
+        raise PhantomPinError(f"{target}: the plot is an HTML page; name a .html file", argument="--plot")
+    if args.output is not None and Path(args.output).resolve() == target.resolve():
+        raise PhantomPinError(f"{target} is the --output file; give two files", argument="--plot")
+    plots.require_matplotlib()
+    return target

@@ -6,23 +6,26 @@ import argparse
 import dataclasses
 import json
 import math
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import drivers
+from phantom_pin import drivers, plots
 from phantom_pin.cli.common import (
     Once,
     add_gimbal,
+    add_plot_option,
     check_record,
     csv_text,
     emit,
     output,
     phantom,
+    plot_target,
     warn,
     warn_gimbal,
-    write_text,
+    write_texts,
 )
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
@@ -84,7 +87,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                          help="output format (default: the --output file's extension, .json or .csv; json on "
                               "standard output)")
     command.add_argument("--output", "-o", action=Once, help="file to write (default: standard output)")
-    command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
+    command.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output or --plot file")
+    add_plot_option(command, "the angles, rates and torques over time with the stops and the saturation")
 
 
 def _format(args: argparse.Namespace) -> str:
@@ -150,6 +154,7 @@ def simulate_command(args: argparse.Namespace) -> int:
     """Run ``phantom-pin simulate``: nothing is written unless the simulation succeeds."""
     target = None if args.output is None else output(args)
     form = _format(args)
+    plot = plot_target(args)
     robot = phantom(args)
     device = Device(robot)
     if args.trajectory is not None:
@@ -184,12 +189,35 @@ def simulate_command(args: argparse.Namespace) -> int:
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
     settings["model"] = robot.config.name
     text = _json(result, settings) if form == "json" else _csv(result, robot.config.name)
+    page = None if plot is None else _plot(result, settings, device, robot.config.name)
+    staged = ([] if target is None else [(target, text, "--output")]) + (
+        [] if plot is None or page is None else [(plot, page, "--plot")])
+    write_texts(staged)                                   # every file or none
     if target is None:
         emit(text)
-        return 0
-    write_text(target, text)
-    print(f"wrote {target} ({len(result.t)} samples)")
+    else:
+        print(f"wrote {target} ({len(result.t)} samples)")
+    if plot is not None and page is not None:
+        print(f"wrote {plot}", file=sys.stderr if target is None else sys.stdout)
     return 0
+
+
+def _plot(result: SimulationResult, settings: dict, device: Device, name: str) -> str:
+    """The --plot page of a run: angles with the stops, rates, applied (and commanded) torques
+    with the saturation's limits (none with --no-saturation)."""
+    limits, policy = device.config.limits.stops, settings["saturation"]
+    stops = (np.array(limits.lower), np.array(limits.upper), limits.coupled.theta2_minus_theta3_max,
+             limits.coupled.theta3_minus_theta2_max)
+    torque_limit = None if policy is False else np.array(device.config.actuation.limit(policy))
+    facts = [("model", name), ("controller", settings["controller"]),
+             ("start", f"θ0 {settings['theta0']} rad, θ̇0 {settings['dtheta0']} rad/s"),
+             ("duration, rate", f"{settings['duration']:g} s, {settings['rate']:g} Hz ({len(result.t)} samples)"),
+             ("friction, stops", f"{'off' if settings['no_friction'] else 'on'}, "
+                                 f"{'off (drawn anyway)' if settings['no_hard_stops'] else 'on'}"),
+             ("saturation", "off" if policy is False else f"{policy} torque, drawn as the torque limits"),
+             ("trajectory", settings["trajectory"] or "none")]
+    return plots.run_page(f"phantom-pin simulate: {name}", facts, result.t, result.theta, result.dtheta,
+                          result.tau, stops, torque_limit, f"saturation ({policy})", result.tau_commanded)
 
 
 def _columns(result: SimulationResult) -> dict[str, str]:

@@ -9,9 +9,20 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import drivers, profiles
-from phantom_pin.cli.common import Once, check_record, csv_text, description, overrides, warn, write_text
+from phantom_pin import drivers, plots, profiles
+from phantom_pin.cli.common import (
+    Once,
+    add_plot_option,
+    check_record,
+    csv_text,
+    description,
+    overrides,
+    plot_target,
+    warn,
+    write_texts,
+)
 from phantom_pin.config import DEFAULT
+from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import bags, excitation, filtering, io, prior, static, timing
@@ -141,6 +152,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     excite.add_argument("--convention", choices=CONVENTIONS, default="report",
                         help="columns in the report's theta (rad) and N m (default), or OpenHaptics' joint "
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
+    add_plot_option(excite, "the trajectory's angles, rates and torques (in the report's terms) with the stops and "
+                            "the joint torque limits")
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
     identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
@@ -189,6 +202,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 def excite_command(args: argparse.Namespace) -> int:
     """phantom-pin excite, for the configuration of --model or --config (and the overrides)."""
     _refuse(args.output, args.force)
+    plot = plot_target(args)
     for name in ("duration", "rate", "period"):
         value = getattr(args, name)
         if not (math.isfinite(value) and value > 0):
@@ -230,12 +244,16 @@ def excite_command(args: argparse.Namespace) -> int:
     theta, dtheta, ddtheta = result.trajectory(t)
     tau = phantom.inverse_dynamics(theta, dtheta, ddtheta) + made.config.actuation.friction.torque(dtheta)
     peak = np.abs(tau).max(axis=0)
+    effort = excitation.continuous_effort(made)
+    page = None if plot is None else _plot(args, made, result, (t, theta, dtheta, tau), effort)
     if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
         theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
         tau = drivers.openhaptics_torque_from_tau(tau)
-    write_text(args.output, csv_text(list(io.TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
-                                     made.config.name, args.convention))
-    effort = excitation.continuous_effort(made)
+    files = [(args.output, csv_text(list(io.TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
+                                    made.config.name, args.convention), "--output")]
+    write_texts(files + ([] if plot is None or page is None else [(plot, page, "--plot")]))  # all or none
+    if plot is not None and page is not None:
+        print(f"wrote {plot}")
     print(f"wrote {args.output}: {periods} period(s) of {args.period:g} s at {args.rate:g} Hz, "
           f"{args.harmonics} harmonics per joint" + (", in OpenHaptics' joint angles (rad) and joint torques "
                                                     "(mN m)" if args.convention == "openhaptics" else ""))
@@ -246,6 +264,25 @@ def excite_command(args: argparse.Namespace) -> int:
           + ", ".join(f"{p:.3f}/{e:.3f}" for p, e in zip(peak, effort)))
     print(f"nearest approach to a stop: {result.min_slack:.3f} rad; the file starts and ends at rest")
     return 0
+
+
+def _plot(args: argparse.Namespace, made: Description, result: excitation.Excitation,
+          samples: tuple[np.ndarray, ...], effort: np.ndarray) -> str:
+    """excite's --plot page: ``samples`` (t s, theta rad, dtheta rad/s, tau N m, in the report's
+    terms) with the stops and ``effort``, the joint torque limits (N m) the optimisation kept to."""
+    t, theta, dtheta, tau = samples
+    limits = made.config.limits.stops
+    stops = (np.array(limits.lower), np.array(limits.upper), limits.coupled.theta2_minus_theta3_max,
+             limits.coupled.theta3_minus_theta2_max)
+    facts = [("model", made.config.name),
+             ("excitation", f"{args.harmonics} harmonics per joint, period {args.period:g} s, "
+                            f"{len(t)} samples at {args.rate:g} Hz, seed {args.seed}"),
+             ("condition number", f"{result.condition:.3g} (general base regressor, columns of unit norm)"),
+             ("nearest approach to a stop", f"{result.min_slack:.3f} rad"),
+             ("torques", "the model's inverse dynamics plus its friction, in the report's terms (N m)"
+                         + ("; the CSV holds OpenHaptics' mN m" if args.convention == "openhaptics" else ""))]
+    return plots.run_page(f"phantom-pin excite: {made.config.name}", facts, t, theta, dtheta, tau, stops, effort,
+                          "joint torque limit")
 
 
 def identify_command(args: argparse.Namespace) -> int:

@@ -14,9 +14,10 @@ from phantom_pin.paths import DESCRIPTION_DIR
 @dataclasses.dataclass(frozen=True)
 class Model:
     """A configuration of the description package: its ``name``, a one-line ``title``, its
-    ``config`` folder (config/NAME), the top-level xacros that generate its URDF and SRDF,
-    and the committed generated files (URDF, SRDF, MJCF and its scene, and ``links_file``: the
-    seven links in full, the xacro's input, generated from physical_parameters.yaml)."""
+    ``config`` folder (config/NAME), the top-level xacros that generate its URDF and SRDF (one
+    pair for every model, given ``model:=NAME``: ``xacro_args``), and the committed generated
+    files (URDF, SRDF, MJCF and its scene ``mjcf/scene_ROBOT.xml``, and ``links_file``: the
+    links in full, the xacro's input, generated from physical_parameters.yaml)."""
 
     name: str
     title: str
@@ -33,21 +34,27 @@ class Model:
     def config(self) -> Path:
         return DESCRIPTION_DIR / "config" / self.name
 
+    @property
+    def xacro_args(self) -> tuple[str, ...]:
+        """The command-line arguments of ``xacro`` that select this model in ``urdf_xacro`` and
+        ``srdf_xacro`` (the other arguments keep their defaults: the model's own files)."""
+        return (f"model:={self.name}",)
 
-def _model(name: str, title: str, robot: str, scene: str) -> Model:
+
+def _model(name: str, title: str, robot: str) -> Model:
     d = DESCRIPTION_DIR
-    return Model(name, title, robot, d / "urdf" / f"{robot}.urdf.xacro", d / "srdf" / "phantom_1_5.srdf.xacro",
+    return Model(name, title, robot, d / "urdf" / "phantom.urdf.xacro", d / "srdf" / "phantom.srdf.xacro",
                  d / "urdf" / f"{robot}.urdf", d / "srdf" / f"{robot}.srdf", d / "mjcf" / f"{robot}.xml",
-                 d / "mjcf" / scene, d / "config" / name / "links.yaml")
+                 d / "mjcf" / f"scene_{robot}.xml", d / "config" / name / "links.yaml")
 
 
 #: The shipped configurations, by name; the first is the default everywhere.
 MODELS = {model.name: model for model in (
-    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5", "scene.xml"),
+    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5"),
     _model("premium_1_5_cad", "PHANToM Premium 1.5, mahilab/Phantom's CAD mass properties and lengths",
-           "phantom_1_5_cad", "scene_phantom_1_5_cad.xml"),
+           "phantom_1_5_cad"),
     _model("touch", "Geomagic Touch / PHANToM Omni: the report's arm at its size, ESTIMATED inertias, "
-                    "no public motor data", "phantom_touch", "scene_phantom_touch.xml"),
+                    "no public motor data", "phantom_touch"),
 )}
 DEFAULT = "premium_1_5"
 

@@ -37,7 +37,7 @@ STOP_COORDINATES.flags.writeable = False
 SATURATIONS = ("continuous", "peak")
 #: MuJoCo's integrators, as config/mjcf.yaml may name them.
 INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
-#: The SRDF's named postures, which joint_limits.yaml gives (srdf/phantom_1_5.srdf.xacro).
+#: The SRDF's named postures, which joint_limits.yaml gives (srdf/phantom.srdf.xacro).
 POSTURES = ("zero", "resting")
 
 
@@ -276,7 +276,7 @@ class Gimbal:
 
 @dataclasses.dataclass(frozen=True)
 class Scene:
-    """scene.xml's picture (m): the shoulder above the table top, the stand's radius, the
+    """The scene's picture (m): the shoulder above the table top, the stand's radius, the
     table's size (x, y, z) and centre ahead of the shoulder, the floor below the table top."""
 
     shoulder_height: float
