@@ -120,8 +120,9 @@ class DriverSimulation:
                 flat = drivers.openhaptics_transform_from_pose(phantom.stylus_pose(theta, g),
                                                                drivers.openhaptics_origin(phantom))
                 transform = flat.reshape(4, 4).T                              # column-major, mm
+                turned = spec.rotation_axes
                 out.append((spec, spec.axes @ transform[:3, 3] * drivers.METRE_PER_MM,
-                            spec.axes @ transform[:3, :3] @ spec.axes.T @ spec.after))
+                            turned @ transform[:3, :3] @ turned.T @ spec.after))
             else:
                 rates = np.concatenate([self.v, np.zeros(3)])
                 angular = (phantom.stylus_jacobian(theta, g) @ rates)[3:]
