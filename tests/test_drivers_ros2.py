@@ -1,7 +1,8 @@
 """End to end over ROS 2 on loopback, with the real rclpy: for every driver profile whose message
 types install here, the simulated driver (phantom-pin sim-driver) and the node (phantom-pin ros2
---driver) as two processes. Released after --hold, the stylus floats (within 2 mm for 5 s); a
-user's 0.5 N up lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
+--driver) as two processes. Released after --hold, the stylus floats (within 2 mm for 5 s; for
+kinisi's one-tick driver only the node's part is asserted, docs/drivers.md); a user's 0.5 N up
+lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
 driver's own formula (driver_reference), holds the Touch's gravity from the closed form (1e-9 N m);
 without the node the stylus falls. omni_msgs (geomagic_touch_ros2) is not on PyPI: the node
 refuses that profile in one line, and the documents' one-file relay (`--relay`) is run as printed
@@ -46,7 +47,8 @@ REPORT = Phantom("touch").config.report
 BAD_WRENCH = {"sawsensablephantom": ("base_link", (float("nan"), 0.0, 0.0), "force"),
               "touch_ros2_control": ("nowhere", (0.0, 0.0, 0.1), "frame_id"),
               "geomagic_touch_x_ros2": ("base_link", (1e9, 0.0, 0.0), "force"),
-              "geomagic_touch_ros2": ("stylus", (0.0, -float("inf"), 0.0), "force")}
+              "geomagic_touch_ros2": ("stylus", (0.0, -float("inf"), 0.0), "force"),
+              "phantom_touch_ros2": ("touch_b_stylus", (0.0, 0.0, 0.1), "frame_id")}
 HOLD = 6.0                           # s, before the simulated driver lets go: the node starts meanwhile
 
 
@@ -169,7 +171,9 @@ def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
     """The node and the simulated driver started together (the driver holds the stylus for HOLD
     s meanwhile); after the release the tip stays within 2 mm for 5 s, every force received holds
     the closed form's gravity at the release posture by the driver's own formula (1e-9 N m), and
-    0.5 N up on `wrench` lifts the tip."""
+    0.5 N up on `wrench` lifts the tip (kinisi's one-tick driver: _one_tick); a bad wrench is
+    dropped with one warning naming its field. The simulated driver's count of ticks with a
+    command is printed."""
     env = _environment(INSTALLED.index(name))
     node = _start(env, "ros2", "--driver", name)
     simulated = _start(env, "sim-driver", "--driver", name, "--hold", str(HOLD), "--theta0", *map(str, THETA0))
@@ -180,6 +184,7 @@ def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
     finally:
         watcher.close()
         results = [_stop(process) for process in (simulated, node)]
+    print(next(line for line in results[0][1].splitlines() if "servo ticks after the release" in line))
     _clean_stops(name, results)
 
 
@@ -198,20 +203,42 @@ def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) ->
     assert watcher.states and watcher.forces, (f"within the {HOLD} s hold: {len(watcher.states)} states, "
                                                f"{len(watcher.forces)} forces")
     watcher.spin(0.05)
-    released, start = watcher.states[-1][0], tip(THETA0)
-    one_tick = watcher.profile.force.hold == "one_tick"
-    watcher.spin(1.0 if one_tick else 5.0)   # the float's 5 s, where a float is possible (below)
+    released = watcher.states[-1][0]
+    watcher.spin(5.0)   # the float's 5 s
     floating = [tip(theta) for at, theta, _ in watcher.states if at >= released]
-    drift = np.linalg.norm(np.array(floating) - start, axis=1).max()
+    drift = np.linalg.norm(np.array(floating) - tip(THETA0), axis=1).max()
     answered = sum(at >= released for at in watcher.received) / len(floating)   # after the release
     print(f"\n{name}: {len(floating)} states after the release, drift {drift * 1e3:.3f} mm, "
           f"{100 * answered:.0f} % of all states answered")
-    if one_tick:
-        # kinisi's driver renders a command in the one servo tick after it arrives (hd++.cpp 138-145): the
-        # stylus floats only where a command lands in every tick, which no ROS 2 transport guarantees; the
-        # node's part is to answer the states
-        assert answered > 0.8
-        return
+    if watcher.profile.force.hold == "one_tick":
+        _one_tick(watcher, answered)
+    else:
+        _floats_and_lifts(name, watcher, drift)
+    # a bad wrench, one kind per profile (the warnings are throttled to one a second): dropped with a
+    # warning naming the field (checked by the caller), nothing sent beyond the driver's clamp or not finite
+    watcher.push(*BAD_WRENCH[name])
+    watcher.spin(0.2)
+    sent = np.array([ref.FORCE[name](force) for force in watcher.forces])
+    assert np.isfinite(sent).all() and np.linalg.norm(sent, axis=1).max() <= watcher.profile.force.clamp * (1 + 1e-12)
+
+
+def _one_tick(watcher: Watcher, answered: float) -> None:
+    """kinisi's driver renders a command in the one servo tick after it arrives (hd++.cpp 138-145):
+    the stylus floats only where a command arrives within every 1 ms tick, which ROS 2 on this
+    shared 2-core machine does not give (docs/drivers.md: the measured shares; the simulated driver
+    logs its own, printed by the caller). The node's part, asserted: it answers the states, and every
+    force it sent while the stylus stood at the release posture holds the closed form's gravity there
+    by the driver's own formula (1e-9 N m)."""
+    assert answered > 0.8
+    moved = next((at for at, theta, _ in watcher.states if np.abs(theta - THETA0).max() > 1e-12), np.inf)
+    jacobian, gravity = ref.tip_jacobian(THETA0), ref.gravity(THETA0, np.zeros(3), REPORT)
+    errors = [np.abs(jacobian.T @ ref.FORCE[watcher.profile.name](force) - gravity).max()
+              for force, at in zip(watcher.forces, watcher.received) if at < moved - 0.2]   # answers to still states
+    assert len(errors) > 100 and max(errors) < 1e-9, (len(errors), max(errors))
+
+
+def _floats_and_lifts(name: str, watcher: Watcher, drift: float) -> None:
+    """A driver that holds its force: the stylus floats, the forces hold gravity, 0.5 N up lifts it."""
     assert drift < 2e-3
     # the driver's other state topics arrive with the joint states, in its frame_id
     assert all(len(m) > 100 and {x.header.frame_id for x in m} == {spec.frame_id}
@@ -236,12 +263,6 @@ def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) ->
     print(f"{name}: {len(errors)} forces checked against the closed form; 0.5 N up lifted the tip "
           f"{(after - before) * 1e3:.1f} mm")
     assert after - before > 1e-3
-    # a bad wrench, one kind per profile (the warnings are throttled to one a second): dropped with a
-    # warning naming the field (checked by the caller), nothing sent beyond the driver's clamp or not finite
-    watcher.push(*BAD_WRENCH[name])
-    watcher.spin(0.2)
-    sent = np.array([ref.FORCE[name](force) for force in watcher.forces])
-    assert np.isfinite(sent).all() and np.linalg.norm(sent, axis=1).max() <= watcher.profile.force.clamp * (1 + 1e-12)
 
 
 #: The documents that print the one-file relay for the omni_msgs driver (`ros2 --relay`).

@@ -64,6 +64,29 @@ def test_the_simulated_drivers_render_as_their_sources_say(device):
     assert np.linalg.norm(big.force(ref.tip_jacobian(theta0))) == pytest.approx(2.0, rel=1e-12)
 
 
+def test_a_command_counts_for_the_servo_tick_after_it_arrived(device):
+    """Commands given with their arrival times and ticks with theirs (s, one clock; seeded): each
+    tick renders J^T F of the latest command arrived by its time (saw holds it), kinisi's only of one
+    arrived since the previous tick (hd++.cpp 138-145: the callback stores the force and sets a flag,
+    the next servo tick sends it and clears the flag; nothing otherwise), whatever the order the
+    loop hands them over in. The stylus held (before ``hold``), so J is the release posture's."""
+    rng = np.random.default_rng(5)
+    arrivals = rng.uniform(0.0, 0.02, 30)
+    commands = rng.uniform(-1.0, 1.0, (30, 3))           # N, under saw's 2 N clamp
+    jacobian = ref.tip_jacobian(RELEASES[0])
+    for name in ("phantom_touch_ros2", "sawsensablephantom"):
+        simulation = DriverSimulation(device, profiles.load(name), RELEASES[0], hold=1.0)
+        for t, c in zip(arrivals, commands):
+            simulation.command(c, at=t)
+        one_tick = name == "phantom_touch_ros2"
+        for k in range(1, 22):
+            simulation.tick(at=k * 1e-3)
+            since = (k - 1) * 1e-3 if one_tick else -np.inf   # kinisi: arrived since the previous tick only
+            arrived = [i for i in range(30) if since < arrivals[i] <= k * 1e-3]
+            want = jacobian.T @ commands[max(arrived, key=lambda i: arrivals[i])] if arrived else np.zeros(3)
+            assert np.abs(simulation.applied - want).max() < 1e-12, (name, k)
+
+
 class SimpleWrench:
     """A WrenchStamped-shaped holder of a force in CalaW's driver frame R."""
 
