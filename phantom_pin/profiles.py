@@ -95,13 +95,15 @@ class StateTopic:
     """A state topic a driver publishes beside its joint states, of a type that installs here:
     ``topic``, ``type`` (STATE_TYPES), ``frame_id``; its vectors are ``axes`` @ OpenHaptics'
     (a pose's position HD_CURRENT_TRANSFORM's translation in m, a twist's linear velocity in m/s
-    and angular in rad/s), a pose's rotation axes @ R_OH @ axes^T @ ``after``."""
+    and angular in rad/s), a pose's rotation C @ R_OH @ C^T @ ``after`` with C =
+    ``rotation_axes`` (the same as ``axes`` unless a driver turns its position only)."""
 
     topic: str
     type: str
     frame_id: str
     axes: np.ndarray
     after: np.ndarray
+    rotation_axes: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -223,9 +225,10 @@ def _state_topics(nodes: list, where: str) -> tuple[StateTopic, ...]:
         if node["type"] not in STATE_TYPES:
             raise ParameterFileError(f"{where}[{k}].type: expected one of {', '.join(STATE_TYPES)}, "
                                      f"got {node['type']!r}")
-        after = node.get("after", np.eye(3).tolist())
+        after, turned = node.get("after", np.eye(3).tolist()), node.get("rotation_axes", node["axes"])
         topics.append(StateTopic(str(node["topic"]), node["type"], str(node["frame_id"]),
-                                 _axes(node["axes"], f"{where}[{k}].axes"), _axes(after, f"{where}[{k}].after")))
+                                 _axes(node["axes"], f"{where}[{k}].axes"), _axes(after, f"{where}[{k}].after"),
+                                 _axes(turned, f"{where}[{k}].rotation_axes")))
     return tuple(topics)
 
 

@@ -12,7 +12,9 @@ its first seconds, as a user's hand would until a node started alongside connect
 ``make_node`` and ``spin`` put it on ROS 2: the profile's joint-state topic at its rate and
 quality of service (positions, rad, in its conventions; efforts, where the driver publishes
 OpenHaptics' joint torques, the motors' J_p^T F in mN m on OpenHaptics' angles), and its force
-topic in its message type.
+topic in its message type. A command counts from the first servo tick at or after its arrival in
+the middleware, as the driver's own ROS thread takes it, however late the loop here runs; at the
+end the log says for how many ticks after the release a command arrived.
 """
 
 from __future__ import annotations
@@ -61,12 +63,27 @@ class DriverSimulation:
         self.time = 0.0                                                 # s, simulated
         self.message: np.ndarray | None = None                          # the last command's numbers
         self.fresh = False
+        self.pending: list[tuple[float, np.ndarray]] = []               # (arrival s, numbers) not yet due
         self.applied = np.zeros(3)                                      # N m, J^T F of the last tick
+        self.ticks = self.commanded = 0                                 # ticks after hold; of them, with a command
 
-    def command(self, numbers: Sequence[float]) -> None:
-        """A force message's three numbers (N, the driver's frame), as the driver receives them."""
-        self.message = np.array([float(v) for v in numbers])
-        self.fresh = True
+    def command(self, numbers: Sequence[float], at: float | None = None) -> None:
+        """A force message's three numbers (N, the driver's frame), as the driver receives them:
+        at once, or, given ``at`` (when it arrived, s, the clock of tick's ``at``), in the first
+        tick at or after that time."""
+        values = np.array([float(v) for v in numbers])
+        if at is None:
+            self.message, self.fresh = values, True
+        else:
+            self.pending.append((float(at), values))
+
+    def _arrived(self, at: float) -> None:
+        """The commands arrived by ``at`` (s) are the driver's: the latest its message (the driver's
+        callback ran for each, as its ROS thread does, independent of the servo thread)."""
+        due = [(t, m) for t, m in self.pending if t <= at]
+        if due:
+            self.message, self.fresh = max(due, key=lambda item: item[0])[1], True
+            self.pending = [(t, m) for t, m in self.pending if t > at]
 
     def force(self, jacobian: np.ndarray) -> np.ndarray:
         """HD_CURRENT_FORCE this tick (N, OH = frame s), as the profile's driver computes it."""
@@ -86,14 +103,20 @@ class DriverSimulation:
         norm = float(np.linalg.norm(force))
         return force * (spec.clamp / norm) if norm > spec.clamp else force
 
-    def tick(self) -> None:
-        """One servo period: the driver's force as joint torques on the plant (after ``hold``)."""
+    def tick(self, at: float | None = None) -> None:
+        """One servo period: the driver's force as joint torques on the plant (after ``hold``);
+        ``at`` (s): the tick's time on the clock of command's ``at``, which takes the commands
+        arrived by then."""
+        if at is not None:
+            self._arrived(at)
         theta = np.array(self.q)
         jacobian = self.device.tip_jacobian(theta)
         self.applied = jacobian.T @ self.force(jacobian)
-        self.fresh = False
         if self.time >= self.hold:
+            self.ticks += 1
+            self.commanded += self.fresh
             self.q, self.v = self.plant.hold(self.q, self.v, self.applied.tolist(), PERIOD, self.steps)
+        self.fresh = False
         self.time += PERIOD
 
     def joint_state(self, gimbal: Sequence[float]) -> tuple[list[str], list[float], list[float]]:
@@ -120,8 +143,9 @@ class DriverSimulation:
                 flat = drivers.openhaptics_transform_from_pose(phantom.stylus_pose(theta, g),
                                                                drivers.openhaptics_origin(phantom))
                 transform = flat.reshape(4, 4).T                              # column-major, mm
+                turned = spec.rotation_axes
                 out.append((spec, spec.axes @ transform[:3, 3] * drivers.METRE_PER_MM,
-                            spec.axes @ transform[:3, :3] @ spec.axes.T @ spec.after))
+                            turned @ transform[:3, :3] @ turned.T @ spec.after))
             else:
                 rates = np.concatenate([self.v, np.zeros(3)])
                 angular = (phantom.stylus_jacobian(theta, g) @ rates)[3:]
@@ -148,12 +172,17 @@ def make_node(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str
             self.others: list[Any] = [self.create_publisher(message_type(spec.type), spec.topic, qos)
                                       for spec in profile.state_topics]
             self.create_subscription(force_type, profile.force.topic, self.on_force, _qos(profile.force.qos))
+            self.received = 0
+            self.offset = time.time() - time.monotonic()   # s: the system clock's reading less the loop's
 
-        def on_force(self, message) -> None:
+        def on_force(self, message, info) -> None:
             vector = message
             for part in (field or "").split("."):
                 vector = getattr(vector, part) if part else vector
-            simulation.command((vector.x, vector.y, vector.z))
+            # when it arrived (the middleware's time, on the system clock), not when this callback ran: the
+            # driver's ROS thread takes each message then, whatever the servo loop here is doing
+            simulation.command((vector.x, vector.y, vector.z), at=info["received_timestamp"] * 1e-9 - self.offset)
+            self.received += 1
 
         def publish_state(self) -> None:
             names, positions, efforts = simulation.joint_state(gimbal)
@@ -189,8 +218,12 @@ def loop(simulation: DriverSimulation, node, executor, stop: threading.Event) ->
     """Real time: the servo ticks due by the clock, the joint states at the profile's rate, and
     the executor's callbacks (force commands) between them, until ``stop``."""
     rate_period = 1.0 / simulation.profile.joint_states.rate
-    start, ticks, published, lagging = time.monotonic(), 0, 0, False
+    start, ticks, published, lagging, late = time.monotonic(), 0, 0, False, 0
     while not stop.is_set():
+        received = -1
+        while received != node.received:   # the commands waiting, before the ticks that may be due
+            received = node.received
+            executor.spin_once(timeout_sec=0.0)
         due = int((time.monotonic() - start) / PERIOD)
         if due - ticks > CATCH_UP:
             if not lagging:
@@ -201,14 +234,19 @@ def loop(simulation: DriverSimulation, node, executor, stop: threading.Event) ->
             due = ticks + CATCH_UP
         while ticks < due:
             held = simulation.time < simulation.hold
-            simulation.tick()
+            at = start + (ticks + 1) * PERIOD
+            simulation.tick(at=at)
             ticks += 1
+            late += simulation.time > simulation.hold and time.monotonic() > at + PERIOD
             if held and simulation.time >= simulation.hold:
                 node.get_logger().info(f"released: the stylus is let go after {simulation.hold:g} s")
             if ticks * PERIOD >= published * rate_period:
                 node.publish_state()
                 published += 1
         executor.spin_once(timeout_sec=max(0.0, start + (ticks + 1) * PERIOD - time.monotonic()))
+    node.get_logger().info(f"a command arrived for {simulation.commanded} of the {simulation.ticks} servo ticks "
+                           f"after the release ({node.received} commands in all); {late} ticks ran more than a period "
+                           "late")
 
 
 def spin(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str = "") -> int:

@@ -134,6 +134,49 @@ def _rx(angle: float) -> np.ndarray:
 
 
 _B = np.array([[0.0, 0, 1], [1, 0, 0], [0, 1, 0]])   # CalaW's REP-103 basis: x = z_OH, y = x_OH, z = y_OH
+
+
+def hdu_quaternion(stored: np.ndarray) -> tuple[float, float, float, float]:
+    """(w, x, y, z) of hduQuaternion::fromRotationMatrix of a stored 3x3 R[i][j]
+    (danepowell/openhaptics@2ce9a48 usr/share/3DTouch/libsrc/HDU/hduQuaternion.cpp 161-200)."""
+    r = stored
+    trace = r[0][0] + r[1][1] + r[2][2]
+    if trace > 0.0:
+        root = math.sqrt(trace + 1.0)
+        w, root = 0.5 * root, 0.5 / root
+        return w, (r[1][2] - r[2][1]) * root, (r[2][0] - r[0][2]) * root, (r[0][1] - r[1][0]) * root
+    i = 0
+    if r[1][1] > r[0][0]:
+        i = 1
+    if r[2][2] > r[i][i]:
+        i = 2
+    j, k = (1, 2, 0)[i], (1, 2, 0)[(1, 2, 0)[i]]
+    root = math.sqrt(r[i][i] - r[j][j] - r[k][k] + 1.0)
+    quat = [0.0, 0.0, 0.0]
+    quat[i] = 0.5 * root
+    root = 0.5 / root
+    quat[j], quat[k] = (r[i][j] + r[j][i]) * root, (r[i][k] + r[k][i]) * root
+    return (r[j][k] - r[k][j]) * root, quat[0], quat[1], quat[2]
+
+
+def quaternion_rotation(w: float, x: float, y: float, z: float) -> np.ndarray:
+    """The rotation (column vectors) of a unit quaternion as geometry_msgs/Quaternion holds it."""
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+
+def geomagic_pose(t: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """omni_state.cpp 284-301 and 241-249 (units mm): hduMatrix transform holds HD_CURRENT_TRANSFORM's
+    16 numbers row by row (hduMatrix.h 43-44, 110-122): transform[i][j] = T[j][i], the translation in
+    its last row; position (transform[3][0], -transform[3][2], transform[3][1]) / 1000; orientation
+    hduQuaternion(rotation_offset * rotation), rotation_offset built row by row (a1..a16, hduMatrix.h
+    46-65), `*` the plain product (hduGenericMatrix.h 261-267)."""
+    transform = np.eye(4)
+    transform[:3, :3], transform[3, :3] = r.T, t     # T^T of T = [[R, t], [0, 1]]
+    offset = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])
+    w, x, y, z = hdu_quaternion(offset @ transform[:3, :3])
+    return np.array([transform[3][0], -transform[3][2], transform[3][1]]), quaternion_rotation(w, x, y, z)
 #: topic -> (kind, formula of (t_OH m, R_OH) or (v_OH m/s, w_OH rad/s)), as each driver writes it
 STATE = {
     # mtsSensableHD.cpp 401-404, 302-306: HD_CURRENT_TRANSFORM in m, OH axes; HD_CURRENT_VELOCITY / 1000
@@ -144,6 +187,8 @@ STATE = {
     "/touch/state/twist": ("twist", lambda v, w: (_B @ v, _B @ w)),
     # phantom_touch_control_node.cpp 267-280, hd++.cpp 194-200: t, R Ry(pi/2) Rx(-pi/2)
     "/pose_stylus_current": ("pose", lambda t, r: (t, r @ _ry(PI / 2) @ _rx(-PI / 2))),
+    # omni_state.cpp 241-249, 284-301 (above)
+    "/phantom/pose": ("pose", geomagic_pose),
     # geomagic_touch_x_component.cpp 184-196: HD_CURRENT_VELOCITY / 1000, HD_CURRENT_ANGULAR_VELOCITY
     "/geomagic_touch_x/twist": ("twist", lambda v, w: (v, w)),
 }

@@ -1,21 +1,26 @@
 """End to end over ROS 2 on loopback, with the real rclpy: for every driver profile whose message
 types install here, the simulated driver (phantom-pin sim-driver) and the node (phantom-pin ros2
---driver) as two processes. Released after --hold, the stylus floats (within 2 mm for 5 s); a
-user's 0.5 N up lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
+--driver) as two processes. Released after --hold, the stylus floats (within 2 mm for 5 s; for
+kinisi's one-tick driver only the node's part is asserted, docs/drivers.md); a user's 0.5 N up
+lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
 driver's own formula (driver_reference), holds the Touch's gravity from the closed form (1e-9 N m);
 without the node the stylus falls. omni_msgs (geomagic_touch_ros2) is not on PyPI: the node
-refuses that profile in one line."""
+refuses that profile in one line, and the documents' one-file relay (`--relay`) is run as printed
+with a stand-in for omni_msgs."""
 
 from __future__ import annotations
 
 import atexit
 import functools
 import os
+import re
 import selectors
 import signal
 import subprocess
 import sys
 import time
+import types
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -41,7 +46,9 @@ REPORT = Phantom("touch").config.report
 #: The bad wrench each profile's test sends, and the field its warning names.
 BAD_WRENCH = {"sawsensablephantom": ("base_link", (float("nan"), 0.0, 0.0), "force"),
               "touch_ros2_control": ("nowhere", (0.0, 0.0, 0.1), "frame_id"),
-              "geomagic_touch_x_ros2": ("base_link", (1e9, 0.0, 0.0), "force")}
+              "geomagic_touch_x_ros2": ("base_link", (1e9, 0.0, 0.0), "force"),
+              "geomagic_touch_ros2": ("stylus", (0.0, -float("inf"), 0.0), "force"),
+              "phantom_touch_ros2": ("touch_b_stylus", (0.0, 0.0, 0.1), "frame_id")}
 HOLD = 6.0                           # s, before the simulated driver lets go: the node starts meanwhile
 
 
@@ -164,7 +171,9 @@ def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
     """The node and the simulated driver started together (the driver holds the stylus for HOLD
     s meanwhile); after the release the tip stays within 2 mm for 5 s, every force received holds
     the closed form's gravity at the release posture by the driver's own formula (1e-9 N m), and
-    0.5 N up on `wrench` lifts the tip."""
+    0.5 N up on `wrench` lifts the tip (kinisi's one-tick driver: _one_tick); a bad wrench is
+    dropped with one warning naming its field. The simulated driver's count of ticks with a
+    command is printed."""
     env = _environment(INSTALLED.index(name))
     node = _start(env, "ros2", "--driver", name)
     simulated = _start(env, "sim-driver", "--driver", name, "--hold", str(HOLD), "--theta0", *map(str, THETA0))
@@ -175,11 +184,16 @@ def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
     finally:
         watcher.close()
         results = [_stop(process) for process in (simulated, node)]
+    print(next(line for line in results[0][1].splitlines() if "servo ticks after the release" in line))
+    _clean_stops(name, results)
+
+
+def _clean_stops(name: str, results: list[tuple[int, str]]) -> None:
+    """Both stopped with 0 and no traceback; the node's log says the bad wrench once, naming its field."""
     for code, err in results:
         assert code == 0 and "Traceback" not in err, err
-    if name in BAD_WRENCH:
-        warnings = [line for line in results[1][1].splitlines() if "dropped a wrench message" in line]
-        assert len(warnings) == 1 and BAD_WRENCH[name][2] in warnings[0], warnings
+    warnings = [line for line in results[1][1].splitlines() if "dropped a wrench message" in line]
+    assert len(warnings) == 1 and BAD_WRENCH[name][2] in warnings[0], warnings
 
 
 def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) -> None:
@@ -189,20 +203,42 @@ def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) ->
     assert watcher.states and watcher.forces, (f"within the {HOLD} s hold: {len(watcher.states)} states, "
                                                f"{len(watcher.forces)} forces")
     watcher.spin(0.05)
-    released, start = watcher.states[-1][0], tip(THETA0)
-    one_tick = watcher.profile.force.hold == "one_tick"
-    watcher.spin(1.0 if one_tick else 5.0)   # the float's 5 s, where a float is possible (below)
+    released = watcher.states[-1][0]
+    watcher.spin(5.0)   # the float's 5 s
     floating = [tip(theta) for at, theta, _ in watcher.states if at >= released]
-    drift = np.linalg.norm(np.array(floating) - start, axis=1).max()
+    drift = np.linalg.norm(np.array(floating) - tip(THETA0), axis=1).max()
     answered = sum(at >= released for at in watcher.received) / len(floating)   # after the release
     print(f"\n{name}: {len(floating)} states after the release, drift {drift * 1e3:.3f} mm, "
           f"{100 * answered:.0f} % of all states answered")
-    if one_tick:
-        # kinisi's driver renders a command in the one servo tick after it arrives (hd++.cpp 138-145): the
-        # stylus floats only where a command lands in every tick, which no ROS 2 transport guarantees; the
-        # node's part is to answer the states
-        assert answered > 0.8
-        return
+    if watcher.profile.force.hold == "one_tick":
+        _one_tick(watcher, answered)
+    else:
+        _floats_and_lifts(name, watcher, drift)
+    # a bad wrench, one kind per profile (the warnings are throttled to one a second): dropped with a
+    # warning naming the field (checked by the caller), nothing sent beyond the driver's clamp or not finite
+    watcher.push(*BAD_WRENCH[name])
+    watcher.spin(0.2)
+    sent = np.array([ref.FORCE[name](force) for force in watcher.forces])
+    assert np.isfinite(sent).all() and np.linalg.norm(sent, axis=1).max() <= watcher.profile.force.clamp * (1 + 1e-12)
+
+
+def _one_tick(watcher: Watcher, answered: float) -> None:
+    """kinisi's driver renders a command in the one servo tick after it arrives (hd++.cpp 138-145):
+    the stylus floats only where a command arrives within every 1 ms tick, which ROS 2 on this
+    shared 2-core machine does not give (docs/drivers.md: the measured shares; the simulated driver
+    logs its own, printed by the caller). The node's part, asserted: it answers the states, and every
+    force it sent while the stylus stood at the release posture holds the closed form's gravity there
+    by the driver's own formula (1e-9 N m)."""
+    assert answered > 0.8
+    moved = next((at for at, theta, _ in watcher.states if np.abs(theta - THETA0).max() > 1e-12), np.inf)
+    jacobian, gravity = ref.tip_jacobian(THETA0), ref.gravity(THETA0, np.zeros(3), REPORT)
+    errors = [np.abs(jacobian.T @ ref.FORCE[watcher.profile.name](force) - gravity).max()
+              for force, at in zip(watcher.forces, watcher.received) if at < moved - 0.2]   # answers to still states
+    assert len(errors) > 100 and max(errors) < 1e-9, (len(errors), max(errors))
+
+
+def _floats_and_lifts(name: str, watcher: Watcher, drift: float) -> None:
+    """A driver that holds its force: the stylus floats, the forces hold gravity, 0.5 N up lifts it."""
     assert drift < 2e-3
     # the driver's other state topics arrive with the joint states, in its frame_id
     assert all(len(m) > 100 and {x.header.frame_id for x in m} == {spec.frame_id}
@@ -221,18 +257,83 @@ def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) ->
         watcher.push("base_link", (0.0, 0.0, 0.5))
         watcher.spin(0.01)
     watcher.push("base_link", (0.0, 0.0, 0.0))
-    watcher.spin(0.1)
-    after = tip(watcher.states[-1][1])[1]
+    # the highest the tip got since the push (it floats within 1e-12 m without one, above), read until it
+    # rose 1 mm or 3 s passed: on a busy machine the push reaches the driver 0.1 s late or more
+    deadline, after = time.monotonic() + 3.0, before
+    while after - before <= 1e-3 and time.monotonic() < deadline:
+        watcher.spin(0.05)
+        after = max((tip(theta)[1] for _, theta, _ in watcher.states[count:]), default=before)
     assert len(watcher.states) > count + 10, "the simulated driver stopped publishing"
     print(f"{name}: {len(errors)} forces checked against the closed form; 0.5 N up lifted the tip "
           f"{(after - before) * 1e3:.1f} mm")
     assert after - before > 1e-3
-    # a bad wrench, one kind per profile (the warnings are throttled to one a second): dropped with a
-    # warning naming the field (checked by the caller), nothing sent beyond the driver's clamp or not finite
-    watcher.push(*BAD_WRENCH[name])
-    watcher.spin(0.2)
-    sent = np.array([ref.FORCE[name](force) for force in watcher.forces])
-    assert np.isfinite(sent).all() and np.linalg.norm(sent, axis=1).max() <= watcher.profile.force.clamp * (1 + 1e-12)
+
+
+#: The documents that print the one-file relay for the omni_msgs driver (`ros2 --relay`).
+RELAY_DOCUMENTS = ("README.md", "docs/drivers.md")
+#: omni_msgs.msg in place of the driver's workspace: OmniFeedback as geometry_msgs/Wrench.
+STAND_IN = "from geometry_msgs.msg import Wrench as OmniFeedback\n"
+
+
+def relay_block(document: str) -> str:
+    """The one python block of ``document`` that uses omni_msgs' OmniFeedback, as printed."""
+    text = (Path(__file__).resolve().parents[1] / document).read_text()
+    blocks = [b for b in re.findall(r"```python\n(.*?)```", text, re.DOTALL) if "OmniFeedback" in b]
+    assert len(blocks) == 1, f"{document}: {len(blocks)} relay blocks"
+    return blocks[0]
+
+
+@pytest.mark.parametrize("document", RELAY_DOCUMENTS)
+def test_the_documented_relay_carries_the_nodes_force_to_the_geomagic_driver(document, tmp_path, monkeypatch):
+    """The relay block of ``document``, executed exactly as printed (a script of its own, as a user
+    runs it), between the node (`ros2 --driver geomagic_touch_ros2 --relay`: Vector3 on
+    /phantom/force_feedback_relay) and the simulated geomagic driver (OmniFeedback on
+    /phantom/force_feedback): the stylus floats (within 2 mm for 5 s, every force the driver receives
+    holding the closed form's gravity by the driver's own formula, 1e-9 N m), 0.5 N up lifts it, and
+    every force the driver receives is, bit for bit, one the node sent to the relay.
+
+    omni_msgs is not on PyPI and cannot be installed here (it is built in the driver's ROS
+    workspace), so the relay, the simulated driver and this test's watcher import a stand-in
+    package whose omni_msgs.msg.OmniFeedback is geometry_msgs/msg/Wrench: a real ROS message
+    whose ``force`` is a geometry_msgs/Vector3 as OmniFeedback's is (its other field is ``torque``
+    where OmniFeedback has ``position``, which neither the relay nor the driver's force path sets,
+    omni_state.cpp 183-196). What this cannot check is the real type's name and wire format."""
+    from geometry_msgs.msg import Vector3
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    name = "geomagic_touch_ros2"
+    package = tmp_path / "omni_msgs"
+    (package / "msg").mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "msg" / "__init__.py").write_text(STAND_IN)
+    (tmp_path / "phantom_pin_relay.py").write_text(relay_block(document))
+    stand_in = types.ModuleType("omni_msgs.msg")
+    exec(STAND_IN, stand_in.__dict__)
+    monkeypatch.setitem(sys.modules, "omni_msgs", types.ModuleType("omni_msgs"))
+    monkeypatch.setitem(sys.modules, "omni_msgs.msg", stand_in)
+    env = _environment()
+    workspace = {**env, "PYTHONPATH": os.pathsep.join(filter(None, (str(tmp_path), env.get("PYTHONPATH"))))}
+    node = _start(env, "ros2", "--driver", name, "--relay")      # without the stand-in: Vector3 only
+    relay = subprocess.Popen([sys.executable, str(tmp_path / "phantom_pin_relay.py")], env=workspace,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    simulated = _start(workspace, "sim-driver", "--driver", name, "--hold", str(HOLD), "--theta0", *map(str, THETA0))
+    watcher = Watcher(name, env)
+    relayed: list = []
+    watcher.node.create_subscription(Vector3, "/phantom/force_feedback" + profiles.RELAY, relayed.append,
+                                     QoSProfile(depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT))
+    try:
+        _wait_for(node, "joint_states ->")
+        _float_and_lift(name, watcher, simulated)
+        assert relay.poll() is None, relay.communicate()[1]
+    finally:
+        watcher.close()
+        results = [_stop(process) for process in (simulated, node)]
+        relay.kill()
+        relay.communicate()
+    _clean_stops(name, results)
+    sent = {(v.x, v.y, v.z) for v in relayed}
+    received = [(f.force.x, f.force.y, f.force.z) for f in watcher.forces]
+    assert len(received) > 100 and all(f in sent for f in received), (len(received), len(sent))
 
 
 def test_without_the_node_the_stylus_falls():

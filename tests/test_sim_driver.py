@@ -64,6 +64,29 @@ def test_the_simulated_drivers_render_as_their_sources_say(device):
     assert np.linalg.norm(big.force(ref.tip_jacobian(theta0))) == pytest.approx(2.0, rel=1e-12)
 
 
+def test_a_command_counts_for_the_servo_tick_after_it_arrived(device):
+    """Commands given with their arrival times and ticks with theirs (s, one clock; seeded): each
+    tick renders J^T F of the latest command arrived by its time (saw holds it), kinisi's only of one
+    arrived since the previous tick (hd++.cpp 138-145: the callback stores the force and sets a flag,
+    the next servo tick sends it and clears the flag; nothing otherwise), whatever the order the
+    loop hands them over in. The stylus held (before ``hold``), so J is the release posture's."""
+    rng = np.random.default_rng(5)
+    arrivals = rng.uniform(0.0, 0.02, 30)
+    commands = rng.uniform(-1.0, 1.0, (30, 3))           # N, under saw's 2 N clamp
+    jacobian = ref.tip_jacobian(RELEASES[0])
+    for name in ("phantom_touch_ros2", "sawsensablephantom"):
+        simulation = DriverSimulation(device, profiles.load(name), RELEASES[0], hold=1.0)
+        for t, c in zip(arrivals, commands):
+            simulation.command(c, at=t)
+        one_tick = name == "phantom_touch_ros2"
+        for k in range(1, 22):
+            simulation.tick(at=k * 1e-3)
+            since = (k - 1) * 1e-3 if one_tick else -np.inf   # kinisi: arrived since the previous tick only
+            arrived = [i for i in range(30) if since < arrivals[i] <= k * 1e-3]
+            want = jacobian.T @ commands[max(arrived, key=lambda i: arrivals[i])] if arrived else np.zeros(3)
+            assert np.abs(simulation.applied - want).max() < 1e-12, (name, k)
+
+
 class SimpleWrench:
     """A WrenchStamped-shaped holder of a force in CalaW's driver frame R."""
 
@@ -130,29 +153,36 @@ def test_the_state_topics_are_each_drivers_own_of_the_stylus_pose_and_velocity(d
     """HD_CURRENT_TRANSFORM of the stylus (Ubitrack's position and rotation of OpenHaptics' angles,
     plus frame s's origin in OpenHaptics' coordinates from gimbal.yaml's openhaptics_shoulder, an
     ESTIMATE) and its velocities (complex steps of Ubitrack's formulas along the joint rates), each
-    through the driver's own formula (driver_reference.STATE): 1e-12."""
+    through the driver's own formula (driver_reference.STATE; geomagic's through OpenHaptics'
+    hduMatrix and hduQuaternion, both branches of its quaternion taken): 1e-12, at a fixed and
+    seeded states inside the stops and the gimbal's ranges."""
     import yaml
 
     from gimbal_reference import derivative, openhaptics, ubitrack
 
     shoulder = np.array(yaml.safe_load((ref.TOUCH / "gimbal.yaml").read_text())["openhaptics_shoulder"])
     origin = shoulder - [0.0, ref.L2, -ref.L1]       # the zero posture's gimbal centre in OpenHaptics' frame
-    theta, gimbal, rates = np.array([0.15, 0.55, 0.62]), np.zeros(3), np.array([0.3, -0.2, 0.4])
-    position, rotation = ubitrack(openhaptics(theta, gimbal))
+    thetas, gimbals = ref.states(6, seed=41)
+    rng = np.random.default_rng(41)
+    seen, traces = set(), []
+    for theta, gimbal in [(np.array([0.15, 0.55, 0.62]), np.zeros(3)), *zip(thetas, gimbals)]:
+        rates = rng.uniform(-0.5, 0.5, 3)
+        position, rotation = ubitrack(openhaptics(theta, gimbal))
 
-    def along(function):   # d function(theta + s rates)/ds at s = 0, complex step
-        return derivative(lambda s: function(theta + s[0] * rates), np.zeros(1), 0)
+        def along(function, theta=theta, rates=rates):   # d function(theta + s rates)/ds at s = 0, complex step
+            return derivative(lambda s: function(theta + s[0] * rates), np.zeros(1), 0)
 
-    velocity = along(lambda t: ubitrack(np.array([-t[0], t[1], t[2], 0, 0, 0], dtype=complex))[0])
-    spin = along(lambda t: ubitrack(np.array([-t[0], t[1], t[2], 0, 0, 0], dtype=complex))[1]) @ rotation.T
-    angular = np.array([spin[2, 1], spin[0, 2], spin[1, 0]])
-    seen = set()
-    for name in PROFILES:
-        simulation = DriverSimulation(device, profiles.load(name), theta)
-        simulation.q, simulation.v = list(theta), list(rates)
-        for spec, first, second in simulation.state_topics(gimbal):
-            kind, formula = ref.STATE[spec.topic]
-            want = formula(position + origin, rotation) if kind == "pose" else formula(velocity, angular)
-            assert np.abs(first - want[0]).max() < 1e-12 and np.abs(second - want[1]).max() < 1e-12, spec.topic
-            seen.add(spec.topic)
+        velocity = along(lambda t, g=gimbal: ubitrack(openhaptics(t, g))[0])
+        spin = along(lambda t, g=gimbal: ubitrack(openhaptics(t, g))[1]) @ rotation.T
+        angular = np.array([spin[2, 1], spin[0, 2], spin[1, 0]])
+        traces.append(np.trace(np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]]) @ rotation.T))   # geomagic's branch
+        for name in PROFILES:
+            simulation = DriverSimulation(device, profiles.load(name), theta)
+            simulation.q, simulation.v = list(theta), list(rates)
+            for spec, first, second in simulation.state_topics(gimbal):
+                kind, formula = ref.STATE[spec.topic]
+                want = formula(position + origin, rotation) if kind == "pose" else formula(velocity, angular)
+                assert np.abs(first - want[0]).max() < 1e-12 and np.abs(second - want[1]).max() < 1e-12, spec.topic
+                seen.add(spec.topic)
     assert seen == set(ref.STATE)
+    assert min(traces) <= 0 < max(traces), traces
