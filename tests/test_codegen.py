@@ -196,7 +196,7 @@ def test_committed_headers_are_fresh(name):
 
 
 def test_the_banner_names_model_source_and_overlay():
-    text = header("premium_1_5_cad", prefix="lab_arm", overrides={"links.crank_link.mass": 0.2})
+    text = header("premium_1_5_cad", prefix="lab_arm", overrides=OVERLAY)    # the generation of CASES' overlay
     banner = text[:text.index("*/")]
     assert "Model: premium_1_5_cad" in banner
     assert "Configuration: robots/phantom_description/config/premium_1_5_cad" in banner
@@ -248,9 +248,9 @@ def test_cli_writes_the_header_and_refuses_bad_input(tmp_path, capsys):
     assert main(["info", "--model", "touch", "--set", "links.forearm_link.mass=-1"]) == 2
     assert capsys.readouterr().err == err  # the same line as any command's describe()
     assert not bad.exists()
-    assert main(["codegen", "--model", "touch", "--set", "links.forearm_link.com.1=0.003",
-                 "-o", str(out), "--force"]) == 0
-    assert "Overlay: links.forearm_link.com.1 = 0.003" in out.read_text()
+    sets = [argument for key, value in OVERLAY.items() for argument in ("--set", f"{key}={value!r}")]
+    assert main(["codegen", "--model", "premium_1_5_cad", *sets, "-o", str(out), "--force"]) == 0
+    assert out.read_text() == generated("premium_1_5_cad", overrides=OVERLAY)  # --set as overrides=
 
 
 

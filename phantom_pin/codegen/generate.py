@@ -390,8 +390,21 @@ def _wrapped(text: str) -> str:
     return "\n *   ".join(textwrap.wrap(text, 88, break_long_words=False, break_on_hyphens=False)) or text
 
 
-def _header(description: Description, prefix: str, origin: str, overlay: str,
-            progress: Callable[[float], None]) -> str:
+#: The functions' bodies by the model's numbers (its URDF, actuation and gimbal): SymPy takes
+#: seconds per model, and the prefix, origin and overlay text only name and describe them.
+_BODIES: dict[tuple[str, str, str], dict[str, str]] = {}
+
+
+def _bodies(description: Description, progress: Callable[[float], None]) -> dict[str, str]:
+    """Each function's C body (by function name), generated once per model's numbers."""
+    key = (description.urdf, repr(description.config.actuation), repr(description.config.gimbal))
+    if key not in _BODIES:
+        _BODIES[key] = _generate(description, progress)
+    return _BODIES[key]
+
+
+def _generate(description: Description, progress: Callable[[float], None]) -> dict[str, str]:
+    """The bodies of the dynamics and kinematics functions (SymPy: rnea, cse, C printing)."""
     model = _Model(description)
     theta = list(sp.symbols("q0:3", real=True))
     dtheta = list(sp.symbols("dq0:3", real=True))
@@ -416,6 +429,24 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
     position = r_s.T * (p_tip - p_s)
     jacobian = [[sp.diff(position[i], theta[j]) for j in range(3)] for i in range(3)]
     T, D, A = ("theta", theta), ("dtheta", dtheta), ("ddtheta", ddtheta)
+    bodies = {
+        "gravity": _body([(f"tau[{i}]", gravity[i]) for i in range(3)], [T]),
+        "inverse_dynamics": _body([(f"tau[{i}]", inverse[i]) for i in range(3)], [T, D, A]),
+        "mass_matrix": _body([(f"M[{3 * i + j}]", mass[i][j]) for i in range(3) for j in range(3)], [T]),
+        "coriolis": _body([(f"c[{i}]", coriolis[i]) for i in range(3)], [T, D]),
+        "tip_position": _body([(f"p[{i}]", position[i]) for i in range(3)], [T]),
+        "tip_jacobian": _body([(f"J[{3 * i + j}]", jacobian[i][j]) for i in range(3) for j in range(3)], [T]),
+        "jacobian_transpose_force": _body([(f"tau[{j}]", sum(jacobian[i][j] * f[i] for i in range(3)))
+                                           for j in range(3)], [T, ("f", f)]),
+    }
+    if description.config.gimbal is not None:
+        bodies["stylus_pose"] = _stylus_body(description)
+    return bodies
+
+
+def _header(description: Description, prefix: str, origin: str, overlay: str,
+            progress: Callable[[float], None]) -> str:
+    body = _bodies(description, progress)
     guard = f"{prefix.upper()}_MODEL_H"
     units = ("theta: the report's joint angles theta1..theta3 (rad); dtheta (rad/s); ddtheta (rad/s^2);\n"
              "torques in N m on theta. " + _ASSUMES)
@@ -423,33 +454,26 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
         _banner(description, prefix, origin, overlay) +
         f"#ifndef {guard}\n#define {guard}\n\n#include <math.h>\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n",
         _function(f"Gravity torques tau = N(theta) (N m) at rest.\n{units}",
-                  f"{prefix}_gravity(const double theta[3], double tau[3])",
-                  _body([(f"tau[{i}]", gravity[i]) for i in range(3)], [T])),
+                  f"{prefix}_gravity(const double theta[3], double tau[3])", body["gravity"]),
         _function(f"Inverse dynamics tau = M(theta) ddtheta + C(theta, dtheta) dtheta + N(theta) (N m),\n"
                   f"the rotors' armature included; no friction.\n{units}",
                   f"{prefix}_inverse_dynamics(const double theta[3], const double dtheta[3], "
-                  f"const double ddtheta[3], double tau[3])",
-                  _body([(f"tau[{i}]", inverse[i]) for i in range(3)], [T, D, A])),
+                  f"const double ddtheta[3], double tau[3])", body["inverse_dynamics"]),
         _function(f"Joint-space mass matrix M(theta) (kg m^2), row-major M[3*i + j], symmetric,\n"
                   f"the rotors' armature on its diagonal.\n{units}",
-                  f"{prefix}_mass_matrix(const double theta[3], double M[9])",
-                  _body([(f"M[{3 * i + j}]", mass[i][j]) for i in range(3) for j in range(3)], [T])),
+                  f"{prefix}_mass_matrix(const double theta[3], double M[9])", body["mass_matrix"]),
         _function(f"Coriolis and centrifugal torques c = C(theta, dtheta) dtheta (N m).\n{units}",
-                  f"{prefix}_coriolis(const double theta[3], const double dtheta[3], double c[3])",
-                  _body([(f"c[{i}]", coriolis[i]) for i in range(3)], [T, D])),
+                  f"{prefix}_coriolis(const double theta[3], const double dtheta[3], double c[3])", body["coriolis"]),
         _function(f"Tip position p (m) in the report's frame s (x left, y up, z forward); the tip is\n"
                   f"the gimbal's centre.\n{_ASSUMES}",
-                  f"{prefix}_tip_position(const double theta[3], double p[3])",
-                  _body([(f"p[{i}]", position[i]) for i in range(3)], [T])),
+                  f"{prefix}_tip_position(const double theta[3], double p[3])", body["tip_position"]),
         _function(f"Tip Jacobian J = dp/dtheta (m/rad), row-major J[3*i + j]: the tip's linear velocity\n"
                   f"in frame s is J dtheta.\n{_ASSUMES}",
-                  f"{prefix}_tip_jacobian(const double theta[3], double J[9])",
-                  _body([(f"J[{3 * i + j}]", jacobian[i][j]) for i in range(3) for j in range(3)], [T])),
+                  f"{prefix}_tip_jacobian(const double theta[3], double J[9])", body["tip_jacobian"]),
         _function(f"Joint torques tau = J^T f (N m) that exert the force f (N, frame s) at the tip.\n{_ASSUMES}",
                   f"{prefix}_jacobian_transpose_force(const double theta[3], const double f[3], double tau[3])",
-                  _body([(f"tau[{j}]", sum(jacobian[i][j] * f[i] for i in range(3))) for j in range(3)],
-                        [T, ("f", f)])),
-        *([] if description.config.gimbal is None else [_stylus(description, prefix)]),
+                  body["jacobian_transpose_force"]),
+        *([] if "stylus_pose" not in body else [_stylus(prefix, body["stylus_pose"])]),
         _openhaptics(prefix),
         f"#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {guard} */\n",
     ]
@@ -485,7 +509,7 @@ def _banner(description: Description, prefix: str, origin: str, overlay: str) ->
             f" */\n")
 
 
-def _stylus(description: Description, prefix: str) -> str:
+def _stylus_body(description: Description) -> str:
     """The stylus frame's pose in frame s (Phantom.stylus_pose): the product of the joint
     transforms with the gimbal's joints free, frame s's inverse first; the URDF's quarter turns
     exact (a change of 6e-17 against Pinocchio's, which leaves the result's rounding)."""
@@ -497,6 +521,11 @@ def _stylus(description: Description, prefix: str) -> str:
     position, rotation = r_s.T * (p_stylus - p_s), r_s.T * r_stylus
     pose = _leaner([*position, *(rotation[i, j] for i in range(3) for j in range(3))])
     outputs = [(f"p[{i}]", pose[i]) for i in range(3)] + [(f"R[{k}]", pose[3 + k]) for k in range(9)]
+    return _body(outputs, [("theta", theta), ("gimbal", gimbal)])
+
+
+def _stylus(prefix: str, body: str) -> str:
+    """The stylus pose's function (_stylus_body) named ``prefix``_stylus_pose."""
     return _function(
         "Pose of the stylus frame in the report's frame s (x left, y up, z forward), as\n"
         "phantom_pin.Phantom.stylus_pose: its origin p (m) is the gimbal's centre (the tip); its\n"
@@ -504,8 +533,7 @@ def _stylus(description: Description, prefix: str) -> str:
         "columns, +z along the stylus towards its back end. theta: the report's theta1..theta3\n"
         "(rad); gimbal: OpenHaptics' raw gimbal angles g1..g3 (rad, the URDF's joint4..joint6).\n"
         f"{_ASSUMES}",
-        f"{prefix}_stylus_pose(const double theta[3], const double gimbal[3], double p[3], double R[9])",
-        _body(outputs, [("theta", theta), ("gimbal", gimbal)]))
+        f"{prefix}_stylus_pose(const double theta[3], const double gimbal[3], double p[3], double R[9])", body)
 
 
 def _openhaptics(prefix: str) -> str:
