@@ -17,7 +17,6 @@ torques and all parameters scaled alike fit equally), hence joint 1 as the refer
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 #: The prior's standard deviation of each joint's torque gain relative to joint 1: a torque
 #: constant or amplifier gain is specified to a few percent, a transmission ratio misread (11.2
@@ -43,6 +42,8 @@ def fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
     Gauss-Markov estimate with that prior (module doc), solved in the base parameters scaled by
     the prior's standard deviations (a singular value decomposition: the log alone may leave
     directions unconstrained)."""
+    import scipy.linalg  # here: 0.17 s that every command line start paid
+
     p = phi.shape[-1]
     moving = np.ones(y.shape, bool) if moving is None else moving
     phi, y = phi * moving[..., None], y * moving
@@ -102,6 +103,8 @@ def solve_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.n
     the regressor, the logged and the known torques, ``prior`` (beta_0, P) or None. Returns
     (beta, covariance, information (of beta and the free inverse gains), the log alone's beta
     and residual RMS per joint in joint 1's scale (N m), (gains (3,), standard deviations (3,)))."""
+    import scipy.linalg
+
     p, scale = phi.shape[-1], np.ones(3)
     # where to start: the gains at 1 (with none free, the loop's one pass is that fit: not done twice)
     beta = fit(phi, (tau - tau0) * moving, moving, prior)[0] if free else np.zeros(p)
