@@ -147,3 +147,33 @@ def test_the_command_table_lists_every_command():
     rows = [line.split("` |")[0] + "`" for line in table.splitlines() if line.startswith("| `phantom-pin")]
     for command in next(a for a in parser()._actions if a.dest == "command").choices:
         assert any(re.search(rf"[ `]{command}[ `]", row) for row in rows), command
+
+
+def test_the_frames_page_says_what_the_urdf_and_the_drivers_module_do():
+    """docs/frames.md against the Touch's URDF (Pinocchio's frame placements at the zero posture)
+    and phantom_pin.drivers: frame s's axes are base_link's (y, z, x), as are the report's
+    dynamics frame's, the tool frame's and the stylus's at zero; stylus_tip is 39 mm from the
+    gimbal's centre; OpenHaptics' angles and torques map as the page writes them."""
+    import numpy as np
+    import pinocchio as pin
+
+    from phantom_pin import drivers, load
+
+    text = " ".join((ROOT / "docs" / "frames.md").read_text().split())
+    assert "x left, y up, z forward: base_link's (y, z, x)" in text
+    assert "39 mm from the gimbal's centre" in text
+    assert "θ = (−a1, a2, a3)" in text and "τ = (−T1, T2, T3) / 1000" in text
+    robot = load("touch")
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
+
+    def pose(name):
+        return data.oMf[robot.model.getFrameId(name)]
+
+    axes = np.eye(3)[:, [1, 2, 0]]    # columns: s's x, y, z in base_link: base_link's y, z, x
+    for frame in ("report_s", "report_dynamics", "tip", "stylus"):
+        assert np.allclose(pose(frame).rotation, axes, atol=1e-12), frame
+    assert np.linalg.norm(pose("stylus_tip").translation - pose("stylus").translation) == pytest.approx(0.039)
+    assert np.allclose(pose("report_dynamics").translation, 0)    # the shoulder: base_link's origin
+    assert np.allclose(drivers.theta_from_openhaptics([0.1, 0.2, 0.3]), [-0.1, 0.2, 0.3])
+    assert np.allclose(drivers.tau_from_openhaptics_torque([1.0, 2.0, 3.0]), [-1e-3, 2e-3, 3e-3])
