@@ -177,3 +177,18 @@ def test_the_frames_page_says_what_the_urdf_and_the_drivers_module_do():
     assert np.allclose(pose("report_dynamics").translation, 0)    # the shoulder: base_link's origin
     assert np.allclose(drivers.theta_from_openhaptics([0.1, 0.2, 0.3]), [-0.1, 0.2, 0.3])
     assert np.allclose(drivers.tau_from_openhaptics_torque([1.0, 2.0, 3.0]), [-1e-3, 2e-3, 3e-3])
+
+
+def test_the_readme_is_one_screen_that_points_into_the_site():
+    """Issue 41: at most about 150 lines; a picture of each model; the build command that CI runs;
+    every local link leads to a file that exists, and every page of the site's nav is reachable."""
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 150
+    for name in ("premium_1_5", "premium_1_5_cad", "touch"):
+        assert f"(docs/pictures/{name}.png)" in readme
+    assert "mkdocs build --strict" in readme and "mkdocs build --strict" in (ROOT / ".ci" / "run").read_text()
+    links = re.findall(r"\]\(([^)#]+)\)", readme)
+    local = [link for link in links if "://" not in link]
+    assert local and all((ROOT / link).exists() for link in local), local
+    nav = re.findall(r":\s*([\w-]+\.md)\s*$", (ROOT / "mkdocs.yml").read_text(), re.M)
+    assert sorted(nav) == sorted(p.name for p in (ROOT / "docs").glob("*.md"))   # every page in the nav
