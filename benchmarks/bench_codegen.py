@@ -1,5 +1,5 @@
 """The generated C header against Pinocchio's own C++ and against the Python API, in one run:
-ns per call of gravity and inverse dynamics, and the ratios (the README's numbers).
+ns per call of gravity and inverse dynamics, and the ratios (the numbers of docs/servo-loop.md).
 
 The header (phantom-pin codegen) and Pinocchio's computeGeneralizedGravity and rnea are timed
 in one C++ program compiled with g++ -O2: Pinocchio's calls are the pin wheel's own compiled

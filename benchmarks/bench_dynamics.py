@@ -1,6 +1,6 @@
 """Each Phantom method against the bare Pinocchio call it wraps, as ratios measured in the
 same run (interleaved rounds, medians: absolute times on a shared machine drift 2x), and
-the batches; prints the targets of issue 11, met or not, and the README's table.
+the batches; prints the targets of issue 11, met or not, and the table of docs/speed.md.
 
     python benchmarks/bench_dynamics.py [--rounds 15] [--batch 1000000]
 """

@@ -39,7 +39,8 @@ JOINT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c")
 #: Limit lines: the colour and dash of stops and torque limits.
 LIMIT_STYLE = {"color": "#c00000", "linestyle": "--", "linewidth": 1.0}
 _STYLE = ("body{font-family:sans-serif;margin:2em;color:#222}h1{font-size:1.4em}h2{font-size:1.1em;"
-          "margin-top:1.5em}table{border-collapse:collapse}td{padding:0 1em 0 0}svg{max-width:100%;height:auto}")
+          "margin-top:1.5em}table{border-collapse:collapse}td,th{padding:0 1em 0 0;text-align:left}"
+          "svg{max-width:100%;height:auto}")
 
 
 def require_matplotlib() -> Any:
@@ -57,7 +58,8 @@ def require_matplotlib() -> Any:
 @dataclasses.dataclass(frozen=True)
 class Curve:
     """One series over time: ``t`` (N,) s and ``values`` (N,), its legend ``label``, its SVG
-    ``gid`` (an id), and its colour and line style."""
+    ``gid`` (an id), and its colour and line style; ``marker`` (a matplotlib marker, e.g. ".")
+    draws a point at each sample (with ``linestyle`` "none": a scatter, one SVG ``use`` a point)."""
 
     t: np.ndarray
     values: np.ndarray
@@ -65,6 +67,7 @@ class Curve:
     gid: str
     color: str
     linestyle: str = "-"
+    marker: str = ""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -109,7 +112,7 @@ def figure_svg(panels: Sequence[Panel], xlabel: str = "t [s]") -> str:
             for curve in panel.curves:
                 keep = thinned(len(curve.t))
                 ax.plot(curve.t[keep], curve.values[keep], color=curve.color, linestyle=curve.linestyle,
-                        linewidth=1.2, label=curve.label, gid=curve.gid)
+                        linewidth=1.2, label=curve.label, gid=curve.gid, marker=curve.marker or None, markersize=2)
             for limit in panel.limits:
                 ax.axhline(limit.value, label=limit.label, gid=limit.gid, **LIMIT_STYLE)
             ax.set_title(panel.title, fontsize=10)

@@ -4,6 +4,7 @@ chromium, project a world point to its pixel with meshcat's camera (75 degrees v
 view, looking at the world origin, z up, from viewer.CAMERA_POSITION)."""
 
 import json
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -68,6 +69,38 @@ def browse(html: Path, png: Path) -> tuple[np.ndarray, list[str], list[str]]:
     urls = [event["params"]["url"] for event in log["events"]
             if event["type"] == start and "file://" in event["params"].get("network_isolation_key", "")]
     return np.asarray(Image.open(png).convert("RGB")).astype(int), console, urls
+
+
+#: SVG coordinates are written with 6 decimals: an affine fit of a curve's points to its numbers
+#: leaves less than this share of the span (measured: below 1e-6).
+AFFINE_TOLERANCE = 1e-5
+
+
+def svg_points(page: str, gid: str) -> np.ndarray:
+    """The (x, y) vertices (SVG px) of the path in the group ``gid`` (M x y L x y ...) of a page
+    drawn by phantom_pin.plots."""
+    group = re.search(rf'<g id="{re.escape(gid)}">\s*<path d="([^"]*)"', page)
+    assert group is not None, gid
+    return np.array([float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", group.group(1))]).reshape(-1, 2)
+
+
+def affine(source: np.ndarray, image: np.ndarray) -> tuple[float, float, float]:
+    """(a, b, worst residual / span) of the least-squares fit image = a source + b."""
+    a, b = np.polyfit(source, image, 1)
+    return a, b, float(np.abs(a * source + b - image).max() / np.ptp(image))
+
+
+def check_page(html: Path, tmp_path: Path, figures: int) -> str:
+    """A phantom_pin.plots page renders in chromium with something drawn, no console line and no
+    request, holds no script, ``figures`` SVGs and no address but the SVG namespaces'; its text."""
+    image, console, urls = browse(html, tmp_path / "page.png")
+    assert console == [] and urls == []
+    assert np.count_nonzero(image.min(axis=2) < 200) > 5000  # curves, axes, text: not a blank page
+    text = html.read_text()
+    # no script, and no address but the SVG namespace's (an identifier, never fetched)
+    assert "<script" not in text and text.count("<svg") == figures
+    assert set(re.findall(r"https?://[^\s\"']*", text)) <= {"http://www.w3.org/2000/svg", "http://www.w3.org/1999/xlink"}
+    return text
 
 
 def project(point: np.ndarray) -> tuple[int, int]:

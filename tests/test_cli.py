@@ -232,7 +232,7 @@ def _config(tmp_path, file, old, new):
 
 
 def test_check_of_a_custom_configuration_passes_and_skips_the_appendix(tmp_path, cli):
-    """The README's example l1 = 0.2096: Phantom vs closed form with the same parameters
+    """The example l1 = 0.2096 of docs/models.md: Phantom vs closed form with the same parameters
     passes; the appendix's torques are not the numbers of this arm, so their row is n/a."""
     config = _config(tmp_path, "kinematics.yaml", "l1: 0.215 ", "l1: 0.2096 ")
     code, out, _ = cli("--config", str(config), "check", "-n", "300", "--json")

@@ -109,7 +109,7 @@ def test_every_joint_survives_with_its_axis_limits_and_dynamics(probe, name):
 
 @pytest.mark.parametrize("name", models())
 def test_sdformat_12_drops_the_mimic_tags_and_the_massless_frames(probe, name):
-    """What a Gazebo Fortress user loses (the README's Gazebo section says what to do): the four
+    """What a Gazebo Fortress user loses (docs/tools.md's Gazebo section says what to do): the four
     <mimic> tags (SDFormat gained //joint/axis/mimic and its URDF parser reads them from Gazebo
     Harmonic on: gazebosim/sdformat#1333), so the parallelogram's pin joints are free; and the
     massless frame links (tip, report_s, report_dynamics, elbow), with their fixed joints."""
@@ -133,7 +133,7 @@ def test_without_the_housing_gazebo_drops_the_whole_arm(probe, tmp_path):
 
 
 def test_a_world_link_around_the_macro_fixes_the_arm_to_gazebos_world(probe, tmp_path):
-    """The README's advice for a fixed base: a `world` link and a fixed joint to base_link in
+    """docs/tools.md's advice for a fixed base: a `world` link and a fixed joint to base_link in
     the user's own top-level file; sdformat makes it a joint fixed to the world (type 3)."""
     root = ET.parse(MODELS["touch"].urdf).getroot()
     root.insert(0, ET.fromstring('<joint name="world_joint" type="fixed"><parent link="world"/>'

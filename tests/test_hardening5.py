@@ -164,11 +164,11 @@ def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_
     assert f"  source: {stated['friction']}\n" not in out
 
 
-def test_the_readme_says_what_ctrl_c_does_to_show_and_ros2():
-    """M7: the README promised one line and 130 on Ctrl-C for every command, while `show`'s live
+def test_the_cli_page_says_what_ctrl_c_does_to_show_and_ros2():
+    """M7: the README (now docs/cli.md) promised one line and 130 on Ctrl-C for every command, while `show`'s live
     viewer and `ros2` exit 0 on it, their normal stop (tests/test_cli.py's
     test_show_serves_on_loopback_until_interrupted runs show and sends SIGINT: exit 0)."""
-    readme = " ".join((Path(__file__).parents[1] / "README.md").read_text().split())
+    readme = " ".join((Path(__file__).parents[1] / "docs" / "cli.md").read_text().split())
     start = readme.index("Ctrl-C prints one line and exits with 130")
     sentence = readme[start:readme.index(". ", start)]
     assert "`show`'s live viewer and the `ros2` node run until Ctrl-C or SIGTERM and then exit 0" in sentence
@@ -664,13 +664,13 @@ def test_an_option_given_twice_is_refused_not_silently_the_last(tmp_path, cli, a
     assert code == 0 and json.loads(out) == json.loads(cli("--set", "l1=0.3", "fk", "0", "0", "0", "--json")[1])
 
 
-def test_the_readmes_command_table_lists_every_command_and_the_newest_options():
-    """L13: the README's command table lacked ros2, show --gimbal and urdf --convention driver.
+def test_the_cli_pages_command_table_lists_every_command_and_the_newest_options():
+    """L13: the README's command table (now docs/cli.md's) lacked ros2, show --gimbal and urdf --convention driver.
     Against the parser itself: every subcommand has a row."""
     from phantom_pin.cli.app import parser
 
-    readme = (Path(__file__).parents[1] / "README.md").read_text()
-    table = readme.split("## Command line")[1].split("\n\n")[1]
+    readme = (Path(__file__).parents[1] / "docs" / "cli.md").read_text()
+    table = readme.split("## The commands at a glance")[1].split("\n\n")[1]
     rows = [line for line in table.splitlines() if line.startswith("| `phantom-pin")]
     commands = next(a for a in parser()._actions if a.dest == "command").choices
     for command in commands:

@@ -1,7 +1,7 @@
 """examples/identify_simulated.py runs headless, writes its figure, and on the CAD device the
 general identification predicts the held-out torques within 0.5 %, far better than the report
 structure's fit and the report's parameters, and says the general model is needed; the figures
-the README and docs/identification.md quote are the ones it prints."""
+docs/getting-started.md and docs/identification.md quote are the ones it prints."""
 
 from pathlib import Path
 
@@ -25,7 +25,7 @@ def test_identify_simulated_example(tmp_path, machine_environment):
     assert general < 0.5 and structure > 3 * general and report > 10 * general
     assert "this device has products of inertia or off-axis centres of mass" in result.stdout
     quoted = (f"general {general:.2f} %, report structure {structure:.2f} %", f"report's parameters {report:.1f} %")
-    readme = " ".join((ROOT / "README.md").read_text().split())
+    readme = " ".join((ROOT / "docs" / "getting-started.md").read_text().split())
     docs = " ".join((ROOT / "docs" / "identification.md").read_text().split())
     for text in (readme, docs):  # before: the docs said 1.59 % where the example printed 1.43 %
         assert quoted[0] in text and quoted[1] in text, quoted

@@ -317,18 +317,18 @@ def test_drake_sap_free_swing_follows_the_closed_form(case, drake_plant, couplin
     assert np.abs(theta - THETA0).max() > 0.3  # it did swing
 
 
-#: The README's one line that silences Drake's two known warnings on our URDFs (and no other).
+#: The one line of docs/tools.md that silences Drake's two known warnings on our URDFs (and no other).
 SILENCE_DRAKE = ('logging.getLogger("drake").addFilter(lambda record: not any(known in record.getMessage() '
                  'for known in ("joint friction", "mechanical reductions")))')
 
 
-def test_drake_warns_only_what_it_ignores_and_the_readmes_line_silences_it(case):
+def test_drake_warns_only_what_it_ignores_and_the_docs_line_silences_it(case):
     """Drake ignores the URDF's Coulomb friction (one warning per actuated joint) and a
     mechanicalReduction other than 1 (one per transmission; it uses drake:gear_ratio); the
-    README's line drops exactly those."""
+    line of docs/tools.md ("In other tools") drops exactly those."""
     import logging
 
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    readme = (Path(__file__).resolve().parents[1] / "docs" / "tools.md").read_text()
     assert SILENCE_DRAKE in readme
 
     class Records(logging.Handler):
@@ -364,14 +364,14 @@ def test_drake_warns_only_what_it_ignores_and_the_readmes_line_silences_it(case)
         logger.filters[:] = filters
 
 
-def test_the_readmes_drake_snippet_fixes_the_base_and_gives_the_closed_forms_gravity():
-    """The README's Drake block, run as written, on the default model: the base welded to the
+def test_the_docs_drake_snippet_fixes_the_base_and_gives_the_closed_forms_gravity():
+    """The Drake block of docs/tools.md, run as written, on the default model: the base welded to the
     world (7 revolute positions, no floating body's 7 more), the 4 couplers, and the gravity of
     the closed form at seeded postures inside the stops (before, the README never fixed the
     base: the arm fell as a free body)."""
     import re
 
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    readme = (Path(__file__).resolve().parents[1] / "docs" / "tools.md").read_text()
     block = next(b for b in re.findall(r"```python\n(.*?)```", readme, re.DOTALL) if "WeldFrames" in b)
     scope: dict = {}
     exec(block, scope)

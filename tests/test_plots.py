@@ -5,55 +5,28 @@ of (t, value) of the run's own output (JSON or CSV), and the limit lines sit at 
 torque limits read from the model's YAML (not from the code that draws them)."""
 
 import json
-import re
 import sys
 
 import numpy as np
 import pytest
 import yaml
 
-from helpers import CONFIG_DIR, browse
+from helpers import AFFINE_TOLERANCE, CONFIG_DIR, affine, check_page, svg_points
 from phantom_pin import plots
 
 #: A swing under gravity compensation: theta3 turns up to the coupled stop, and joint 3's gravity
 #: torque changes with it (-0.029 N m at 0.4 rad, -0.067 at 2 rad).
 SWING = ("simulate", "--theta0", "0", "0.3", "0.4", "--dtheta0", "0.5", "0.5", "4", "--controller", "gravity",
          "--duration", "0.5")
-#: SVG coordinates are written with 6 decimals: an affine fit leaves less than this share of the
-#: span (measured: below 1e-6).
-AFFINE_TOLERANCE = 1e-5
-
-
-def _points(page: str, gid: str) -> np.ndarray:
-    """The (x, y) vertices (SVG px) of the path in the group ``gid`` (M x y L x y ...)."""
-    group = re.search(rf'<g id="{re.escape(gid)}">\s*<path d="([^"]*)"', page)
-    assert group is not None, gid
-    return np.array([float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", group.group(1))]).reshape(-1, 2)
-
-
-def _affine(source: np.ndarray, image: np.ndarray) -> tuple[float, float, float]:
-    """(a, b, worst residual / span) of the least-squares fit image = a source + b."""
-    a, b = np.polyfit(source, image, 1)
-    return a, b, float(np.abs(a * source + b - image).max() / np.ptp(image))
-
-
 def _limit_value(page: str, gid: str, a: float, b: float) -> float:
     """The data value of a horizontal limit line through the y axis map px = a value + b."""
-    y = _points(page, gid)[:, 1]
+    y = svg_points(page, gid)[:, 1]
     assert np.ptp(y) == 0, gid  # horizontal
     return (y[0] - b) / a
 
 
 def _check_page(html, tmp_path) -> str:
-    """The page renders in chromium with something drawn, no console line and no request; its text."""
-    image, console, urls = browse(html, tmp_path / "page.png")
-    assert console == [] and urls == []
-    assert np.count_nonzero(image.min(axis=2) < 200) > 5000  # curves, axes, text: not a blank page
-    text = html.read_text()
-    # no script, and no address but the SVG namespace's (an identifier, never fetched)
-    assert "<script" not in text and text.count("<svg") == 3
-    assert set(re.findall(r"https?://[^\s\"']*", text)) <= {"http://www.w3.org/2000/svg", "http://www.w3.org/1999/xlink"}
-    return text
+    return check_page(html, tmp_path, 3)
 
 
 def _stops() -> dict:
@@ -69,18 +42,18 @@ def test_simulate_plot_draws_the_run_and_its_stops(tmp_path, cli):
     t, theta, tau = np.array(run["t"]), np.array(run["theta"]), np.array(run["tau"])
     page = _check_page(html, tmp_path)
     assert len(t) == 501 < plots.MAX_POINTS  # every sample drawn
-    points = _points(page, "theta-joint2")
+    points = svg_points(page, "theta-joint2")
     assert points.shape == (len(t), 2)
-    ax, bx, worst_x = _affine(t, points[:, 0])
-    ay, by, worst_y = _affine(theta[:, 1], points[:, 1])
+    ax, bx, worst_x = affine(t, points[:, 0])
+    ay, by, worst_y = affine(theta[:, 1], points[:, 1])
     assert worst_x < AFFINE_TOLERANCE and worst_y < AFFINE_TOLERANCE and ax > 0 and ay < 0  # SVG's y points down
     stops = _stops()
     for side in ("lower", "upper"):
         assert _limit_value(page, f"theta-limit-joint2-{side}", ay, by) == pytest.approx(stops["joint2"][side],
                                                                                          abs=1e-5)
     # the coupled stops, on theta3 - theta2
-    coupling = _points(page, "theta-coupling")
-    ac, bc, worst = _affine(theta[:, 2] - theta[:, 1], coupling[:, 1])
+    coupling = svg_points(page, "theta-coupling")
+    ac, bc, worst = affine(theta[:, 2] - theta[:, 1], coupling[:, 1])
     assert worst < AFFINE_TOLERANCE
     assert _limit_value(page, "theta-limit-coupling-upper", ac, bc) == pytest.approx(
         stops["theta3_minus_theta2_max"], abs=1e-5)
@@ -88,7 +61,7 @@ def test_simulate_plot_draws_the_run_and_its_stops(tmp_path, cli):
         -stops["theta2_minus_theta3_max"], abs=1e-5)
     # gravity compensation along the swing: the torques vary, and the saturation's lines are the
     # motors' continuous torque times the ratios (actuation.yaml)
-    a, b, worst = _affine(tau[:, 2], _points(page, "tau-joint3")[:, 1])
+    a, b, worst = affine(tau[:, 2], svg_points(page, "tau-joint3")[:, 1])
     assert worst < AFFINE_TOLERANCE and np.ptp(tau[:, 2]) > 0.01
     actuation = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())
     continuous = actuation["motor"]["max_continuous_torque"] * actuation["transmission_ratio"]["joint3"]
@@ -106,10 +79,10 @@ def test_excite_plot_draws_the_trajectory_and_its_limits(tmp_path, cli):
     t, theta, tau = table[:, 0], table[:, 1:4], table[:, 10:13]
     page = _check_page(html, tmp_path)
     for gid, values in (("theta-joint3", theta[:, 2]), ("tau-joint2", tau[:, 1])):
-        points = _points(page, gid)
+        points = svg_points(page, gid)
         assert points.shape == (len(t), 2)
-        assert _affine(t, points[:, 0])[2] < AFFINE_TOLERANCE and _affine(values, points[:, 1])[2] < AFFINE_TOLERANCE
-    a, b, _ = _affine(tau[:, 1], _points(page, "tau-joint2")[:, 1])
+        assert affine(t, points[:, 0])[2] < AFFINE_TOLERANCE and affine(values, points[:, 1])[2] < AFFINE_TOLERANCE
+    a, b, _ = affine(tau[:, 1], svg_points(page, "tau-joint2")[:, 1])
     actuation = yaml.safe_load((CONFIG_DIR / "actuation.yaml").read_text())
     effort = actuation["motor"]["max_continuous_torque"] * actuation["transmission_ratio"]["joint2"]
     assert _limit_value(page, "tau-limit-joint2-upper", a, b) == pytest.approx(effort, rel=1e-4)
@@ -121,10 +94,10 @@ def test_a_long_series_is_drawn_at_every_kth_sample_and_its_last():
     t = np.arange(5000) / 1000.0
     values = np.sin(7 * t)
     svg = plots.figure_svg([plots.Panel("p", "y", [plots.Curve(t, values, "y", "long", "#000000")])])
-    points = _points(svg, "long")
+    points = svg_points(svg, "long")
     kept = np.append(np.arange(0, 5000, 3), 4999)
     assert points.shape == (len(kept), 2)
-    assert _affine(values[kept], points[:, 1])[2] < AFFINE_TOLERANCE
+    assert affine(values[kept], points[:, 1])[2] < AFFINE_TOLERANCE
 
 
 def test_plot_refusals_write_nothing(tmp_path, cli, monkeypatch):

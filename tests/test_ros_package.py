@@ -102,7 +102,7 @@ def test_launch_file_shows_each_committed_robot(monkeypatch):
     assert rviz.package == "rviz2"
     with pytest.raises(RuntimeError, match="convention:=driver: no phantom_1_5_driver.urdf"):
         opaque.function({"robot": "phantom_1_5", "convention": "driver", "gui": "true", "node": "false"})
-    # phantom_pin's node beside robot_state_publisher: the command line the README gives, which
+    # phantom_pin's node beside robot_state_publisher: the command line docs/ros2.md gives, which
     # parses (the model is the robot's)
     assert node.default_value == "false"
     publisher, ours, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false",

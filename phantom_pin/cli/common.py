@@ -296,15 +296,16 @@ def add_plot_option(parser: argparse.ArgumentParser, what: str) -> None:
                              "needs the plots extra: pip install 'phantom_pin[plots]'); --force overwrites it")
 
 
-def plot_target(args: argparse.Namespace) -> Path | None:
-    """The --plot file checked before any work (an .html name, not --output's, writable as
-    output() checks, matplotlib installed), or None without --plot."""
-    if args.plot is None:
+def plot_target(args: argparse.Namespace, option: str = "--plot") -> Path | None:
+    """The page named by ``option`` (--plot, identify's --report) checked before any work (an
+    .html name, not --output's, writable as output() checks, matplotlib installed), or None
+    without it."""
+    if getattr(args, option.lstrip("-")) is None:
         return None
-    target = output(args, "--plot")
+    target = output(args, option)
     if target.suffix.lower() not in (".html", ".htm"):
-        raise PhantomPinError(f"{target}: the plot is an HTML page; name a .html file", argument="--plot")
+        raise PhantomPinError(f"{target}: the plot is an HTML page; name a .html file", argument=option)
     if args.output is not None and Path(args.output).resolve() == target.resolve():
-        raise PhantomPinError(f"{target} is the --output file; give two files", argument="--plot")
+        raise PhantomPinError(f"{target} is the --output file; give two files", argument=option)
     plots.require_matplotlib()
     return target

@@ -26,6 +26,7 @@ from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import bags, excitation, filtering, io, prior, static, timing
+from phantom_pin.identification import page as identification_page
 from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.result import RefusedError, identify, refusal, write_yaml
 from phantom_pin.identification.structures import General
@@ -71,7 +72,7 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
 TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
                    ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", "held"),
                    ("min_speed", "--min-speed", filtering.MIN_SPEED), ("cutoff", "--cutoff", 20.0),
-                   ("accept", "--accept", False))
+                   ("accept", "--accept", False), ("report", "--report", None))
 
 
 def _static_command(args: argparse.Namespace, phantom: Phantom, recording: bags.Recording | None,
@@ -194,6 +195,12 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--static", action="store_true",
                           help="gravity from rest: the log's or bag's stretches held still (0.5 s or more), or a "
                                "CSV of postures (theta1..3 rad, tau1..3 N m, no t column); the prior holds the rest")
+    identify.add_argument("--report", type=Path, metavar="FILE.html", action=Once,
+                          help="also write one self-contained HTML page of the fit (matplotlib's SVG, no script; "
+                               "needs the plots extra): measured and predicted torques over time, the held-out "
+                               "check, the torque left to friction and the residual against the rate, each "
+                               "parameter with its uncertainty, the timing and gain findings, the warnings; "
+                               "written with the overlay or not at all; --force overwrites it")
     identify.add_argument("--convention", choices=CONVENTIONS, default="report",
                           help="the log's theta and tau columns: the report's theta (rad) and N m (default), "
                                "or OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad) and joint torques (mN m)")
@@ -290,6 +297,7 @@ def identify_command(args: argparse.Namespace) -> int:
     _refuse(args.output, args.force)
     _writable(args.output)
     _suffix(args.output, (".yaml", ".yml"), "a YAML overlay")
+    report = plot_target(args, "--report")
     recording = _recording(args)
     given = overrides(args)
     made = description(args, given)
@@ -325,7 +333,12 @@ def identify_command(args: argparse.Namespace) -> int:
         print(line)
     for warning in result.warnings():
         warn(warning)              # on stderr, as every command's (and in the overlay's header)
-    result.write(args.output, force=True)     # --output checked above, before any work
+    page = None if report is None else identification_page.report_page(result, phantom.config.name)
+    # --output and --report checked above, before any work; both written, or neither
+    write_texts([(args.output, result.text(), "--output")] + ([] if page is None or report is None else
+                                                              [(report, page, "--report")]))
+    if report is not None:
+        print(f"wrote {report}")
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
     print(f"wrote {args.output} (phantom-pin {chosen}urdf --params {args.output} -o my_phantom.urdf)")

@@ -26,7 +26,7 @@ from phantom_pin.exceptions import InvalidInputError, LogError
 from phantom_pin.identification import checks
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.filtering import MIN_CYCLES, MIN_SPEED, Samples, filtered
-from phantom_pin.identification.fit import Fit
+from phantom_pin.identification.fit import Curves, Fit
 from phantom_pin.identification.io import Log
 from phantom_pin.identification.least_squares import fit as least_squares
 from phantom_pin.identification.least_squares import inverse_information, marginal, rms, solve_gains
@@ -136,7 +136,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
                                ready.beta0, information, priors.typical(model.matrix, model.scale),
                                model.base_names, spread),
               delay=timed.delay, delay_estimated=delay is None, timing=timing, timing_residual=timed.residuals,
-              ratios=phantom.config.actuation.ratios)
+              ratios=phantom.config.actuation.ratios,
+              curves=Curves(log.t[samples.index], samples.dtheta, samples.tau, phi @ written + ready.tau0,
+                            samples.friction @ x[-6:], moving))
     problems = checks.problems(fit, model, phi, (timed.samples.tau - ready.tau0) * moving, log, phantom)
     stage(1.0)
     return dataclasses.replace(fit, problems=tuple(problems))

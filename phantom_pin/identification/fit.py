@@ -10,6 +10,23 @@ import numpy as np
 from phantom_pin.identification.prediction import Prediction
 
 
+@dataclasses.dataclass(frozen=True)
+class Curves:
+    """The fitted samples as identify --report draws them: ``t`` (N,) s, the log's times of the
+    kept samples; ``dtheta`` (N, 3) rad/s, filtered; ``measured`` (N, 3) N m, the filtered torques
+    at the fitted timing and delay, in joint 1's torque scale (the gains applied); ``predicted``
+    (N, 3) N m, the written model's (its base regressor times the written base parameters, the
+    known parts added); ``friction`` (N, 3) N m, the written friction's share of ``predicted``;
+    ``moving`` (N, 3) bool, the equations fitted."""
+
+    t: np.ndarray
+    dtheta: np.ndarray
+    measured: np.ndarray
+    predicted: np.ndarray
+    friction: np.ndarray
+    moving: np.ndarray
+
+
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class Fit:
     """Result of ``estimate``.
@@ -36,7 +53,7 @@ class Fit:
     ``timing`` the torque timing fitted (timing.TIMINGS); ``timing_residual``: each timing's
     weighted residual (the sum over the joints of the residual's mean square over the
     torque's, at zero delay when it is estimated, else at the given one), the smaller fitting
-    the log better."""
+    the log better. ``curves``: the samples fitted, measured and predicted (Curves)."""
 
     structure: str
     names: tuple[str, ...]
@@ -65,6 +82,7 @@ class Fit:
     timing: str = "held"
     timing_residual: dict[str, float] = dataclasses.field(default_factory=dict)
     ratios: tuple[float, float, float] | None = None
+    curves: Curves | None = None
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:

@@ -75,8 +75,12 @@ class Identification:
                 + [f"(written with --accept) {problem}" for problem in fit.problems])
 
     def write(self, path: Path | str, force: bool = False) -> None:
-        """Write the overlay (dotted --params keys, SI units) with the fit in comments to ``path``
-        (YAML); an existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
+        """Write the overlay (text()) to ``path`` (YAML); an existing file only with ``force``
+        (InvalidInputError naming ``path`` otherwise)."""
+        write_yaml(path, [], {}, force=force, text=self.text())
+
+    def text(self) -> str:
+        """The overlay: dotted --params keys (SI units) with the fit in comments, as YAML text."""
         fit = self.fit
         lines = [f"# Identified by phantom-pin identify from {self.source} ({fit.structure} structure): a --params",
                  "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
@@ -97,17 +101,23 @@ class Identification:
         lines += ["# What the log does not excite comes from the model's values (the prior, within its stated "
                   f"{100 * fit.prediction.spread:.0f} % spread)." if np.isfinite(fit.prediction.spread) else
                   "# Directions the torques do not determine are kept near the model's values (the prior)."]
-        write_yaml(path, [line[2:] for line in lines], self.keys, force=force)
+        return yaml_text([line[2:] for line in lines], self.keys)
 
 
-def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], force: bool = False) -> None:
-    """An overlay file at ``path``: the ``comments`` (one ``# `` line each), then the ``keys`` as
-    YAML; an existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
+def yaml_text(comments: list[str], keys: dict[str, object]) -> str:
+    """An overlay's text: the ``comments`` (one ``# `` line each), then the ``keys`` as YAML."""
+    lines = [f"# {line}" for line in comments] + [f"{key}: {value!r}" for key, value in keys.items()]
+    return "\n".join(lines) + "\n"
+
+
+def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], force: bool = False,
+               text: str | None = None) -> None:
+    """An overlay file at ``path``: yaml_text(``comments``, ``keys``), or ``text`` if given; an
+    existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
     path = Path(path)
     if path.exists() and not force:
         raise InvalidInputError(f"{path} exists; force=True overwrites it", argument="path")
-    lines = [f"# {line}" for line in comments] + [f"{key}: {value!r}" for key, value in keys.items()]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    path.write_text(yaml_text(comments, keys) if text is None else text, encoding="utf-8")
 
 
 def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str = "general",

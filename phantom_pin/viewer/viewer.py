@@ -30,8 +30,10 @@ from phantom_pin.viewer.server import MeshcatServer
 #: Camera position (m, base_link) from which the whole workspace is in view. meshcat
 #: 0.3's orbit controls always look at the world origin, here the shoulder.
 CAMERA_POSITION = np.array([0.42, 0.36, 0.22])
-#: Default arrow length per newton of tip force (m/N), and the arrow's radius (m).
-FORCE_SCALE, _ARROW_RADIUS = 0.03, 0.0025
+#: Default arrow length per newton of tip force (m/N).
+FORCE_SCALE = 0.03
+#: The force arrow's radius (m).
+_ARROW_RADIUS = 0.0025
 #: meshcat paths: the robot's root node, and the force arrow under it.
 _ROOT = "phantom"
 _FORCE_PATH = f"{_ROOT}/force"
