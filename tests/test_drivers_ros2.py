@@ -290,8 +290,9 @@ def _floats_and_lifts(name: str, watcher: Watcher, drift: float) -> None:
 #: The documents that print the one-file relay for the omni_msgs driver (`ros2 --relay`).
 ROOT = Path(__file__).resolve().parents[1]
 #: The documents that print the relay: README.md and the documentation pages with an OmniFeedback block.
-RELAY_DOCUMENTS = tuple(sorted(str(path.relative_to(ROOT))
-                               for path in [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")] if re.search(r"```python(?:-norun)?\n[^`]*OmniFeedback", path.read_text())))
+RELAY = re.compile(r"```python(?:-norun)?\n[^`]*OmniFeedback")
+DOCUMENTS = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
+RELAY_DOCUMENTS = tuple(sorted(str(path.relative_to(ROOT)) for path in DOCUMENTS if RELAY.search(path.read_text())))
 #: omni_msgs.msg in place of the driver's workspace: OmniFeedback as geometry_msgs/Wrench.
 STAND_IN = "from geometry_msgs.msg import Wrench as OmniFeedback\n"
 
