@@ -232,7 +232,7 @@ def test_the_identification_api_checks_its_input(tmp_path):
     data = log(end=3.0)
     path = tmp_path / "log.csv"
     identification.write_log(path, data.t, data.theta, data.tau)
-    with pytest.raises(io.LogError, match="^path: .* exists; pass force=True"):
+    with pytest.raises(io.LogError, match="^path: .* exists; use force=True"):
         identification.write_log(path, data.t, data.theta, data.tau)
     identification.write_log(path, data.t, data.theta, data.tau, force=True)
     with pytest.raises(InvalidInputError, match="^theta: "):

@@ -34,9 +34,9 @@ def solve_ik(model: pin.Model, data: pin.Data, tip: int, p: Kinematics, target: 
     distance = math.hypot(x, y - p.l2, z + p.l1)  # from the shoulder (0, l2, -l1) in s
     if not abs(p.l1 - p.l2) * (1 - 1e-12) <= distance <= (p.l1 + p.l2) * (1 + 1e-12):
         raise UnreachableTargetError(
-            f"position: {np.array2string(target, precision=4)} m is {distance:.4g} m from "
+            f"{np.array2string(target, precision=4)} m is {distance:.4g} m from "
             f"the shoulder, outside the reachable shell [{abs(p.l1 - p.l2):.4f}, "
-            f"{p.l1 + p.l2:.4f}] m")
+            f"{p.l1 + p.l2:.4f}] m", argument="position")
     sign = 1.0 if branch == "report" else -1.0
     for seed in SEEDS[branch]:
         theta = _newton(model, data, tip, (x, y, z), np.array([math.atan2(x, z + p.l1), *seed]))
@@ -46,7 +46,7 @@ def solve_ik(model: pin.Model, data: pin.Data, tip: int, p: Kinematics, target: 
         if theta is not None and sign * math.cos(theta[2] - theta[1]) > -BRANCH_SLACK:
             return wrap_angle(theta)
     raise UnreachableTargetError(
-        f"position: no {branch}-branch solution found for {target} m")
+        f"no {branch}-branch solution found for {target} m", argument="position")
 
 
 def _newton(model: pin.Model, data: pin.Data, tip: int, target: tuple[float, float, float],

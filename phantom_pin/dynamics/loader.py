@@ -69,18 +69,18 @@ def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin
         for name in ("urdf_path", "srdf_path"):
             path = Path(getattr(loader, name))
             if not path.is_file():
-                raise ParameterFileError(f"{name}: {path} is not a file")
+                raise ParameterFileError(f"{path} is not a file", argument=name)
             try:
                 texts.append(path.read_text(encoding="utf-8"))
             except UnicodeDecodeError as error:
-                raise ParameterFileError(f"{name}: {path} is not a text file") from error
+                raise ParameterFileError(f"{path} is not a text file", argument=name) from error
         urdf, srdf = texts
         urdf_name, srdf_name = f"urdf_path: {loader.urdf_path}", f"srdf_path: {loader.srdf_path}"
         check_urdf(urdf, urdf_name)
         config = None  # a URDF file of one's own keeps Pinocchio's g and its rotors
     else:
-        raise InvalidInputError(f"source: expected a PhantomLoader class, a model name, a configuration "
-                                f"folder or a Description, got {source!r}")
+        raise InvalidInputError(f"expected a PhantomLoader class, a model name, a configuration "
+                                f"folder or a Description, got {source!r}", argument="source")
     package_dirs = [str(p) for p in loader.package_dirs]
     try:
         model = build_model(urdf, config)
@@ -88,7 +88,7 @@ def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin
                     for kind in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL)]
     except (RuntimeError, ValueError, AttributeError) as error:  # Pinocchio's, several lines
         label, what = urdf_name.split(": ", 1)
-        raise ParameterFileError(f"{label}: Pinocchio cannot load {what} ({_first_line(error)})") from error
+        raise ParameterFileError(f"Pinocchio cannot load {what} ({_first_line(error)})", argument=label) from error
     robot = pin.RobotWrapper(model, *geometry)
     try:
         pin.loadReferenceConfigurationsFromXML(robot.model, srdf, False)
@@ -98,11 +98,11 @@ def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin
         pin.removeCollisionPairsFromXML(robot.model, robot.collision_model, srdf, False)
     except (RuntimeError, ValueError, AttributeError) as error:
         label, what = srdf_name.split(": ", 1)
-        raise ParameterFileError(f"{label}: Pinocchio cannot read {what} ({_first_line(error)})") from error
+        raise ParameterFileError(f"Pinocchio cannot read {what} ({_first_line(error)})", argument=label) from error
     postures = [entry.key() for entry in robot.model.referenceConfigurations]
     if loader.ref_posture not in postures:
         raise InvalidInputError(
-            f"ref_posture: {loader.ref_posture!r} is not a posture of the SRDF (it has {sorted(postures)})")
+            f"{loader.ref_posture!r} is not a posture of the SRDF (it has {sorted(postures)})", argument="ref_posture")
     robot.q0 = robot.model.referenceConfigurations[loader.ref_posture].copy()
     robot.rebuildData()
     return robot

@@ -198,7 +198,7 @@ class Phantom:
         the shoulder). The result may lie outside the joint limits: see within_limits.
         """
         if branch not in SEEDS:
-            raise InvalidInputError(f"branch: expected 'report' or 'other', got {branch!r}")
+            raise InvalidInputError(f"expected 'report' or 'other', got {branch!r}", argument="branch")
         kinematics = self._kinematics, self._kinematics_data, self._frame_tip, self.config.kinematics
         return self._each(lambda p: solve_ik(*kinematics, p, branch), ("position",), position)
 

@@ -81,16 +81,17 @@ def _check_arguments(**values: float) -> None:
     for name, value in values.items():
         if name in integers:
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < integers[name]:
-                raise InvalidInputError(f"{name}: expected an integer of at least {integers[name]}, got {value!r}")
+                raise InvalidInputError(f"expected an integer of at least {integers[name]}, got {value!r}",
+                                        argument=name)
         elif isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-            raise InvalidInputError(f"{name}: expected a finite number, got {value!r}")
+            raise InvalidInputError(f"expected a finite number, got {value!r}", argument=name)
     if values["period"] <= 0:
-        raise InvalidInputError(f"period: expected a positive number (s), got {values['period']!r}")
+        raise InvalidInputError(f"expected a positive number (s), got {values['period']!r}", argument="period")
     for name in ("margin", "amplitude_weight"):
         if values[name] < 0:
-            raise InvalidInputError(f"{name}: expected a number >= 0, got {values[name]!r}")
+            raise InvalidInputError(f"expected a number >= 0, got {values[name]!r}", argument=name)
     if not 0 < values["torque_share"] <= 1:
-        raise InvalidInputError(f"torque_share: expected a share in (0, 1], got {values['torque_share']!r}")
+        raise InvalidInputError(f"expected a share in (0, 1], got {values['torque_share']!r}", argument="torque_share")
 
 
 def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,
