@@ -13,7 +13,7 @@ Output, every message carrying the input's header stamp:
 
 - ``gravity_torque`` (sensor_msgs/JointState): the joint torques that hold the arm (N m), as
   effort on the input's own joint names: for the drivers' names the torques conjugate to
-  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3), tau the report's
+  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3) (drivers.effort_from_tau), tau the report's
   (Phantom.gravity); for the model's names tau itself. Position and velocity are empty.
 - ``gravity_torque_openhaptics`` (sensor_msgs/JointState): the same torques as
   HD_CURRENT_JOINT_TORQUE takes them (mN m, on OpenHaptics' angles and signs:
@@ -224,7 +224,7 @@ class Bridge:
         empty or one value per name."""
         values, driver = self._values(names, positions, velocity)
         arm = [values[n] for n in (self.driver_names if driver else self.model_arm)]
-        theta = np.array([arm[0], arm[1], arm[1] + arm[2]]) if driver else np.array(arm)
+        theta = drivers.theta_from_driver(*arm) if driver else np.array(arm)
         gimbal = self._gimbal(values)
         state = np.concatenate([theta, gimbal if gimbal is not None else
                                 (self.gimbal.locked_at if self.gimbal else [])])
@@ -237,7 +237,7 @@ class Bridge:
                                     argument="position")
         phantom = self.phantom
         tau = phantom.gravity(theta) if gimbal is None else phantom.gravity(theta, gimbal)
-        effort = np.array([tau[0], tau[1] + tau[2], tau[2]]) if driver else tau
+        effort = drivers.effort_from_tau(tau) if driver else tau
         tip = self.base_from_s @ phantom.forward_kinematics(theta)
         stylus = None if gimbal is None else self.base_from_s @ phantom.stylus_tip_pose(theta, gimbal)
         return Output(tuple(self.driver_names if driver else self.model_arm), effort,

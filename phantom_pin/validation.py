@@ -98,3 +98,13 @@ def output_path(path: str | os.PathLike[str], force: bool, name: str, force_hint
     if output.exists() and not force:
         raise error(f"{output} exists; use {force_hint} to overwrite it", argument=name)
     return output
+
+
+def fixed_rate(t: np.ndarray) -> float:
+    """The rate (Hz) of times ``t`` (s, (N,), N >= 2) sampled at a fixed rate: (N - 1) / (t[-1] - t[0])."""
+    return float((len(t) - 1) / (t[-1] - t[0]))
+
+
+def uneven(step: np.ndarray, tolerance: float) -> bool:
+    """Whether the intervals ``step`` (s) stray from their mean by more than ``tolerance`` of it."""
+    return bool(np.abs(step - step.mean()).max() > tolerance * step.mean())

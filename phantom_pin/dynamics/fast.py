@@ -7,7 +7,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Sequence
-from typing import Any, TypeGuard
+from typing import Any, TypeGuard, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -15,6 +15,7 @@ import pinocchio as pin
 from phantom_pin.dynamics.coupling import Coupling
 
 ONE = (3,)
+T = TypeVar("T")
 #: eigenpy converts boolean arrays, which as_states refuses: the fast paths that check only
 #: shapes send them to the checked path (a builtin dtype is one object)
 BOOL = np.dtype(bool)
@@ -44,6 +45,15 @@ def is_one(value: object) -> TypeGuard[np.ndarray]:
         return a.__class__ is not bool and isfinite(a + b + c)
     except (AttributeError, TypeError, ValueError):
         return False
+
+
+def attempt(function: Callable[..., T], *args: Any) -> T | None:
+    """``function(*args)``, the fast paths' one try: None where eigenpy refuses a dtype
+    (TypeError), which the checked path then converts, or names."""
+    try:
+        return function(*args)
+    except TypeError:
+        return None
 
 
 def rows(function: Callable[..., np.ndarray], *arrays: np.ndarray, before: tuple = (),
@@ -92,11 +102,8 @@ def frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Callab
     frame s; a closure, so that its fast path is as short as forward_kinematics'."""
     def method(self: Any, theta: object) -> np.ndarray:
         model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
-        if is_one(theta):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                return pin.computeFrameJacobian(model, data, theta, tip, reference)
-            except TypeError:
-                pass
+        if is_one(theta) and (out := attempt(pin.computeFrameJacobian, model, data, theta, tip, reference)) is not None:
+            return out  # the fast path
         return self._each(pin.computeFrameJacobian, ("theta",), theta, before=(model, data),
                           after=(tip, reference))
     method.__name__, method.__qualname__, method.__doc__ = name, f"Phantom.{name}", doc

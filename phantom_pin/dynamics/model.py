@@ -15,7 +15,18 @@ from phantom_pin.config import MODELS, Config
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.dynamics.build import rooted_at_frame
-from phantom_pin.dynamics.fast import BOOL, ONE, accelerations, coriolis, finite, frame_jacobian, is_one, isfinite, rows
+from phantom_pin.dynamics.fast import (
+    BOOL,
+    ONE,
+    accelerations,
+    attempt,
+    coriolis,
+    finite,
+    frame_jacobian,
+    is_one,
+    isfinite,
+    rows,
+)
 from phantom_pin.dynamics.fast import solve_spd as solve_spd  # (where it lived before)
 from phantom_pin.dynamics.ik import SEEDS, solve_ik
 from phantom_pin.dynamics.models import models
@@ -178,7 +189,7 @@ class Phantom:
     # -- kinematics ------------------------------------------------------------------
     def forward_kinematics(self, theta: object) -> np.ndarray:
         """Pose g_st of the tool frame t in frame s (eq. 10): shape (..., 4, 4), metres."""
-        if is_one(theta):  # the fast path
+        if is_one(theta):  # the fast path, inline: attempt(self._pose, ...) costs 0.2 us of its 0.9
             try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
                 return pin.updateFramePlacement(self._kinematics, self._kinematics_data, self._frame_tip).homogeneous
@@ -246,12 +257,9 @@ class Phantom:
         ``gimbal`` for a bad argument or a result that is not finite."""
         arm: Any = values  # finite vectors (3,) once is_one says so
         if self.stylus_model is not None and is_one(gimbal) and all(map(is_one, arm)):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                out = one(self._one_six(arm[0], gimbal), *(self._one_six(v, None) for v in arm[1:]))
-                if finite(out):  # rates can overflow
-                    return out
-            except TypeError:
-                pass
+            out = attempt(one, self._one_six(arm[0], gimbal), *(self._one_six(v, None) for v in arm[1:]))
+            if out is not None and finite(out):  # rates can overflow
+                return out
         arrays = self._six(names, gimbal, *values)
         with np.errstate(invalid="ignore", over="ignore"):  # reported by finite_result
             out = rows(one, *(a.reshape(-1, 6) for a in arrays))
@@ -278,22 +286,22 @@ class Phantom:
     def _stylus_frame(self, frame: int, theta: object, gimbal: object, jacobian: bool = False) -> np.ndarray:
         model = self.stylus_model
         if is_one(theta) and is_one(gimbal) and model is not None and not jacobian:  # the fast path
-            try:
-                pin.forwardKinematics(model, self._stylus_data, self._one_six(theta, gimbal))
-                return pin.updateFramePlacement(model, self._stylus_data, frame).homogeneous
-            except TypeError:
-                pass
+            return self._stylus_placement(frame, self._one_six(theta, gimbal))
         (q,) = self._six(("theta",), gimbal, theta)
         model, data = self._stylus()
 
         def one(configuration: np.ndarray) -> np.ndarray:
             if jacobian:  # columns in (theta, g) order
                 return pin.computeFrameJacobian(model, data, configuration, frame, pin.WORLD)[:, self._order]
-            pin.forwardKinematics(model, data, configuration)
-            return pin.updateFramePlacement(model, data, frame).homogeneous
+            return self._stylus_placement(frame, configuration)
 
         out = np.array([one(c) for c in q.reshape(-1, 6)])
         return finite_result(out.reshape(q.shape[:-1] + out.shape[1:]), "theta, gimbal")
+
+    def _stylus_placement(self, frame: int, q: np.ndarray) -> np.ndarray:
+        """The stylus model's ``frame`` at the six-joint q: (4, 4)."""
+        pin.forwardKinematics(self.stylus_model, self._stylus_data, q)
+        return pin.updateFramePlacement(self.stylus_model, self._stylus_data, frame).homogeneous
 
     def stylus_pose(self, theta: object, gimbal: object) -> np.ndarray:
         """Pose of the stylus frame in frame s: (..., 4, 4), metres. Its origin is the gimbal
@@ -329,11 +337,8 @@ class Phantom:
         ``locked_at``, as in gravity."""
         if gimbal is not None:
             return self._held(self._held_mass, ("theta",), gimbal, theta)
-        if is_one(theta):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                return pin.crba(self.model, self.data, theta)
-            except TypeError:
-                pass
+        if is_one(theta) and (out := attempt(pin.crba, self.model, self.data, theta)) is not None:  # the fast path
+            return out
         # the binding of crba returns the full symmetric matrix (DEVELOPERS.md), not data.M
         return self._each(pin.crba, ("theta",), theta, before=(self.model, self.data))
 
@@ -348,12 +353,9 @@ class Phantom:
         if gimbal is not None:
             return self._held(self._held_coriolis, ("theta", "dtheta"), gimbal, theta, dtheta)
         if is_one(theta) and is_one(dtheta):  # the fast path; rates can overflow C
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                out = coriolis(self.coupling, self._tree_data, theta, dtheta)
-                if finite(out):
-                    return out
-            except TypeError:
-                pass
+            out = attempt(coriolis, self.coupling, self._tree_data, theta, dtheta)
+            if out is not None and finite(out):
+                return out
         names = ("theta", "dtheta")
         return self._tree_batch(pin.computeCoriolisMatrix, names, *self._states(names, theta, dtheta),
                                 before=(self.coupling.tree, self._tree_data))
@@ -371,11 +373,8 @@ class Phantom:
         """
         if gimbal is not None:
             return self._held(self._held_gravity, ("theta",), gimbal, theta)
-        if is_one(theta):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                return pin.computeGeneralizedGravity(self.model, self.data, theta)
-            except TypeError:
-                pass
+        if is_one(theta) and (out := attempt(pin.computeGeneralizedGravity, self.model, self.data, theta)) is not None:
+            return out  # the fast path
         (q,) = self._states(("theta",), theta)
         if q.ndim == 1:
             return finite_result(pin.computeGeneralizedGravity(self.model, self.data, q), "theta")
@@ -478,13 +477,11 @@ class Phantom:
         """
         coupling = self.coupling
         if is_one(theta) and is_one(dtheta) and is_one(ddtheta):  # the fast path; rates can overflow
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                both = coupling.project(self._tree_derivatives(
-                    coupling.configuration(theta), coupling.tangent(dtheta), coupling.tangent(ddtheta)))
-                if finite(both):
-                    return both[0], both[1]
-            except TypeError:
-                pass
+            tree = attempt(self._tree_derivatives, coupling.configuration(theta), coupling.tangent(dtheta),
+                           coupling.tangent(ddtheta))
+            both = None if tree is None else coupling.project(tree)
+            if both is not None and finite(both):
+                return both[0], both[1]
         names = ("theta", "dtheta", "ddtheta")
         both = self._tree_batch(self._tree_derivatives, names, *self._states(names, theta, dtheta, ddtheta))
         return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()

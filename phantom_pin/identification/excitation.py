@@ -16,6 +16,7 @@ import numpy as np
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.identification.least_squares import condition_number as condition_number  # (lived here)
 from phantom_pin.identification.structures import General, Report, friction_block
 
 #: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
@@ -58,12 +59,6 @@ def continuous_effort(description: Description) -> np.ndarray:
     its joint, or the configuration's joint_torque_limit without public motor data (the Touch).
     The excitation's torque bound."""
     return np.array(description.config.actuation.effort)
-
-
-def condition_number(phi: np.ndarray) -> float:
-    """Condition number of a stacked base regressor after scaling its columns to unit norm."""
-    norms = np.linalg.norm(phi, axis=0)
-    return float(np.linalg.cond(phi / np.where(norms > 0, norms, 1.0)))
 
 
 @dataclasses.dataclass(frozen=True)

@@ -18,7 +18,7 @@ import numpy as np
 
 from phantom_pin import drivers
 from phantom_pin.exceptions import LogError
-from phantom_pin.validation import as_states, output_path
+from phantom_pin.validation import as_states, fixed_rate, output_path, uneven
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
 TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3",
@@ -55,7 +55,8 @@ class Log:
 
     @property
     def rate(self) -> float:
-        return float((len(self.t) - 1) / (self.t[-1] - self.t[0]))
+        """The log's rate (Hz), (N - 1) / its duration."""
+        return fixed_rate(self.t)
 
 
 def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> None:
@@ -76,14 +77,8 @@ def write_log(path: Path | str, t: object, theta: object, tau: object, force: bo
         raise LogError(f"expected numbers (s), got {t!r:.60}", argument="t") from None
     angles, _ = as_states(theta, "theta")
     torques, _ = as_states(tau, "tau")
-    if times.ndim != 1 or angles.shape != (len(times), 3) or torques.shape != (len(times), 3):
-        raise LogError(f"t, theta, tau: expected shapes (N,), (N, 3), (N, 3), got {times.shape}, "
-                       f"{angles.shape}, {torques.shape}")
-    if not np.isfinite(times).all():
-        raise LogError("contains NaN or inf", argument="t")
-    if not (np.diff(times) > 0).all():
-        raise LogError("the times must increase strictly", argument="t")
-    write_csv(path, LOG_COLUMNS, np.column_stack([times, angles, torques]))
+    log = Log(times, angles, torques)  # the log's one validation: shapes, finite, increasing (naming log)
+    write_csv(path, LOG_COLUMNS, np.column_stack([log.t, log.theta, log.tau]))
 
 
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, str]], dict[str, np.ndarray]]:
@@ -146,7 +141,7 @@ def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
     _, column = _read_table(path, TRAJECTORY_COLUMNS)
     t = column["t"]
     step = np.diff(t)
-    if len(t) < 2 or not (step > 0).all() or np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
+    if len(t) < 2 or not (step > 0).all() or uneven(step, RATE_TOLERANCE):
         raise LogError(f"{path}: the times must increase at a fixed rate")
     theta, dtheta, ddtheta, tau = (np.column_stack([column[f"{name}{j}"] for j in (1, 2, 3)])
                                    for name in ("theta", "dtheta", "ddtheta", "tau"))
@@ -207,7 +202,7 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
                        + (f" (line {lines[2 + int(np.argmin(step > 0))][0]})" if len(t) >= 2 else ""))
     if t[-1] - t[0] < MIN_DURATION:
         raise LogError(f"{path}: too short ({t[-1] - t[0]:.3g} s; at least {MIN_DURATION} s)")
-    if np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
+    if uneven(step, RATE_TOLERANCE):
         raise LogError(f"{path}: not at a fixed rate (intervals {step.min():.4g}..{step.max():.4g} s)")
     theta = np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)])
     tau = np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)])

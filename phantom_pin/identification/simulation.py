@@ -22,6 +22,7 @@ from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import Encoders, simulate
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log
+from phantom_pin.validation import fixed_rate
 
 
 def _per_joint(value: object, name: str, unit: str, least: float, strict: bool) -> np.ndarray:
@@ -78,7 +79,7 @@ def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, 
     follow = tracking(t, theta, dtheta, tau)
     rng = np.random.default_rng(seed)
     commanded = np.zeros((len(t), 3))
-    rate = (len(t) - 1) / (t[-1] - t[0])
+    rate = fixed_rate(t)
     # what the controller sees: simulate's own encoder model (the true state stays the plant's,
     # for the disturbance)
     sense = Encoders(device, theta[0], dtheta[0], rate) if quantization else None
