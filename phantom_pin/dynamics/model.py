@@ -63,7 +63,8 @@ class Phantom:
     Attributes: ``description`` (the Description it was built from), ``config`` (its
     typed configuration), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's
     rotor inertias times ratio^2; a gimbal locked), ``data``, ``coupling`` (the mimic-free
-    tree model and the coupling matrix read from the URDF's mimic tags), ``gimbal_joints``
+    tree model and the coupling matrix read from the URDF's mimic tags), ``full_coupling`` (the
+    same with every joint of the URDF free: ``coupling`` itself without a gimbal), ``gimbal_joints``
     (the gimbal's joint names, () without one), ``stylus_model`` (the six-joint mimic model
     rooted at frame s, or None), ``threads`` (OpenMP threads of batched inverse dynamics).
     """
