@@ -241,6 +241,21 @@ def openhaptics_transform_from_pose(pose: object, origin: object = None) -> np.n
     return finite_result(np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,)), "pose")
 
 
+def theta_from_driver(waist: float | np.ndarray, shoulder: float | np.ndarray,
+                      elbow: float | np.ndarray) -> np.ndarray:
+    """The report's theta (rad) of the Touch-era drivers' coordinates (rad, floats or arrays of
+    one shape; the elbow relative to the shoulder): (waist, shoulder, shoulder + elbow), unchecked
+    (theta_from_joint_state checks and names its input)."""
+    return np.stack([waist, shoulder, shoulder + elbow], axis=-1)
+
+
+def effort_from_tau(tau: np.ndarray) -> np.ndarray:
+    """The torques (N m) conjugate to the drivers' coordinates (waist, shoulder, elbow) of the
+    report's tau (N m, (3,) or (..., 3)): (tau1, tau2 + tau3, tau3), the effort of their
+    joint_states."""
+    return np.stack([tau[..., 0], tau[..., 1] + tau[..., 2], tau[..., 2]], axis=-1)
+
+
 def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:
     """The report's theta (rad) of a driver's joint_states: ``names`` (sequence of str, as in
     sensor_msgs/JointState, each joint of JOINT_STATE_NAMES with ``prefix`` exactly once;
@@ -252,7 +267,7 @@ def theta_from_joint_state(names: object, position: object, prefix: str = "") ->
     values, _ = as_states(position, "position", width=len(given))
     waist, shoulder, elbow = (values[..., given.index(name)] for name in wanted)
     with np.errstate(over="ignore"):  # reported by finite_result, naming position
-        return finite_result(np.stack([waist, shoulder, shoulder + elbow], axis=-1), "position")
+        return finite_result(theta_from_driver(waist, shoulder, elbow), "position")
 
 
 def joint_state_from_theta(theta: object, prefix: str = "") -> tuple[list[str], np.ndarray]:

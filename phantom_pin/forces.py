@@ -31,7 +31,6 @@ import pinocchio as pin
 
 from phantom_pin.config.types import Friction
 from phantom_pin.device.device import Device
-from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.profiles import Profile
@@ -74,7 +73,7 @@ class Frames:
     def __init__(self, phantom: Phantom) -> None:
         self.prefix = prefix = phantom.description.prefix
         self.gimbal = phantom.config.gimbal
-        self.full = Coupling(phantom.description.urdf)  # every joint of the URDF, the gimbal free
+        self.full = phantom.full_coupling  # every joint of the URDF, the gimbal free (the Phantom's)
         self._data = self.full.tree.createData()
         self.names = tuple(f.name for f in self.full.tree.frames if f.name != "universe")
         data = phantom.model.createData()

@@ -13,7 +13,7 @@ Output, every message carrying the input's header stamp:
 
 - ``gravity_torque`` (sensor_msgs/JointState): the joint torques that hold the arm (N m), as
   effort on the input's own joint names: for the drivers' names the torques conjugate to
-  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3), tau the report's
+  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3) (drivers.effort_from_tau), tau the report's
   (Phantom.gravity); for the model's names tau itself. Position and velocity are empty.
 - ``gravity_torque_openhaptics`` (sensor_msgs/JointState): the same torques as
   HD_CURRENT_JOINT_TORQUE takes them (mN m, on OpenHaptics' angles and signs:
@@ -224,7 +224,7 @@ class Bridge:
         empty or one value per name."""
         values, driver = self._values(names, positions, velocity)
         arm = [values[n] for n in (self.driver_names if driver else self.model_arm)]
-        theta = np.array([arm[0], arm[1], arm[1] + arm[2]]) if driver else np.array(arm)
+        theta = drivers.theta_from_driver(*arm) if driver else np.array(arm)
         gimbal = self._gimbal(values)
         state = np.concatenate([theta, gimbal if gimbal is not None else
                                 (self.gimbal.locked_at if self.gimbal else [])])
@@ -237,7 +237,7 @@ class Bridge:
                                     argument="position")
         phantom = self.phantom
         tau = phantom.gravity(theta) if gimbal is None else phantom.gravity(theta, gimbal)
-        effort = np.array([tau[0], tau[1] + tau[2], tau[2]]) if driver else tau
+        effort = drivers.effort_from_tau(tau) if driver else tau
         tip = self.base_from_s @ phantom.forward_kinematics(theta)
         stylus = None if gimbal is None else self.base_from_s @ phantom.stylus_tip_pose(theta, gimbal)
         return Output(tuple(self.driver_names if driver else self.model_arm), effort,
@@ -300,12 +300,7 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
 
     bridge = Bridge(phantom)
     prefix = bridge.prefix
-    names = {**TOPICS, **(topics or {})}
-    if driver is not None and "joint_states" not in (topics or {}):
-        names["joint_states"] = driver.profile.joint_states.topic
-    unknown = sorted(set(names) - set(TOPICS))
-    if unknown:
-        raise InvalidInputError(f"unknown topic roles {unknown} (known: {', '.join(TOPICS)})", argument="topics")
+    names = _topic_names(topics, driver)
     model_names = [*bridge.model_arm, *(bridge.model_gimbal if bridge.gimbal is not None else ())]
     force_type: Any = None if driver is None else message_type(driver.profile.force.type)
 
@@ -330,38 +325,32 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
             self.warned: set[str] = set()
 
         def on_wrench(self, message) -> None:
-            force, torque = message.wrench.force, message.wrench.torque
-            try:
-                self.user = driver.wrench(  # type: ignore[union-attr]  # only with a driver
-                    message.header.frame_id, (force.x, force.y, force.z))
-            except InvalidInputError as error:
-                self.get_logger().warning(f"dropped a wrench message: {error}", throttle_duration_sec=1.0)
-                return
-            if (torque.x or torque.y or torque.z) and "torque" not in self.warned:
-                self.warned.add("torque")
-                self.get_logger().warning("wrench: its torque part is ignored (the arm has three motors: a force at "
-                                          "the gimbal centre only)")
+            _on_wrench(self, driver, message)  # type: ignore[arg-type]  # only with a driver
 
         def on_joint_states(self, message) -> None:
             stamp = message.header.stamp
             try:
-                if driver is None:
-                    out = bridge(message.name, message.position, message.velocity)
-                else:
-                    theta, gimbal = driver.state(message.name, message.position, message.velocity)
-                    self.send_force(theta, gimbal, stamp)
-                    now = time.monotonic()
-                    if now < self.next_outputs:  # the servo path first: the rest at OUTPUTS_RATE,
-                        return                   # and only while someone listens
-                    self.next_outputs = now + 1.0 / OUTPUTS_RATE
-                    if not any(p.get_subscription_count() for p in self.outputs.values()):
-                        return
-                    out = bridge(model_names, [*theta, *(gimbal if gimbal is not None else ())])
+                out = bridge(message.name, message.position, message.velocity) if driver is None else \
+                    self.serve(driver.state(message.name, message.position, message.velocity), stamp)
             except InvalidInputError as error:
                 self.dropped += 1
                 self.get_logger().warning(f"dropped a joint_states message: {error}", throttle_duration_sec=1.0)
                 return
-            self.publish_outputs(out, stamp, message.header.frame_id)
+            if out is not None:
+                self.publish_outputs(out, stamp, message.header.frame_id)
+
+        def serve(self, state: tuple[np.ndarray, np.ndarray | None], stamp) -> Output | None:
+            """The driver's path: the force command first; the outputs at OUTPUTS_RATE, and only
+            while someone listens (else None)."""
+            theta, gimbal = state
+            self.send_force(theta, gimbal, stamp)
+            now = time.monotonic()
+            if now < self.next_outputs:
+                return None
+            self.next_outputs = now + 1.0 / OUTPUTS_RATE
+            if not any(p.get_subscription_count() for p in self.outputs.values()):
+                return None
+            return bridge(model_names, [*theta, *(gimbal if gimbal is not None else ())])
 
         def send_force(self, theta: np.ndarray, gimbal: np.ndarray | None, stamp) -> None:
             _send_force(self, driver, force_type, theta, gimbal, stamp)  # type: ignore[arg-type]
@@ -370,6 +359,33 @@ def make_node(phantom: Phantom, topics: Mapping[str, str] | None = None, name: s
             _publish_outputs(self.outputs, out, stamp, frame_id, prefix)
 
     return GravityNode()
+
+
+def _topic_names(topics: Mapping[str, str] | None, driver: DriverBridge | None) -> dict[str, str]:
+    """The topic of each role (TOPICS renamed by ``topics``; a driver's joint states by its
+    profile unless renamed); InvalidInputError naming ``topics`` for an unknown role."""
+    names = {**TOPICS, **(topics or {})}
+    if driver is not None and "joint_states" not in (topics or {}):
+        names["joint_states"] = driver.profile.joint_states.topic
+    unknown = sorted(set(names) - set(TOPICS))
+    if unknown:
+        raise InvalidInputError(f"unknown topic roles {unknown} (known: {', '.join(TOPICS)})", argument="topics")
+    return names
+
+
+def _on_wrench(node, driver: DriverBridge, message) -> None:
+    """Keep a user's WrenchStamped (checked) as the node's ``user`` force; a throttled warning
+    where it is dropped, one warning ever that its torque part is ignored."""
+    force, torque = message.wrench.force, message.wrench.torque
+    try:
+        node.user = driver.wrench(message.header.frame_id, (force.x, force.y, force.z))
+    except InvalidInputError as error:
+        node.get_logger().warning(f"dropped a wrench message: {error}", throttle_duration_sec=1.0)
+        return
+    if (torque.x or torque.y or torque.z) and "torque" not in node.warned:
+        node.warned.add("torque")
+        node.get_logger().warning("wrench: its torque part is ignored (the arm has three motors: a force at "
+                                  "the gimbal centre only)")
 
 
 def _send_force(node, driver: DriverBridge, force_type: type, theta: np.ndarray, gimbal: np.ndarray | None,

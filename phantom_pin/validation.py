@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 
 
 def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, bool]:
@@ -81,15 +81,30 @@ def wrap_angle(angle: np.ndarray) -> np.ndarray:
     return np.where(outside, np.pi - (np.pi - angle) % (2 * np.pi), angle)
 
 
-def output_path(path: str | os.PathLike[str], force: bool, name: str, force_hint: str = "force=True") -> Path:
-    """``path`` as the Path of a file to write: raise InvalidInputError naming ``name``
-    if it is a folder, if its folder does not exist, or if it exists and not ``force``
-    (``force_hint`` says how to ask for overwriting)."""
+def output_path(path: str | os.PathLike[str], force: bool, name: str, force_hint: str = "force=True",
+                error: type[PhantomPinError] = InvalidInputError) -> Path:
+    """``path`` as the Path of a file to write, checked before any work: the one output check of
+    every writer (the library's and the command line's). Raise ``error`` naming ``name`` if it is
+    a folder, if its folder does not exist or cannot be written in, or if it exists and not
+    ``force`` (``force_hint`` says how to ask for overwriting). A path that exists and is no
+    regular file (/dev/null, a pipe) is written in place: its folder is not asked."""
     output = Path(path)
     if output.is_dir():
-        raise InvalidInputError(f"{output} is a folder; give a file name", argument=name)
+        raise error(f"{output} is a folder; name a file", argument=name)
     if not output.parent.is_dir():
-        raise InvalidInputError(f"folder {output.parent} does not exist", argument=name)
+        raise error(f"folder {output.parent} does not exist", argument=name)
+    if (output.is_file() or not output.exists()) and not os.access(output.resolve().parent, os.W_OK):
+        raise error(f"cannot write in {output.resolve().parent}", argument=name)
     if output.exists() and not force:
-        raise InvalidInputError(f"{output} exists; use {force_hint} to overwrite it", argument=name)
+        raise error(f"{output} exists; use {force_hint} to overwrite it", argument=name)
     return output
+
+
+def fixed_rate(t: np.ndarray) -> float:
+    """The rate (Hz) of times ``t`` (s, (N,), N >= 2) sampled at a fixed rate: (N - 1) / (t[-1] - t[0])."""
+    return float((len(t) - 1) / (t[-1] - t[0]))
+
+
+def uneven(step: np.ndarray, tolerance: float) -> bool:
+    """Whether the intervals ``step`` (s) stray from their mean by more than ``tolerance`` of it."""
+    return bool(np.abs(step - step.mean()).max() > tolerance * step.mean())

@@ -154,7 +154,7 @@ def test_excite_writes_whole_periods_and_consistent_columns(tmp_path, cli):
     (["--duration", "1e300"], "--duration, --rate: 1e+300 s at 1000 Hz is more than 2000000 rows"),
     (["--period", "1e-300"], "--period: 1e-300 s is outside 0.5..600 s"),
     (["--rate", "1"], "--rate: 1 Hz samples the highest harmonic (5 / 5 s) fewer than 20 times per cycle"),
-    (["-o", "/nonexistent-folder/traj.csv"], "--output: cannot write in /nonexistent-folder"),
+    (["-o", "/nonexistent-folder/traj.csv"], "--output: folder /nonexistent-folder does not exist"),
 ])
 def test_excite_checks_its_options_before_any_work(tmp_path, cli, option, message):
     """One line, exit 2, nothing written, within a second: before the optimisation."""
@@ -229,7 +229,7 @@ def test_excite_simulate_identify_without_code(tmp_path, cli):
 
 
 @pytest.mark.parametrize("arguments, message", [
-    (["identify", "LOG", "-o", "OUT/missing/id.yaml"], "--output: cannot write in"),
+    (["identify", "LOG", "-o", "OUT/missing/id.yaml"], "missing does not exist"),
     (["identify", "LOG", "-o", "OUT", "--force"], "is a folder; name a file"),
     (["identify", "LOG", "-o", "OUT/id.yaml", "--cutoff", "1e-9"], "--cutoff: 1e-09 Hz is too low for a"),
     (["identify", "LOG", "-o", "OUT/id.yaml", "--cutoff", "nan"], "--cutoff: expected a finite positive"),
@@ -248,3 +248,15 @@ def test_bad_options_name_themselves_before_any_work(tmp_path, cli, arguments, m
     code, out, err = cli(*args)
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert out == "" and sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+@pytest.mark.parametrize("command", ["excite", "identify LOG"])
+def test_a_folder_one_cannot_write_in_is_refused_before_any_work(tmp_path, cli, monkeypatch, command):
+    """The one output check of every writer (validation.output_path, which the command line's
+    output() calls) asks the folder's permission before any work: --output names the folder.
+    (os.access is stubbed: root may write anywhere.)"""
+    monkeypatch.setattr("phantom_pin.validation.os.access", lambda *_: False)
+    args = [str(tmp_path / "log.csv") if a == "LOG" else a for a in command.split()]
+    code, out, err = cli(*args, "-o", str(tmp_path / "out.yaml" if "identify" in args else tmp_path / "out.csv"))
+    assert code == 2 and f"--output: cannot write in {tmp_path}" in err and out == "", err
+    assert list(tmp_path.iterdir()) == []

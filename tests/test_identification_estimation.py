@@ -232,12 +232,12 @@ def test_the_identification_api_checks_its_input(tmp_path):
     data = log(end=3.0)
     path = tmp_path / "log.csv"
     identification.write_log(path, data.t, data.theta, data.tau)
-    with pytest.raises(io.LogError, match="^path: .* exists; pass force=True"):
+    with pytest.raises(io.LogError, match="^path: .* exists; use force=True"):
         identification.write_log(path, data.t, data.theta, data.tau)
     identification.write_log(path, data.t, data.theta, data.tau, force=True)
     with pytest.raises(InvalidInputError, match="^theta: "):
         identification.write_log(tmp_path / "b.csv", data.t, data.theta[:, :2], data.tau)
-    with pytest.raises(io.LogError, match="^t, theta, tau: expected shapes"):
+    with pytest.raises(io.LogError, match=r"^log: expected t \(N,\), theta \(N, 3\), tau \(N, 3\)"):
         identification.write_log(tmp_path / "c.csv", data.t[:-1], data.theta, data.tau)
     assert not (tmp_path / "b.csv").exists() and not (tmp_path / "c.csv").exists()
     for kwargs, argument in (({"log": "log.csv"}, "log"), ({"phantom": "premium_1_5"}, "phantom"),

@@ -90,10 +90,10 @@ def merge_model_options(args: argparse.Namespace, suffix: str) -> None:
 def source(args: argparse.Namespace) -> str | Path:
     """The model name or the configuration folder the command works on."""
     if args.config is not None and args.model != DEFAULT:
-        raise PhantomPinError("--config: give --model or --config, not both")
+        raise PhantomPinError("give --model or --config, not both", argument="--config")
     if args.config is None and args.model not in models():
-        raise PhantomPinError(f"--model: {args.model!r} is not a model ({', '.join(models())}); "
-                              "use --config for a folder")
+        raise PhantomPinError(f"{args.model!r} is not a model ({', '.join(models())}); "
+                              "use --config for a folder", argument="--model")
     return args.config if args.config is not None else args.model
 
 

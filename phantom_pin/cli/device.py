@@ -34,6 +34,7 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import io
 from phantom_pin.progress import Progress
+from phantom_pin.validation import fixed_rate
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization", "gimbal")} | {
@@ -131,8 +132,8 @@ def _tracking(args: argparse.Namespace) -> _Run:
     if args.convention == "openhaptics":  # a linear map: rates as angles
         theta, dtheta = drivers.theta_from_openhaptics(theta), drivers.theta_from_openhaptics(dtheta)
         tau = drivers.tau_from_openhaptics_torque(tau)
-    rate = (len(t) - 1) / (t[-1] - t[0])
-    return _Run(theta[0].tolist(), dtheta[0].tolist(), float(t[-1] - t[0]), rate, tracking(t, theta, dtheta, tau))
+    return _Run(theta[0].tolist(), dtheta[0].tolist(), float(t[-1] - t[0]), fixed_rate(t),
+                tracking(t, theta, dtheta, tau))
 
 
 def _free(args: argparse.Namespace, robot: Phantom) -> _Run:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +15,7 @@ from phantom_pin.cli.common import (
     check_record,
     csv_text,
     description,
+    output,
     overrides,
     plot_target,
     warn,
@@ -45,20 +45,6 @@ PERIOD_RANGE = (0.5, 600.0)
 def _periods(duration: float, period: float) -> int:
     """Whole periods covering ``duration`` (s), at least one."""
     return max(1, math.ceil(duration / period - 1e-9))
-
-
-def _refuse(path: Path, force: bool) -> None:
-    if path.exists() and not force:
-        raise PhantomPinError(f"--output: {path} exists; use --force to overwrite it")
-
-
-def _writable(path: Path) -> None:
-    """--output names a file in a folder we may write, before any work."""
-    folder = path.resolve().parent
-    if path.is_dir():
-        raise PhantomPinError(f"--output: {path} is a folder; name a file")
-    if not folder.is_dir() or not os.access(folder, os.W_OK):
-        raise PhantomPinError(f"--output: cannot write in {folder}")
 
 
 def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
@@ -132,7 +118,7 @@ def _delay(text: str | None) -> float | None:
     try:
         value = float(text)
     except ValueError:
-        raise PhantomPinError(f"--delay: expected seconds (a number such as 0.001), got {text!r}") from None
+        raise PhantomPinError(f"expected seconds (a number such as 0.001), got {text!r}", argument="--delay") from None
     return timing.delay_argument(value)
 
 
@@ -208,22 +194,24 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
 
 def excite_command(args: argparse.Namespace) -> int:
     """phantom-pin excite, for the configuration of --model or --config (and the overrides)."""
-    _refuse(args.output, args.force)
+    output(args)
     plot = plot_target(args)
     for name in ("duration", "rate", "period"):
         value = getattr(args, name)
         if not (math.isfinite(value) and value > 0):
-            raise PhantomPinError(f"--{name}: expected a finite positive number, got {value!r}")
+            raise PhantomPinError(f"expected a finite positive number, got {value!r}", argument=f"--{name}")
     for name, least in (("harmonics", 2), ("iterations", 1), ("restarts", 1), ("seed", 0)):
         if getattr(args, name) < least:
-            raise PhantomPinError(f"--{name}: expected an integer of at least {least}, got {getattr(args, name)}")
+            raise PhantomPinError(f"expected an integer of at least {least}, got {getattr(args, name)}",
+                                  argument=f"--{name}")
     if not PERIOD_RANGE[0] <= args.period <= PERIOD_RANGE[1]:
-        raise PhantomPinError(f"--period: {args.period:g} s is outside {PERIOD_RANGE[0]:g}..{PERIOD_RANGE[1]:g} s "
-                              "(shorter periods ask more torque than the arm has; longer ones excite nothing)")
+        raise PhantomPinError(f"{args.period:g} s is outside {PERIOD_RANGE[0]:g}..{PERIOD_RANGE[1]:g} s "
+                              "(shorter periods ask more torque than the arm has; longer ones excite nothing)",
+                              argument="--period")
     if args.rate < MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:
-        raise PhantomPinError(f"--rate: {args.rate:g} Hz samples the highest harmonic ({args.harmonics} / "
+        raise PhantomPinError(f"{args.rate:g} Hz samples the highest harmonic ({args.harmonics} / "
                               f"{args.period:g} s) fewer than {MIN_SAMPLES_PER_HARMONIC} times per cycle; use at least "
-                              f"{MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:g} Hz")
+                              f"{MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:g} Hz", argument="--rate")
     rows = args.rate * args.period * math.ceil(min(args.duration, MAX_ROWS * args.period) / args.period) + 1
     if rows > MAX_ROWS:
         raise PhantomPinError(f"--duration, --rate: {args.duration:g} s at {args.rate:g} Hz is more than "
@@ -231,7 +219,6 @@ def excite_command(args: argparse.Namespace) -> int:
                               f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1
-    _writable(args.output)
     _suffix(args.output, (".csv",), "CSV")
     if not math.isclose(periods * args.period, args.duration, rel_tol=1e-9):
         warn(f"--duration {args.duration:g} s rounded up to {periods} whole period(s) of {args.period:g} s: "
@@ -294,8 +281,7 @@ def _plot(args: argparse.Namespace, made: Description, result: excitation.Excita
 
 def identify_command(args: argparse.Namespace) -> int:
     """phantom-pin identify, for the configuration of --model or --config (and the overrides)."""
-    _refuse(args.output, args.force)
-    _writable(args.output)
+    output(args)
     _suffix(args.output, (".yaml", ".yml"), "a YAML overlay")
     report = plot_target(args, "--report")
     recording = _recording(args)
@@ -309,10 +295,10 @@ def identify_command(args: argparse.Namespace) -> int:
         return _static_command(args, phantom, recording, given)
     if args.structure == "report" and phantom.config.report is None:
         how = " with its --params/--set overrides" if given else ""
-        raise PhantomPinError(f"--structure: report needs a model in the report's form; {phantom.config.name}{how} "
-                              "gives its links in full (use --structure general)")
+        raise PhantomPinError(f"report needs a model in the report's form; {phantom.config.name}{how} "
+                              "gives its links in full (use --structure general)", argument="--structure")
     if not (math.isfinite(args.cutoff) and args.cutoff > 0):
-        raise PhantomPinError(f"--cutoff: expected a finite positive frequency (Hz), got {args.cutoff!r}")
+        raise PhantomPinError(f"expected a finite positive frequency (Hz), got {args.cutoff!r}", argument="--cutoff")
     delay = _delay(args.delay)
     if recording is None:
         check_record(args.log, phantom.config.name, args.convention, "LOG")

@@ -16,19 +16,20 @@ write each function as straight-line double arithmetic (literals with 17 signifi
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import textwrap
-import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from phantom_pin.codegen.tree import ARM_JOINTS as ARM_JOINTS  # (where it lived before)
+from phantom_pin.codegen.tree import Joint, read_tree
 from phantom_pin.config import MODELS
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.description.gimbal import locked
-from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
+from phantom_pin.description.urdf import parse
+from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 
 try:
     import sympy as sp
@@ -37,8 +38,6 @@ except ImportError:  # pragma: no cover - the codegen extra
     sp = None
     C99CodePrinter = object
 
-#: The independent joints the header covers: the arm's three (the report's theta1..theta3).
-ARM_JOINTS = ("joint1", "joint2", "joint3")
 #: The URDF links of the report's frame s, of the tip (the gimbal's centre) and of the stylus
 #: frame (a model with a stylus gimbal; Phantom.stylus_pose's).
 FRAME_S, TIP, STYLUS = "report_s", "tip", "stylus"
@@ -61,93 +60,6 @@ def is_identifier(name: object) -> bool:
     """Whether ``name`` is a C identifier (letters, digits, underscores; not a leading digit)."""
     return (isinstance(name, str) and name.isascii() and name.replace("_", "a").isalnum()
             and not name[0].isdigit())
-
-
-# -- the URDF's tree ---------------------------------------------------------------------
-@dataclasses.dataclass(frozen=True)
-class _Joint:
-    name: str
-    parent: str
-    child: str
-    xyz: tuple[float, float, float]
-    rpy: tuple[float, float, float]
-    axis: tuple[float, float, float] | None       # None: fixed
-    coordinate: int | None = None                 # index of theta driving it (None: fixed)
-    multiplier: float = 1.0
-    offset: float = 0.0
-
-
-@dataclasses.dataclass(frozen=True)
-class _Link:
-    mass: float
-    com: tuple[float, float, float]
-    rpy: tuple[float, float, float]
-    inertia: tuple[float, float, float, float, float, float]  # ixx ixy ixz iyy iyz izz
-
-
-def _get(element: ET.Element, path: str, key: str, default: str | None = None) -> str:
-    """The attribute ``key`` of ``element``'s child at ``path`` ("" for the element itself);
-    ``default`` where absent; ParameterFileError if absent without a default."""
-    found = element if not path else element.find(path)
-    value = None if found is None else found.get(key)
-    if value is None:
-        if default is None:
-            raise ParameterFileError(f"URDF {element.tag} {element.get('name')!r}: no {path or element.tag} {key}")
-        return default
-    return value
-
-
-def _floats(text: str) -> tuple[float, float, float]:
-    x, y, z = (float(v) for v in text.split())
-    return x, y, z
-
-
-def _read_urdf(urdf: str, prefix: str, independent: tuple[str, ...] = ARM_JOINTS
-               ) -> tuple[str, list[_Joint], dict[str, _Link]]:
-    """(root link, joints in topological order, links with an inertial) of a URDF text; the
-    joints ``independent`` (without ``prefix``) are the coordinates, in that order."""
-    root = ET.fromstring(urdf)
-    links: dict[str, _Link] = {}
-    for link in root.findall("link"):
-        inertial = link.find("inertial")
-        if inertial is not None:
-            ixx, ixy, ixz, iyy, iyz, izz = (float(_get(inertial, "inertia", k, "0"))
-                                            for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
-            links[_get(link, "", "name")] = _Link(
-                float(_get(inertial, "mass", "value")), _floats(_get(inertial, "origin", "xyz", "0 0 0")),
-                _floats(_get(inertial, "origin", "rpy", "0 0 0")), (ixx, ixy, ixz, iyy, iyz, izz))
-    arm = [prefix + name for name in independent]
-    joints = []
-    for joint in root.findall("joint"):
-        name, kind = _get(joint, "", "name"), _get(joint, "", "type")
-        xyz, rpy = _floats(_get(joint, "origin", "xyz", "0 0 0")), _floats(_get(joint, "origin", "rpy", "0 0 0"))
-        parent, child = _get(joint, "parent", "link"), _get(joint, "child", "link")
-        if kind == "fixed":
-            joints.append(_Joint(name, parent, child, xyz, rpy, None))
-            continue
-        if kind not in ("revolute", "continuous"):
-            raise ParameterFileError(f"joint {name}: codegen covers revolute and fixed joints, not {kind}")
-        x, y, z = _floats(_get(joint, "axis", "xyz", "1 0 0"))
-        norm = math.sqrt(x * x + y * y + z * z)
-        primary = _get(joint, "mimic", "joint", name)
-        multiplier = float(_get(joint, "mimic", "multiplier", "1"))
-        offset = float(_get(joint, "mimic", "offset", "0"))
-        if primary not in arm:
-            raise ParameterFileError(f"joint {name}: codegen covers the joints {', '.join(arm)} "
-                                     f"(and joints that mimic them), not {primary}")
-        joints.append(_Joint(name, parent, child, xyz, rpy, (x / norm, y / norm, z / norm), arm.index(primary),
-                             multiplier, offset))
-    children = {j.child for j in joints}
-    base = next(j.parent for j in joints if j.parent not in children)
-    order: list[_Joint] = []
-    frontier = [base]
-    while frontier:  # breadth first: every joint after its parent link's own joint
-        here = frontier.pop(0)
-        for each in joints:
-            if each.parent == here:
-                order.append(each)
-                frontier.append(each.child)
-    return base, order, links
 
 
 # -- symbolic algebra -----------------------------------------------------------------------
@@ -194,7 +106,7 @@ class _Model:
         gimbal = description.config.gimbal
         urdf = description.urdf if gimbal is None or free else \
             locked(description.urdf, description.prefix, gimbal.locked_at)
-        self.root, self.joints, links = _read_urdf(urdf, description.prefix,
+        self.root, self.joints, links = read_tree(urdf, description.prefix,
                                                    ARM_JOINTS + GIMBAL_JOINTS if free else ARM_JOINTS)
         self.gravity = _num(description.config.gravity)
         self.armature = [_num(a) for a in description.config.actuation.armature]
@@ -208,13 +120,13 @@ class _Model:
         self.placements = {j.name: (_rpy(j.rpy, exact), sp.Matrix([_num(v) for v in j.xyz])) for j in self.joints}
 
     @staticmethod
-    def angle(joint: _Joint, theta: list[Any]) -> Any:
+    def angle(joint: Joint, theta: list[Any]) -> Any:
         """A joint's angle (rad): multiplier * its coordinate + offset (0 for a fixed joint)."""
         if joint.coordinate is None:
             return sp.Integer(0)
         return _num(joint.multiplier) * theta[joint.coordinate] + _num(joint.offset)
 
-    def rotation(self, joint: _Joint, theta: list[Any]) -> Any:
+    def rotation(self, joint: Joint, theta: list[Any]) -> Any:
         """The child frame's orientation in the parent's (parent -> child rotation)."""
         fixed = self.placements[joint.name][0]
         if joint.axis is None:
@@ -495,7 +407,7 @@ def _banner(description: Description, prefix: str, origin: str, overlay: str) ->
     return (f"/* {prefix}: the dynamics and kinematics of the PHANToM model {name}, generated by\n"
             f" * phantom-pin codegen (phantom_pin.codegen) from its configuration. Do not edit: regenerate.\n"
             f" *\n"
-            f" * Model: {name} (URDF robot {ET.fromstring(description.urdf).get('name')})\n"
+            f" * Model: {name} (URDF robot {parse(description.urdf).get('name')})\n"
             f" * Configuration: {origin}\n"
             f" * Overlay: {_wrapped(overlay)}\n"
             f" * Gravity: {description.config.gravity!r} m/s^2 along base_link's -z; armature (kg m^2): "

@@ -70,15 +70,16 @@ def resolve(source: object, argument: str = "model") -> tuple[str, Path, Model |
     A string without a path separator that names no folder must be a model's name;
     InvalidInputError naming ``argument`` otherwise."""
     if not isinstance(source, (str, os.PathLike)):
-        raise InvalidInputError(f"{argument}: expected a model name ({', '.join(MODELS)}) or a "
-                                f"configuration folder, got {source!r}")
+        raise InvalidInputError(f"expected a model name ({', '.join(MODELS)}) or a "
+                                f"configuration folder, got {source!r}", argument=argument)
     if isinstance(source, str) and source in MODELS:
         model = MODELS[source]
         return model.name, model.config, model
     folder = Path(source)
     if not folder.is_dir():
         if isinstance(source, str) and os.sep not in source and "/" not in source:
-            raise InvalidInputError(f"{argument}: {source!r} is neither a model ({', '.join(MODELS)}) nor a folder")
-        raise InvalidInputError(f"{argument}: {folder} is not a folder")
+            raise InvalidInputError(f"{source!r} is neither a model ({', '.join(MODELS)}) nor a folder",
+                                    argument=argument)
+        raise InvalidInputError(f"{folder} is not a folder", argument=argument)
     shipped = next((m for m in MODELS.values() if m.config.resolve() == folder.resolve()), None)
     return (shipped.name if shipped else str(folder)), folder, shipped

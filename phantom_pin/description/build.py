@@ -140,7 +140,7 @@ def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | No
     """(config, model, URDF, SRDF) of a model name or folder: each file read once, xacro run on
     the checked Config (``convention`` passed to the URDF's top-level xacro)."""
     if not isinstance(prefix, str):
-        raise InvalidInputError(f"prefix: expected a string, got {prefix!r}")
+        raise InvalidInputError(f"expected a string, got {prefix!r}", argument="prefix")
     if not PREFIX.fullmatch(prefix):
         raise InvalidInputError(f"expected a ROS name's start (letters, digits, _ and /, not starting with a digit), "
                                 f"got {prefix!r}", argument="prefix")
@@ -199,7 +199,7 @@ def shipped(name: str = configuration.DEFAULT) -> Description:
     """A named model with its committed URDF, SRDF and MJCF files (which
     tests/test_description.py shows equal to describe(name)), read once per process."""
     if name not in configuration.MODELS:
-        raise InvalidInputError(f"model: {name!r} is not a model ({', '.join(configuration.MODELS)})")
+        raise InvalidInputError(f"{name!r} is not a model ({', '.join(configuration.MODELS)})", argument="model")
     model = configuration.MODELS[name]
     config = configuration.read(name)
     urdf = model.urdf.read_text(encoding="utf-8")

@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.config.types import GIMBAL_JOINTS
+from phantom_pin.description.urdf import child_link, parse, read
 from phantom_pin.exceptions import ParameterFileError
 
 if TYPE_CHECKING:
@@ -28,7 +29,7 @@ def locked(urdf_xml: str, prefix: str, angles: Sequence[float]) -> str:
     """``urdf_xml`` with its gimbal joints (``prefix`` + GIMBAL_JOINTS) fixed at ``angles``
     (rad): each becomes a fixed joint whose origin rpy is its own composed with its rotation;
     its axis and limit are dropped. ParameterFileError if a gimbal joint is missing."""
-    root = ET.fromstring(urdf_xml)
+    root = parse(urdf_xml)
     for name, angle in zip(GIMBAL_JOINTS, angles):
         joint = root.find(f"joint[@name='{prefix}{name}']")
         if joint is None:
@@ -56,19 +57,15 @@ def arm_only(description: Description) -> Description:
     config = description.config
     if config.gimbal is None:
         return description
-    root = ET.fromstring(description.urdf)
-    children: dict[str, list[ET.Element]] = {}
-    for joint in root.findall("joint"):
-        parent = joint.find("parent")
-        children.setdefault("" if parent is None else parent.get("link", ""), []).append(joint)
+    tree = read(description.urdf)
+    root, children = tree.root, tree.children
     first = root.find(f"joint[@name='{description.prefix}{GIMBAL_JOINTS[0]}']")
     if first is None:
         raise ParameterFileError(f"URDF: no gimbal joint {description.prefix}{GIMBAL_JOINTS[0]}")
     doomed = [first]
     while doomed:
         joint = doomed.pop()
-        child = joint.find("child")
-        link = "" if child is None else child.get("link", "")
+        link = child_link(joint)
         doomed.extend(children.get(link, []))
         root.remove(joint)
         element = root.find(f"link[@name='{link}']")

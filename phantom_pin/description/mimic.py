@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import xml.etree.ElementTree as ET
 
+from phantom_pin.description.urdf import parse
 from phantom_pin.exceptions import ParameterFileError
 
 
@@ -21,10 +22,12 @@ class Mimic:
 
 def read_mimic_tags(urdf_xml: str) -> dict[str, Mimic]:
     """The <mimic> tags of a URDF document, keyed by the mimicking joint's name."""
-    try:
-        root = ET.fromstring(urdf_xml)
-    except ET.ParseError as error:
-        raise ParameterFileError(f"URDF is not well-formed XML: {error}") from error
+    return mimic_tags(parse(urdf_xml))
+
+
+def mimic_tags(root: ET.Element) -> dict[str, Mimic]:
+    """The <mimic> tags of a parsed URDF (phantom_pin.description.urdf.parse), keyed by the
+    mimicking joint's name."""
     mimics = {}
     for joint in root.findall("joint"):
         tag = joint.find("mimic")

@@ -33,7 +33,10 @@ import numpy as np
 
 from phantom_pin.config import Config, Scene
 from phantom_pin.config.types import GIMBAL_JOINTS
-from phantom_pin.description.mimic import read_mimic_tags
+from phantom_pin.description.mimic import Mimic, mimic_tags
+from phantom_pin.description.urdf import Urdf, child_link, read
+from phantom_pin.description.urdf import attribute as _attr
+from phantom_pin.description.urdf import child as _child
 from phantom_pin.exceptions import ParameterFileError
 
 # (the header names the module as it was when the shipped files were first generated:
@@ -64,23 +67,6 @@ def _quat_from_rpy(rpy: list[float]) -> np.ndarray:
     sr, sp, sy = (math.sin(a) for a in half)
     return np.array([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
                      cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
-
-
-def _child(element: ET.Element, path: str) -> ET.Element:
-    """The sub-element at ``path`` that describe()'s URDF always has; ParameterFileError naming
-    what is missing otherwise (a URDF of one's own)."""
-    found = element.find(path)
-    if found is None:
-        raise ParameterFileError(f"URDF: <{element.tag} name={element.get('name')!r}> has no <{path}>")
-    return found
-
-
-def _attr(element: ET.Element, name: str) -> str:
-    """The attribute ``name`` of ``element``, which describe()'s URDF always gives."""
-    value = element.get(name)
-    if value is None:
-        raise ParameterFileError(f"URDF: <{element.tag} name={element.get('name')!r}> has no {name} attribute")
-    return value
 
 
 def _content(element: ET.Element, path: str) -> str:
@@ -134,7 +120,7 @@ def _inertial(body: ET.Element, link: ET.Element) -> None:
     element.set("fullinertia", _vec([i["ixx"], i["iyy"], i["izz"], i["ixy"], i["ixz"], i["iyz"]]))
 
 
-def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_file: str,  # noqa: C901 (one MJCF, section by section)
+def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_file: str,
                robot_name: str) -> tuple[str, str]:
     """The MJCF texts (robot, scene) of a URDF and SRDF generated from ``config`` with
     ``prefix`` (phantom_pin.description.describe does all three in one place).
@@ -142,34 +128,36 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     The robot MJCF's names equal the URDF's. The scene includes the robot as
     ``robot_file`` and adds a floor, a light, a table and a stand under the turret.
     ``robot_name`` names the generated files in the header (urdf/ROBOT_NAME.urdf).
+    The sections, in the file's order: _defaults (compiler, option, default classes, materials),
+    _Bodies (the link tree), _contact, _tendon_and_equalities, _actuators_and_sensors; _scene.
     """
     device_stops = config.limits.stops
-    stop_ranges = {f"{prefix}joint{j + 1}": (device_stops.lower[j], device_stops.upper[j]) for j in range(3)}
     settings = config.mujoco
-    stops = config.limits.stops.coupled
     # the stops' spring and damper in solref's direct form (-stiffness, -damping), per unit of
     # mjcf.yaml's stop_inertia: MuJoCo's limits are stiff per unit of acceleration, not torque
     stop_soft = {"solreflimit": _vec([-device_stops.stiffness / settings.stop_inertia,
                                       -device_stops.damping / settings.stop_inertia]),
                  "solimplimit": _vec(settings.stop_solimp)}
-    friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
-                            settings.friction_solref_damping_ratio])
-    urdf = ET.fromstring(urdf_xml)
+    tree = read(urdf_xml)
     srdf = ET.fromstring(srdf_xml)
-    mimics = read_mimic_tags(urdf_xml)
-    links = {_attr(link, "name"): link for link in urdf.findall("link")}
-    joints = urdf.findall("joint")
-    children: dict[str, list[ET.Element]] = {}
-    for joint in joints:
-        children.setdefault(_attr(_child(joint, "parent"), "link"), []).append(joint)
-    child_links = {_attr(_child(joint, "child"), "link") for joint in joints}
-    (root_link,) = [name for name in links if name not in child_links]
-    transmissions = {_attr(_child(t, "joint"), "name"): t for t in urdf.findall("transmission")}
+    mimics = mimic_tags(tree.root)
+    mujoco = ET.Element("mujoco", {"model": tree.name})
+    _defaults(mujoco, tree, config)
+    _Bodies(tree, config, prefix, set(mimics), stop_soft).add(ET.SubElement(mujoco, "worldbody"),
+                                                              tree.base).set("childclass", "phantom")
+    _contact(mujoco, srdf)
+    _tendon_and_equalities(mujoco, config, prefix, mimics, stop_soft)
+    _actuators_and_sensors(mujoco, tree, config, prefix)
+    return (_text(mujoco, robot_name),
+            _text(_scene(settings.scene, tree.links[f"{prefix}turret_link"], robot_file, tree.name), robot_name))
 
-    timestep = settings.timestep
-    mujoco = ET.Element("mujoco", {"model": _attr(urdf, "name")})
+
+def _defaults(mujoco: ET.Element, tree: Urdf, config: Config) -> None:
+    """The compiler, the option (timestep, integrator, gravity unless MuJoCo's), the default
+    classes (phantom: the joints' axis; visual, collision, frame) and the URDF's materials."""
+    settings = config.mujoco
     ET.SubElement(mujoco, "compiler", {"angle": "radian", "autolimits": "true"})
-    option = ET.SubElement(mujoco, "option", {"timestep": _num(timestep), "integrator": settings.integrator})
+    option = ET.SubElement(mujoco, "option", {"timestep": _num(settings.timestep), "integrator": settings.integrator})
     if config.gravity != MUJOCO_GRAVITY:  # MuJoCo's default is the report's
         option.set("gravity", _vec([0, 0, -config.gravity]))
 
@@ -183,46 +171,70 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
                   {"size": "0.004", "rgba": "1 0 0 1", "group": "4"})
 
     asset = ET.SubElement(mujoco, "asset")
-    for material in urdf.findall("material"):
+    for material in tree.root.findall("material"):
         ET.SubElement(asset, "material", {"name": _attr(material, "name"),
                                           "rgba": _attr(_child(material, "color"), "rgba")})
 
-    worldbody = ET.SubElement(mujoco, "worldbody")
 
-    def add_body(parent: ET.Element, name: str, joint: ET.Element | None = None) -> ET.Element:
+class _Bodies:
+    """The URDF's link tree as nested MJCF bodies: ``add(parent, link, joint)`` writes one link with
+    its joint, inertial, geoms, its frames (fixed childless links without inertia) as sites, and
+    its child links' bodies."""
+
+    def __init__(self, tree: Urdf, config: Config, prefix: str, mimics: set[str], stop_soft: dict[str, str]) -> None:
+        settings, stops = config.mujoco, config.limits.stops
+        self.tree, self.mimics, self.stop_soft = tree, mimics, stop_soft
+        self.rotor_inertia = config.actuation.rotor[0]
+        self.stop_ranges = {f"{prefix}joint{j + 1}": (stops.lower[j], stops.upper[j]) for j in range(3)}
+        self.friction_solref = _vec([settings.friction_solref_timesteps * settings.timestep,
+                                     settings.friction_solref_damping_ratio])
+
+    def add(self, parent: ET.Element, name: str, joint: ET.Element | None = None) -> ET.Element:
         """The link ``name`` as a body: its joint, inertial, geoms, frame sites, child bodies."""
         body = ET.SubElement(parent, "body", {"name": name})
         if joint is not None:
-            _place(body, joint.find("origin"))
-            if _attr(joint, "type") == "revolute":
-                ET.SubElement(body, "joint", _joint_attributes(joint, transmissions, config.actuation.rotor[0],
-                                                               _attr(joint, "name") in mimics, friction_solref,
-                                                               stop_ranges.get(_attr(joint, "name")), stop_soft))
-            elif _attr(joint, "type") != "fixed":
-                raise ValueError(f"unsupported URDF joint type {joint.get('type')!r}")
-        link = links[name]
+            self._joint(body, joint)
+        link = self.tree.links[name]
         _inertial(body, link)
         for visual in link.findall("visual"):
             material = visual.find("material")
             _geom(body, visual, "visual", _attr(material, "name") if material is not None else None)
         for collision in link.findall("collision"):
             _geom(body, collision, "collision")
+        children = self.tree.children
         for child_joint in children.get(name, []):
-            child = _attr(_child(child_joint, "child"), "link")
-            if (_attr(child_joint, "type") == "fixed" and links[child].find("inertial") is None
+            child = child_link(child_joint)
+            if (_attr(child_joint, "type") == "fixed" and self.tree.links[child].find("inertial") is None
                     and child not in children):  # a frame: a site on this body
                 _place(ET.SubElement(body, "site", {"name": child, "class": "frame"}),
                        child_joint.find("origin"))
             else:
-                add_body(body, child, child_joint)
+                self.add(body, child, child_joint)
         return body
 
-    add_body(worldbody, root_link).set("childclass", "phantom")
+    def _joint(self, body: ET.Element, joint: ET.Element) -> None:
+        _place(body, joint.find("origin"))
+        name = _attr(joint, "name")
+        if _attr(joint, "type") == "revolute":
+            ET.SubElement(body, "joint", _joint_attributes(joint, self.tree.transmissions, self.rotor_inertia,
+                                                           name in self.mimics, self.friction_solref,
+                                                           self.stop_ranges.get(name), self.stop_soft))
+        elif _attr(joint, "type") != "fixed":
+            raise ValueError(f"unsupported URDF joint type {joint.get('type')!r}")
 
+
+def _contact(mujoco: ET.Element, srdf: ET.Element) -> None:
+    """The SRDF's disabled pairs as excludes (MuJoCo excludes only parent-child)."""
     contact = ET.SubElement(mujoco, "contact")
     for pair in srdf.iter("disable_collisions"):
         ET.SubElement(contact, "exclude", {"body1": _attr(pair, "link1"), "body2": _attr(pair, "link2")})
 
+
+def _tendon_and_equalities(mujoco: ET.Element, config: Config, prefix: str, mimics: dict[str, Mimic],
+                           stop_soft: dict[str, str]) -> None:
+    """The coupled stops as a fixed tendon; the mimic couplings and the gimbal's locks as joint
+    equalities."""
+    settings, stops = config.mujoco, config.limits.stops.coupled
     # the parallelogram's coupled stops, which a URDF cannot express, as a fixed tendon
     # theta2 - theta3 limited to [-(theta3 - theta2)_max, (theta2 - theta3)_max]
     tendon = ET.SubElement(ET.SubElement(mujoco, "tendon"), "fixed", {
@@ -233,7 +245,7 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
     ET.SubElement(tendon, "joint", {"joint": f"{prefix}joint3", "coef": "-1"})
 
     equality = ET.SubElement(mujoco, "equality")
-    solref = _vec([settings.equality_solref_timesteps * timestep, settings.equality_solref_damping_ratio])
+    solref = _vec([settings.equality_solref_timesteps * settings.timestep, settings.equality_solref_damping_ratio])
     for mimic in mimics.values():
         ET.SubElement(equality, "joint", {
             "joint1": mimic.joint, "joint2": mimic.primary,
@@ -247,9 +259,13 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
                 "polycoef": _vec([angle, 0, 0, 0, 0]),
                 "solref": solref, "solimp": _vec(settings.equality_solimp)})
 
+
+def _actuators_and_sensors(mujoco: ET.Element, tree: Urdf, config: Config, prefix: str) -> None:
+    """One motor per transmission (gear = its ratio, the saturation torque at the motor shaft),
+    the transmissions' joint position and velocity sensors and the tip's position."""
     actuator = ET.SubElement(mujoco, "actuator")
     motor = config.actuation.motor
-    for index, (name, transmission) in enumerate(transmissions.items()):
+    for index, (name, transmission) in enumerate(tree.transmissions.items()):
         ratio = float(_content(transmission, "actuator/mechanicalReduction"))
         # the saturation policy's torque at the motor shaft: the data sheet's number itself (not a
         # quotient's rounding), or the joint's without motor data (gear 1)
@@ -260,14 +276,12 @@ def mjcf_texts(urdf_xml: str, srdf_xml: str, config: Config, prefix: str, robot_
                                           "ctrlrange": _vec([-torque, torque]),
                                           "forcerange": _vec([-torque, torque])})
     sensor = ET.SubElement(mujoco, "sensor")
-    for name in transmissions:
+    for name in tree.transmissions:
         ET.SubElement(sensor, "jointpos", {"name": f"{name}_pos", "joint": name})
-    for name in transmissions:
+    for name in tree.transmissions:
         ET.SubElement(sensor, "jointvel", {"name": f"{name}_vel", "joint": name})
     ET.SubElement(sensor, "framepos", {"name": f"{prefix}tip_pos", "objtype": "site",
                                        "objname": f"{prefix}tip"})
-    return (_text(mujoco, robot_name),
-            _text(_scene(settings.scene, links[f"{prefix}turret_link"], robot_file, _attr(urdf, "name")), robot_name))
 
 
 def _joint_attributes(joint: ET.Element, transmissions: dict[str, ET.Element], rotor_inertia: float,

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
+from phantom_pin.description.urdf import parse
 from phantom_pin.exceptions import ParameterFileError
 from phantom_pin.inertial import Inertial, problem, tensor6, vector3
 
@@ -60,11 +61,7 @@ def check_urdf(urdf_xml: str, source: str = "URDF") -> None:
     radius and length, <box> size and <sphere> radius is finite and > 0 (m).
     Links without <inertial> (pure frames) are accepted.
     """
-    try:
-        root = ET.fromstring(urdf_xml)
-    except ET.ParseError as error:
-        raise ParameterFileError(f"{source}: not well-formed XML ({error})") from error
-    for link in root.iter("link"):
+    for link in parse(urdf_xml, source).iter("link"):
         name = link.get("name", "?")
         element = link.find("inertial")
         if element is not None:

@@ -7,6 +7,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from phantom_pin.validation import fixed_rate
+
 #: The PD gains of the tracking controller (N m/rad, N m s/rad).
 KP, KD = 5.0, 0.05
 
@@ -17,7 +19,7 @@ def tracking(t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarr
     (s; theta rad, dtheta rad/s, tau the feed-forward torque N m, each (N, 3)): at time s it
     returns tau[k] + kp (theta[k] - theta_measured) + kd (dtheta[k] - dtheta_measured), k the
     sample at t[0] + s (the last one after the end): simulate's time starts at 0."""
-    rate = (len(t) - 1) / (t[-1] - t[0])
+    rate = fixed_rate(t)
 
     def controller(time: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         k = min(int(round(time * rate)), len(t) - 1)

@@ -69,10 +69,24 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
         raise InvalidInputError(f"expected a callable (share done, 0..1) or None, got {progress!r}",
                                 argument="progress")
     count, substeps = _steps(device, theta, duration, rate, samples, substeps, friction, hard_stops)
-    period = 1.0 / rate
     plant = Plant(device, friction=friction, hard_stops=hard_stops, saturation=saturation,
-                  contact_step=period / substeps)
+                  contact_step=1.0 / rate / substeps)
     sense = Encoders(device, theta, velocity, rate) if quantization else None
+    out_theta, out_dtheta, commanded, applied = _loop(device, plant, controller, sense, theta, velocity, samples,
+                                                       rate, count, progress, saturation)
+    theta_out, applied_out = _rows(out_theta), _rows(applied)
+    return SimulationResult(
+        t=np.arange(samples) / rate, theta=theta_out, dtheta=_rows(out_dtheta), tau=applied_out,
+        tau_commanded=_rows(commanded),
+        current=None if device.config.actuation.motor is None else device.motor_currents(applied_out),
+        tip=device.phantom.forward_kinematics(theta_out)[:, :3, 3], rate=rate, substeps=substeps)
+
+def _loop(device: Device, plant: Plant, controller: Controller | None, sense: Encoders | None, theta: np.ndarray,
+          velocity: np.ndarray, samples: int, rate: float, count: int,
+          progress: Callable[[float], None] | None, saturation: bool | str) -> tuple[array.array, ...]:
+    """simulate's samples: the sensed state to the controller, its torque held over each period
+    (plant.hold); flat buffers (theta, dtheta, commanded, applied), three doubles a sample."""
+    period = 1.0 / rate
     q, v = theta.tolist(), velocity.tolist()          # the state, Python floats
     # the samples, flat buffers of doubles (appending costs less than a NumPy row assignment)
     out_theta, out_dtheta, commanded, applied = (array.array("d") for _ in range(4))
@@ -100,12 +114,8 @@ def simulate(theta0: object, duration: float, controller: Controller | None = No
                               _rows(out_theta)[0]) from None
     if progress is not None:
         progress(1.0)
-    theta_out, applied_out = _rows(out_theta), _rows(applied)
-    return SimulationResult(
-        t=np.arange(samples) / rate, theta=theta_out, dtheta=_rows(out_dtheta), tau=applied_out,
-        tau_commanded=_rows(commanded),
-        current=None if device.config.actuation.motor is None else device.motor_currents(applied_out),
-        tip=device.phantom.forward_kinematics(theta_out)[:, :3, 3], rate=rate, substeps=substeps)
+    return out_theta, out_dtheta, commanded, applied
+
 
 
 def _options(friction: object, hard_stops: object, quantization: object, saturation: object) -> bool | str:

@@ -13,7 +13,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin.config import Config
 from phantom_pin.description.mimic import Mimic, read_mimic_tags
+from phantom_pin.dynamics.build import build_model
 from phantom_pin.exceptions import ParameterFileError
 
 #: Largest tree model (velocity dimension) whose projections use the Kronecker product.
@@ -23,15 +25,15 @@ _KRON_MAX_NV = 16
 class Coupling:
     """The constant coupling between a reduced (mimic) model and its tree model.
 
-    Attributes: ``tree`` and ``reduced`` (pinocchio.Model), ``matrix`` (G, shape
+    Attributes: ``tree`` and ``reduced`` (pinocchio.Model, phantom_pin.dynamics.build's; with
+    ``config``, its gravity), ``matrix`` (G, shape
     (tree.nv, reduced.nv)) and ``mimics`` (the URDF's tags). Tangent vectors and
     matrices are mapped by G; configurations by ``configuration``.
     """
 
-    def __init__(self, urdf_xml: str, root_joint: pin.JointModel | None = None) -> None:
-        args = (urdf_xml,) if root_joint is None else (urdf_xml, root_joint)
-        self.tree = pin.buildModelFromXML(*args, mimic=False)
-        self.reduced = pin.buildModelFromXML(*args, mimic=True)
+    def __init__(self, urdf_xml: str, root_joint: pin.JointModel | None = None, config: Config | None = None) -> None:
+        self.tree = build_model(urdf_xml, config, mimic=False, root_joint=root_joint)
+        self.reduced = build_model(urdf_xml, config, mimic=True, root_joint=root_joint)
         self.mimics = read_mimic_tags(urdf_xml)
         self.matrix = np.zeros((self.tree.nv, self.reduced.nv))
         # (tree idx_q, tree nq, reduced idx_q, multiplier, offset) per mimic joint

@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-import tempfile
 from pathlib import Path
 
-import numpy as np
 import pinocchio as pin
 
 from phantom_pin.config import DEFAULT, MODELS, Config
 from phantom_pin.description.build import Description, description_of
 from phantom_pin.description.physical import check_urdf
+from phantom_pin.dynamics.build import build_model, has_rotors, load_rotor_parameters
+from phantom_pin.dynamics.build import gravity_of as gravity_of  # (where it lived before)
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.paths import DESCRIPTION_DIR
 
@@ -39,21 +39,6 @@ def _first_line(error: Exception) -> str:
     return lines[0] if lines else type(error).__name__
 
 
-def load_rotor_parameters(model: pin.Model, srdf_xml: str) -> None:
-    """Set ``model.armature`` from an SRDF text's rotor_params (rotor inertia x ratio^2,
-    kg m^2), as pinocchio.loadRotorParameters, which reads only files."""
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "rotors.srdf"
-        path.write_text(srdf_xml, encoding="utf-8")
-        pin.loadRotorParameters(model, str(path), False)
-
-
-def gravity_of(config: Config) -> pin.Motion:
-    """Pinocchio's gravity of a configuration: (0, 0, -g) m/s^2 in base_link (a URDF cannot
-    carry it; Pinocchio's default, 9.81, is the report's)."""
-    return pin.Motion(np.array([0.0, 0.0, -config.gravity]), np.zeros(3))
-
-
 def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin.RobotWrapper:
     """The PHANToM as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
     joint1..3 = the report's theta1..3 in rad), with ``visual_model``,
@@ -77,48 +62,47 @@ def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin
         description = description_of(source, "source")
         loader, urdf, srdf = PhantomLoader, description.urdf, description.srdf  # checked by describe()
         urdf_name, srdf_name = "source: the description's URDF", "source: the description's SRDF"
+        config: Config | None = description.config
     elif isinstance(source, type) and issubclass(source, PhantomLoader):
         loader = source
         texts = []
         for name in ("urdf_path", "srdf_path"):
             path = Path(getattr(loader, name))
             if not path.is_file():
-                raise ParameterFileError(f"{name}: {path} is not a file")
+                raise ParameterFileError(f"{path} is not a file", argument=name)
             try:
                 texts.append(path.read_text(encoding="utf-8"))
             except UnicodeDecodeError as error:
-                raise ParameterFileError(f"{name}: {path} is not a text file") from error
+                raise ParameterFileError(f"{path} is not a text file", argument=name) from error
         urdf, srdf = texts
         urdf_name, srdf_name = f"urdf_path: {loader.urdf_path}", f"srdf_path: {loader.srdf_path}"
         check_urdf(urdf, urdf_name)
+        config = None  # a URDF file of one's own keeps Pinocchio's g and its rotors
     else:
-        raise InvalidInputError(f"source: expected a PhantomLoader class, a model name, a configuration "
-                                f"folder or a Description, got {source!r}")
+        raise InvalidInputError(f"expected a PhantomLoader class, a model name, a configuration "
+                                f"folder or a Description, got {source!r}", argument="source")
     package_dirs = [str(p) for p in loader.package_dirs]
     try:
-        model = pin.buildModelFromXML(urdf, mimic=True)
+        model = build_model(urdf, config)
         geometry = [pin.buildGeomFromUrdfString(model, urdf, kind, package_dirs=package_dirs)
                     for kind in (pin.GeometryType.COLLISION, pin.GeometryType.VISUAL)]
     except (RuntimeError, ValueError, AttributeError) as error:  # Pinocchio's, several lines
         label, what = urdf_name.split(": ", 1)
-        raise ParameterFileError(f"{label}: Pinocchio cannot load {what} ({_first_line(error)})") from error
-    if isinstance(source, (Description, str)):  # a URDF file of one's own keeps Pinocchio's g
-        model.gravity = gravity_of(description.config)
+        raise ParameterFileError(f"Pinocchio cannot load {what} ({_first_line(error)})", argument=label) from error
     robot = pin.RobotWrapper(model, *geometry)
     try:
         pin.loadReferenceConfigurationsFromXML(robot.model, srdf, False)
-        if loader.has_rotor_parameters and (
-                not isinstance(source, (Description, str)) or description.config.actuation.motor is not None):
-            load_rotor_parameters(robot.model, srdf)  # a model without public motor data has none
+        if loader.has_rotor_parameters and has_rotors(config):
+            load_rotor_parameters(robot.model, srdf)
         robot.collision_model.addAllCollisionPairs()
         pin.removeCollisionPairsFromXML(robot.model, robot.collision_model, srdf, False)
     except (RuntimeError, ValueError, AttributeError) as error:
         label, what = srdf_name.split(": ", 1)
-        raise ParameterFileError(f"{label}: Pinocchio cannot read {what} ({_first_line(error)})") from error
+        raise ParameterFileError(f"Pinocchio cannot read {what} ({_first_line(error)})", argument=label) from error
     postures = [entry.key() for entry in robot.model.referenceConfigurations]
     if loader.ref_posture not in postures:
         raise InvalidInputError(
-            f"ref_posture: {loader.ref_posture!r} is not a posture of the SRDF (it has {sorted(postures)})")
+            f"{loader.ref_posture!r} is not a posture of the SRDF (it has {sorted(postures)})", argument="ref_posture")
     robot.q0 = robot.model.referenceConfigurations[loader.ref_posture].copy()
     robot.rebuildData()
     return robot

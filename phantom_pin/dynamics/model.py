@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import itertools
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TypeGuard
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -15,125 +14,24 @@ import pinocchio as pin
 from phantom_pin.config import MODELS, Config
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, description_of
-from phantom_pin.description.gimbal import locked
-from phantom_pin.dynamics.coupling import Coupling
-from phantom_pin.dynamics.loader import gravity_of, load_rotor_parameters
-from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
-from phantom_pin.validation import as_states, finite_result, same_batch, within_box, wrap_angle
-
-#: Newton iterations and position tolerance (m) of inverse_kinematics.
-_IK_ITERATIONS, _IK_TOLERANCE = 60, 1e-13
-#: Damping (m^2) of the normal equations: small enough that Newton still converges on the
-#: shell's boundaries, where the Jacobian is singular (1e-12 stalled there near 6e-13 m).
-_IK_DAMPING = 1e-16
-#: Largest Newton step (rad); seeds (theta2, theta3 in rad) for each elbow branch.
-_IK_MAX_STEP = 0.3
-#: cos(theta3 - theta2) within this of 0 counts as either branch (the shell's boundaries).
-_IK_BRANCH_SLACK = 1e-5
-_IK_SEEDS = {"report": ((0.35, 0.3), (0.9, 1.0)), "other": ((-0.35, -2.8), (0.9, -1.5))}
-
-
-_ONE = (3,)
-#: eigenpy converts boolean arrays, which as_states refuses: the fast paths that check only
-#: shapes send them to the checked path (a builtin dtype is one object)
-_BOOL = np.dtype(bool)
-_isfinite = math.isfinite
-
-
-def _finite(array: np.ndarray) -> bool:
-    """Cheap: True if ``array`` holds no NaN or inf (False also when its sum overflows,
-    which only sends the caller to its slow path, where the full checks name the culprit)."""
-    return math.isfinite(sum(array.ravel("K").tolist()))
-
-
-def _one(value: object) -> TypeGuard[np.ndarray]:
-    """The fast paths' check, written once: True if ``value`` is a finite vector of shape (3,)
-    (an array; the dtype is left to eigenpy, but for booleans, which eigenpy would take: their
-    tolist() gives bools, sent to the checked path, which refuses them by name).
-
-    ``a, b, c = value.tolist() if value.size == 3 else ()`` then ``isfinite(a + b + c)`` is the
-    cheapest check (0.16 us, against 0.33 us for a shape comparison and sum()): a batch fails
-    to unpack () without being listed (ValueError), as tolist() of a (1, 3) array does; that of
-    a (3, 1) array unpacks into lists whose sum isfinite refuses (TypeError), as it refuses
-    complex numbers and strings; lists have no size (AttributeError). A sum that overflows only
-    sends a finite input to the checked path. Functions of theta alone stay finite on a finite
-    theta; where rates enter, whose products can overflow, the caller checks the result too."""
-    try:
-        a, b, c = value.tolist() if value.size == 3 else ()  # type: ignore[attr-defined,misc]
-        return a.__class__ is not bool and _isfinite(a + b + c)
-    except (AttributeError, TypeError, ValueError):
-        return False
-
-
-def _rows(function: Callable[..., np.ndarray], *arrays: np.ndarray, before: tuple = (),
-          after: tuple = ()) -> np.ndarray:
-    """``function(*before, *rows, *after)`` of each row of ``arrays`` (each (N, k)), stacked
-    into one new array. map calls a Pinocchio function with its fixed arguments (model,
-    data, frame...) in ``before`` and ``after`` without a Python frame per row."""
-    fixed = map(itertools.repeat, before), map(itertools.repeat, after)
-    return np.array(list(map(function, *fixed[0], *arrays, *fixed[1])))
-
-
-def solve_spd(m: list[list[float]], r: Sequence[float]) -> tuple[float, float, float] | None:
-    """x with m x = r for a symmetric 3x3 ``m`` (nested lists; the upper triangle is read),
-    by its adjugate; None unless m is positive definite (Sylvester: leading minors > 0)."""
-    (a, b, c), (_, d, e), (_, _, f) = m
-    cof_a, cof_b, cof_c = d * f - e * e, c * e - b * f, b * e - c * d
-    minor2, det = a * d - b * b, a * cof_a + b * cof_b + c * cof_c
-    if not (a > 0 and minor2 > 0 and det > 0):
-        return None
-    cof_d, cof_e = a * f - c * c, b * c - a * e
-    r0, r1, r2 = r
-    return ((cof_a * r0 + cof_b * r1 + cof_c * r2) / det,
-            (cof_b * r0 + cof_d * r1 + cof_e * r2) / det,
-            (cof_c * r0 + cof_e * r1 + minor2 * r2) / det)
-
-
-def _accelerations(mass: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """x with ``mass`` x = ``rhs`` (a symmetric (3, 3) M and (3,) torques): solve_spd, or where M
-    is not positive definite (or not finite) Cholesky, which decides, as ever (LinAlgError)."""
-    acc = solve_spd(mass.tolist(), rhs.tolist())
-    if acc is None:
-        factor = np.linalg.cholesky(mass)
-        return np.linalg.solve(factor.T, np.linalg.solve(factor, rhs))
-    return np.array(acc)
-
-
-def _coriolis(coupling: Coupling, tree_data: pin.Data, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The Coriolis matrix of ``coupling``'s reduced model at (q, v): Pinocchio's is silently wrong
-    on mimic models (DEVELOPERS.md), so the tree's, projected: C = G^T C_tree G."""
-    return coupling.project(pin.computeCoriolisMatrix(coupling.tree, tree_data, coupling.configuration(q),
-                                                      coupling.tangent(v)))
-
-
-def _frame_jacobian(name: str, reference: pin.ReferenceFrame, doc: str) -> Callable[..., np.ndarray]:
-    """A Phantom method: the tip's frame Jacobian in ``reference`` of the model rooted at
-    frame s; a closure, so that its fast path is as short as forward_kinematics'."""
-    def method(self: Phantom, theta: object) -> np.ndarray:
-        model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
-        if _one(theta):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                return pin.computeFrameJacobian(model, data, theta, tip, reference)
-            except TypeError:
-                pass
-        return self._each(pin.computeFrameJacobian, ("theta",), theta, before=(model, data),
-                          after=(tip, reference))
-    method.__name__, method.__qualname__, method.__doc__ = name, f"Phantom.{name}", doc
-    return method
-
-
-def _rooted_at(source: pin.Model, world_to_s: pin.SE3) -> pin.Model:
-    """A copy of ``source`` expressed in frame s: every placement on the world, joints' and
-    frames', premultiplied by ``world_to_s`` (gravity rotated alike)."""
-    model = source.copy()
-    for jid in range(1, model.njoints):
-        if model.parents[jid] == 0:
-            model.jointPlacements[jid] = world_to_s * model.jointPlacements[jid]
-    for frame in model.frames:
-        if frame.parentJoint == 0:
-            frame.placement = world_to_s * frame.placement
-    model.gravity = world_to_s.act(model.gravity)
-    return model
+from phantom_pin.dynamics.build import rooted_at_frame
+from phantom_pin.dynamics.fast import (
+    BOOL,
+    ONE,
+    accelerations,
+    attempt,
+    coriolis,
+    finite,
+    frame_jacobian,
+    is_one,
+    isfinite,
+    rows,
+)
+from phantom_pin.dynamics.fast import solve_spd as solve_spd  # (where it lived before)
+from phantom_pin.dynamics.ik import SEEDS, solve_ik
+from phantom_pin.dynamics.models import models
+from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.validation import as_states, finite_result, same_batch, within_box
 
 
 class Phantom:
@@ -165,7 +63,8 @@ class Phantom:
     Attributes: ``description`` (the Description it was built from), ``config`` (its
     typed configuration), ``model`` (the mimic model, nq = nv = 3, armature = the SRDF's
     rotor inertias times ratio^2; a gimbal locked), ``data``, ``coupling`` (the mimic-free
-    tree model and the coupling matrix read from the URDF's mimic tags), ``gimbal_joints``
+    tree model and the coupling matrix read from the URDF's mimic tags), ``full_coupling`` (the
+    same with every joint of the URDF free: ``coupling`` itself without a gimbal), ``gimbal_joints``
     (the gimbal's joint names, () without one), ``stylus_model`` (the six-joint mimic model
     rooted at frame s, or None), ``threads`` (OpenMP threads of batched inverse dynamics).
     """
@@ -180,13 +79,11 @@ class Phantom:
         self.config: Config = description.config
         gimbal, prefix = self.config.gimbal, description.prefix
         self.gimbal_joints: tuple[str, ...] = () if gimbal is None else tuple(prefix + j for j in GIMBAL_JOINTS)
-        self.coupling = Coupling(description.urdf if gimbal is None else
-                                 locked(description.urdf, prefix, gimbal.locked_at))
+        built = models(description)
+        #: every joint of the URDF free (the coupling itself without a gimbal): the ROS 2 node's frames
+        self.full_coupling = built.full
+        self.coupling = built.coupling
         self.model: pin.Model = self.coupling.reduced
-        for model in (self.model, self.coupling.tree):  # the configuration's g, along base_link's -z
-            model.gravity = gravity_of(self.config)
-        if self.config.actuation.motor is not None:  # else no rotor_params, armature 0 (Actuation.rotor)
-            load_rotor_parameters(self.model, description.srdf)
         self.data = self.model.createData()
         self._tree_data = self.coupling.tree.createData()
         self._frame_s = self.model.getFrameId(prefix + "report_s")
@@ -194,32 +91,23 @@ class Phantom:
         pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
         # report_s is fixed to the world: a copy of the model whose world is frame s gives
         # g_st and J^s directly (its joints' placements on the world premultiplied by g_s^-1)
-        self._kinematics = self._rooted_at(self.data.oMf[self._frame_s].inverse())
+        self._kinematics = rooted_at_frame(self.model, prefix + "report_s")
         self._kinematics_data = self._kinematics.createData()
         self.threads = os.cpu_count() or 1
         self._pool: pin.ModelPool | None = None
-        self.stylus_model: pin.Model | None = None
+        #: the six joints' mimic model rooted at frame s, and its coupling's tree (the Coriolis matrix
+        #: of the gimbal held, see coriolis_matrix), from the URDF with the gimbal free
+        self.stylus_model: pin.Model | None = built.stylus
+        self._stylus_coupling = built.full
+        self._stylus_tree_data = built.full.tree.createData()
         self._frame_stylus = self._frame_stylus_tip = -1
-        if gimbal is not None:  # the six-joint model, rooted at frame s as _kinematics
-            #: the six joints' mimic model and its tree (the Coriolis matrix of the gimbal held, see
-            #: coriolis_matrix), from the URDF with the gimbal free
-            self._stylus_coupling = Coupling(description.urdf)
-            self._stylus_tree_data = self._stylus_coupling.tree.createData()
-            six = self._stylus_coupling.reduced
-            six.gravity = gravity_of(self.config)
-            six_data = six.createData()
-            pin.framesForwardKinematics(six, six_data, pin.neutral(six))
-            self.stylus_model = _rooted_at(six, six_data.oMf[six.getFrameId(prefix + "report_s")].inverse())
-            names = (*(f"{prefix}joint{j}" for j in (1, 2, 3)), *self.gimbal_joints)
+        if built.stylus is not None and built.order is not None:
             #: the six-joint model's q (and, every joint revolute, v) of (theta, g): q[order] = (theta1..3, g1..3)
-            self._order = np.array([self.stylus_model.joints[self.stylus_model.getJointId(n)].idx_q for n in names])
+            self._order = built.order
             self._arm, self._arm_block = self._order[:3], np.ix_(self._order[:3], self._order[:3])
-            armature = self.stylus_model.armature.copy()
-            armature[self._arm] = self.model.armature  # the rotors, as the arm's model has them
-            self.stylus_model.armature = armature
-            self._stylus_data = self.stylus_model.createData()
-            self._frame_stylus = self.stylus_model.getFrameId(f"{prefix}stylus")
-            self._frame_stylus_tip = self.stylus_model.getFrameId(f"{prefix}stylus_tip")
+            self._stylus_data = built.stylus.createData()
+            self._frame_stylus = built.stylus.getFrameId(f"{prefix}stylus")
+            self._frame_stylus_tip = built.stylus.getFrameId(f"{prefix}stylus_tip")
 
     @classmethod
     def from_model(cls, name: str) -> Phantom:
@@ -241,9 +129,6 @@ class Phantom:
         return cls(description)
 
     # -- helpers ---------------------------------------------------------------------
-    def _rooted_at(self, world_to_s: pin.SE3) -> pin.Model:
-        return _rooted_at(self.model, world_to_s)
-
     @staticmethod
     def _states(names: tuple[str, ...], *values: object) -> list[np.ndarray]:
         arrays = [as_states(v, n)[0] for n, v in zip(names, values)]
@@ -259,7 +144,7 @@ class Phantom:
         arrays = cls._states(names, *values)
         if arrays[0].ndim == 1:
             return finite_result(function(*before, *arrays, *after), ", ".join(names))
-        out = _rows(function, *(a.reshape(-1, a.shape[-1]) for a in arrays), before=before, after=after)
+        out = rows(function, *(a.reshape(-1, a.shape[-1]) for a in arrays), before=before, after=after)
         return finite_result(out.reshape(arrays[0].shape[:-1] + out.shape[1:]), ", ".join(names))
 
     def _tree_batch(self, function: Callable[..., np.ndarray], names: tuple[str, ...],
@@ -270,7 +155,7 @@ class Phantom:
         finiteness (an overflow is reported by finite_result, not by NumPy's warnings)."""
         coupling = self.coupling
         with np.errstate(invalid="ignore", over="ignore"):
-            tree = _rows(function, coupling.configuration(theta.reshape(-1, 3)),
+            tree = rows(function, coupling.configuration(theta.reshape(-1, 3)),
                          *(coupling.tangent(r.reshape(-1, 3)) for r in rates), before=before)
             out = coupling.project(tree)
         return finite_result(out.reshape(theta.shape[:-1] + out.shape[1:]), ", ".join(names))
@@ -305,7 +190,7 @@ class Phantom:
     # -- kinematics ------------------------------------------------------------------
     def forward_kinematics(self, theta: object) -> np.ndarray:
         """Pose g_st of the tool frame t in frame s (eq. 10): shape (..., 4, 4), metres."""
-        if _one(theta):  # the fast path
+        if is_one(theta):  # the fast path, inline: attempt(self._pose, ...) costs 0.2 us of its 0.9
             try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
                 pin.forwardKinematics(self._kinematics, self._kinematics_data, theta)
                 return pin.updateFramePlacement(self._kinematics, self._kinematics_data, self._frame_tip).homogeneous
@@ -324,63 +209,10 @@ class Phantom:
         (-pi, pi], as closed_form.inverse_kinematics returns them (theta1 = +pi behind
         the shoulder). The result may lie outside the joint limits: see within_limits.
         """
-        if branch not in _IK_SEEDS:
-            raise InvalidInputError(f"branch: expected 'report' or 'other', got {branch!r}")
-        return self._each(lambda p: self._solve_ik(p, branch), ("position",), position)
-
-    def _solve_ik(self, target: np.ndarray, branch: str) -> np.ndarray:
-        p = self.config.kinematics
-        x, y, z = target.tolist()
-        distance = math.hypot(x, y - p.l2, z + p.l1)  # from the shoulder (0, l2, -l1) in s
-        if not abs(p.l1 - p.l2) * (1 - 1e-12) <= distance <= (p.l1 + p.l2) * (1 + 1e-12):
-            raise UnreachableTargetError(
-                f"position: {np.array2string(target, precision=4)} m is {distance:.4g} m from "
-                f"the shoulder, outside the reachable shell [{abs(p.l1 - p.l2):.4f}, "
-                f"{p.l1 + p.l2:.4f}] m")
-        sign = 1.0 if branch == "report" else -1.0
-        for seed in _IK_SEEDS[branch]:
-            theta = self._newton((x, y, z), np.array([math.atan2(x, z + p.l1), *seed]))
-            # the report's branch has the elbow open forwards, cos(theta3 - theta2) =
-            # sin(alpha) >= 0; on the shell's boundaries (alpha = 0 or pi) both branches
-            # meet, where Newton's angles are good to about sqrt(tolerance / l) ~ 1e-6 rad
-            if theta is not None and sign * math.cos(theta[2] - theta[1]) > -_IK_BRANCH_SLACK:
-                return wrap_angle(theta)
-        raise UnreachableTargetError(
-            f"position: no {branch}-branch solution found for {target} m")
-
-    def _newton(self, target: tuple[float, float, float], theta: np.ndarray) -> np.ndarray | None:
-        """Damped Newton on the tip position from ``theta``; None if it does not converge.
-
-        Each step solves the damped normal equations (J^T J + damping I) step = J^T error,
-        J the tip point's (3, 3) Jacobian in s; in floats, which is 2x faster than NumPy on
-        3-vectors."""
-        model, data, tip = self._kinematics, self._kinematics_data, self._frame_tip
-        tx, ty, tz = target
-        for _ in range(_IK_ITERATIONS):
-            # rows 0-2 of the LOCAL_WORLD_ALIGNED Jacobian: the tip point's velocity in s;
-            # its columns a, b, c, one per joint
-            jacobian = pin.computeFrameJacobian(model, data, theta, tip, pin.LOCAL_WORLD_ALIGNED)
-            (a0, b0, c0), (a1, b1, c1), (a2, b2, c2) = jacobian[:3].tolist()
-            x, y, z = data.oMf[tip].translation.tolist()
-            ex, ey, ez = tx - x, ty - y, tz - z
-            if math.hypot(ex, ey, ez) < _IK_TOLERANCE:
-                return theta
-            ab = a0 * b0 + a1 * b1 + a2 * b2
-            ac = a0 * c0 + a1 * c1 + a2 * c2
-            bc = b0 * c0 + b1 * c1 + b2 * c2
-            normal = [[a0 * a0 + a1 * a1 + a2 * a2 + _IK_DAMPING, ab, ac],
-                      [ab, b0 * b0 + b1 * b1 + b2 * b2 + _IK_DAMPING, bc],
-                      [ac, bc, c0 * c0 + c1 * c1 + c2 * c2 + _IK_DAMPING]]
-            gradient = (a0 * ex + a1 * ey + a2 * ez, b0 * ex + b1 * ey + b2 * ez,
-                        c0 * ex + c1 * ey + c2 * ez)
-            step = solve_spd(normal, gradient)
-            if step is None:  # singular to rounding: LAPACK's LU, as before the float path
-                step = np.linalg.solve(np.array(normal), gradient).tolist()
-            largest = max(map(abs, step))
-            scale = 1.0 if largest <= _IK_MAX_STEP else _IK_MAX_STEP / largest
-            t0, t1, t2 = theta.tolist()
-            theta = np.array([t0 + scale * step[0], t1 + scale * step[1], t2 + scale * step[2]])
-        return None
+        if branch not in SEEDS:
+            raise InvalidInputError(f"expected 'report' or 'other', got {branch!r}", argument="branch")
+        kinematics = self._kinematics, self._kinematics_data, self._frame_tip, self.config.kinematics
+        return self._each(lambda p: solve_ik(*kinematics, p, branch), ("position",), position)
 
     # -- the stylus (a model with a gimbal) ----------------------------------------------
     def _stylus(self) -> tuple[pin.Model, pin.Data]:
@@ -424,17 +256,14 @@ class Phantom:
         model's arrays of theta (``values[0]``) with the gimbal and of the arm's other ``values``
         (_six), one state or over the broadcast batch; InvalidInputError naming ``names`` and
         ``gimbal`` for a bad argument or a result that is not finite."""
-        arm: Any = values  # finite vectors (3,) once _one says so
-        if self.stylus_model is not None and _one(gimbal) and all(map(_one, arm)):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                out = one(self._one_six(arm[0], gimbal), *(self._one_six(v, None) for v in arm[1:]))
-                if _finite(out):  # rates can overflow
-                    return out
-            except TypeError:
-                pass
+        arm: Any = values  # finite vectors (3,) once is_one says so
+        if self.stylus_model is not None and is_one(gimbal) and all(map(is_one, arm)):  # the fast path
+            out = attempt(one, self._one_six(arm[0], gimbal), *(self._one_six(v, None) for v in arm[1:]))
+            if out is not None and finite(out):  # rates can overflow
+                return out
         arrays = self._six(names, gimbal, *values)
         with np.errstate(invalid="ignore", over="ignore"):  # reported by finite_result
-            out = _rows(one, *(a.reshape(-1, 6) for a in arrays))
+            out = rows(one, *(a.reshape(-1, 6) for a in arrays))
         return finite_result(out.reshape(arrays[0].shape[:-1] + out.shape[1:]), ", ".join((*names, "gimbal")))
 
     # the arm's rows (and columns) of the six-joint model's dynamics at one state, for _held
@@ -445,35 +274,35 @@ class Phantom:
         return pin.crba(self.stylus_model, self._stylus_data, q)[self._arm_block]  # the full matrix, as mass_matrix's
 
     def _held_coriolis(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        return _coriolis(self._stylus_coupling, self._stylus_tree_data, q, v)[self._arm_block]
+        return coriolis(self._stylus_coupling, self._stylus_tree_data, q, v)[self._arm_block]
 
     def _held_torques(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
         return pin.rnea(self.stylus_model, self._stylus_data, q, v, a)[self._arm]
 
     def _held_forward(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         model, data, arm = self.stylus_model, self._stylus_data, self._arm
-        return _accelerations(pin.crba(model, data, q)[self._arm_block],
+        return accelerations(pin.crba(model, data, q)[self._arm_block],
                               tau[arm] - pin.nonLinearEffects(model, data, q, v)[arm])
 
     def _stylus_frame(self, frame: int, theta: object, gimbal: object, jacobian: bool = False) -> np.ndarray:
         model = self.stylus_model
-        if _one(theta) and _one(gimbal) and model is not None and not jacobian:  # the fast path
-            try:
-                pin.forwardKinematics(model, self._stylus_data, self._one_six(theta, gimbal))
-                return pin.updateFramePlacement(model, self._stylus_data, frame).homogeneous
-            except TypeError:
-                pass
+        if is_one(theta) and is_one(gimbal) and model is not None and not jacobian:  # the fast path
+            return self._stylus_placement(frame, self._one_six(theta, gimbal))
         (q,) = self._six(("theta",), gimbal, theta)
         model, data = self._stylus()
 
         def one(configuration: np.ndarray) -> np.ndarray:
             if jacobian:  # columns in (theta, g) order
                 return pin.computeFrameJacobian(model, data, configuration, frame, pin.WORLD)[:, self._order]
-            pin.forwardKinematics(model, data, configuration)
-            return pin.updateFramePlacement(model, data, frame).homogeneous
+            return self._stylus_placement(frame, configuration)
 
         out = np.array([one(c) for c in q.reshape(-1, 6)])
         return finite_result(out.reshape(q.shape[:-1] + out.shape[1:]), "theta, gimbal")
+
+    def _stylus_placement(self, frame: int, q: np.ndarray) -> np.ndarray:
+        """The stylus model's ``frame`` at the six-joint q: (4, 4)."""
+        pin.forwardKinematics(self.stylus_model, self._stylus_data, q)
+        return pin.updateFramePlacement(self.stylus_model, self._stylus_data, frame).homogeneous
 
     def stylus_pose(self, theta: object, gimbal: object) -> np.ndarray:
         """Pose of the stylus frame in frame s: (..., 4, 4), metres. Its origin is the gimbal
@@ -494,12 +323,12 @@ class Phantom:
         g1..g3) (rad/s)."""
         return self._stylus_frame(self._frame_stylus, theta, gimbal, jacobian=True)
 
-    spatial_jacobian = _frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3),
+    spatial_jacobian = frame_jacobian("spatial_jacobian", pin.WORLD, """Spatial Jacobian J^s (eq. 22): (..., 6, 3),
         twist (v, omega) in frame s.
 
         Pinocchio's WORLD frame Jacobian of ``tip`` in the model rooted at frame s.
         """)
-    body_jacobian = _frame_jacobian("body_jacobian", pin.LOCAL, """Body Jacobian J^b (eq. 24): (..., 6, 3),
+    body_jacobian = frame_jacobian("body_jacobian", pin.LOCAL, """Body Jacobian J^b (eq. 24): (..., 6, 3),
         twist (v, omega) in the tool frame t.""")
 
     # -- dynamics --------------------------------------------------------------------
@@ -509,11 +338,8 @@ class Phantom:
         ``locked_at``, as in gravity."""
         if gimbal is not None:
             return self._held(self._held_mass, ("theta",), gimbal, theta)
-        if _one(theta):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                return pin.crba(self.model, self.data, theta)
-            except TypeError:
-                pass
+        if is_one(theta) and (out := attempt(pin.crba, self.model, self.data, theta)) is not None:  # the fast path
+            return out
         # the binding of crba returns the full symmetric matrix (DEVELOPERS.md), not data.M
         return self._each(pin.crba, ("theta",), theta, before=(self.model, self.data))
 
@@ -527,13 +353,10 @@ class Phantom:
         """
         if gimbal is not None:
             return self._held(self._held_coriolis, ("theta", "dtheta"), gimbal, theta, dtheta)
-        if _one(theta) and _one(dtheta):  # the fast path; rates can overflow C
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                out = _coriolis(self.coupling, self._tree_data, theta, dtheta)
-                if _finite(out):
-                    return out
-            except TypeError:
-                pass
+        if is_one(theta) and is_one(dtheta):  # the fast path; rates can overflow C
+            out = attempt(coriolis, self.coupling, self._tree_data, theta, dtheta)
+            if out is not None and finite(out):
+                return out
         names = ("theta", "dtheta")
         return self._tree_batch(pin.computeCoriolisMatrix, names, *self._states(names, theta, dtheta),
                                 before=(self.coupling.tree, self._tree_data))
@@ -551,11 +374,8 @@ class Phantom:
         """
         if gimbal is not None:
             return self._held(self._held_gravity, ("theta",), gimbal, theta)
-        if _one(theta):  # the fast path
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                return pin.computeGeneralizedGravity(self.model, self.data, theta)
-            except TypeError:
-                pass
+        if is_one(theta) and (out := attempt(pin.computeGeneralizedGravity, self.model, self.data, theta)) is not None:
+            return out  # the fast path
         (q,) = self._states(("theta",), theta)
         if q.ndim == 1:
             return finite_result(pin.computeGeneralizedGravity(self.model, self.data, q), "theta")
@@ -567,7 +387,7 @@ class Phantom:
         shape (...) (a 0-d array for one state). On the tree model: the coupling maps the
         whole batch, Pinocchio runs per row."""
         (q,) = self._states(("theta",), theta)
-        energy = _rows(pin.computePotentialEnergy, self.coupling.configuration(q.reshape(-1, 3)),
+        energy = rows(pin.computePotentialEnergy, self.coupling.configuration(q.reshape(-1, 3)),
                        before=(self.coupling.tree, self._tree_data))
         return energy.reshape(q.shape[:-1])  # finite: V is a sum of masses times heights
 
@@ -582,14 +402,14 @@ class Phantom:
             return self._held(self._held_torques, ("theta", "dtheta", "ddtheta"), gimbal, theta, dtheta, ddtheta)
         q: Any = theta  # any object: its shape is asked, not assumed (lists have none)
         try:  # the fast path: one state (3,); eigenpy refuses (TypeError) complex and object
-            if (q.shape == dtheta.shape == ddtheta.shape == _ONE  # type: ignore[attr-defined]
-                    and _BOOL is not q.dtype and _BOOL is not dtheta.dtype  # type: ignore[attr-defined]
-                    and _BOOL is not ddtheta.dtype):  # type: ignore[attr-defined]
+            if (q.shape == dtheta.shape == ddtheta.shape == ONE  # type: ignore[attr-defined]
+                    and BOOL is not q.dtype and BOOL is not dtheta.dtype  # type: ignore[attr-defined]
+                    and BOOL is not ddtheta.dtype):  # type: ignore[attr-defined]
                 tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
                 # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
                 # only then are the inputs inspected, to name the bad one.
                 t0, t1, t2 = tau.tolist()
-                if _isfinite(t0 + t1 + t2):
+                if isfinite(t0 + t1 + t2):
                     return tau
         except (AttributeError, TypeError):  # no shape (lists), or not for eigenpy
             pass
@@ -600,7 +420,7 @@ class Phantom:
         return finite_result(self._batched(q, v, a), ", ".join(names))
 
     def _forward(self, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        return _accelerations(pin.crba(self.model, self.data, theta),
+        return accelerations(pin.crba(self.model, self.data, theta),
                               tau - pin.nonLinearEffects(self.model, self.data, theta, dtheta))
 
     def forward_dynamics(self, theta: object, dtheta: object, tau: object, gimbal: object = None) -> np.ndarray:
@@ -621,15 +441,15 @@ class Phantom:
         # so the result is checked; theta1 enters neither M nor the bias torques, so theta is
         # checked first. A tau of shape (3, 1) unpacks into lists, whose difference with a float
         # raises TypeError.
-        if _one(theta):
+        if is_one(theta):
             try:
                 t0, t1, t2 = torques.tolist()
-                if rates.shape == _ONE and t0.__class__ is not bool and rates.dtype is not _BOOL:
+                if rates.shape == ONE and t0.__class__ is not bool and rates.dtype is not BOOL:
                     model, data = self.model, self.data
                     bias = pin.nonLinearEffects(model, data, theta, dtheta).tolist()
                     acc = solve_spd(pin.crba(model, data, theta).tolist(),
                                     (t0 - bias[0], t1 - bias[1], t2 - bias[2]))
-                    if acc is not None and _isfinite(sum(acc)):  # rates can overflow
+                    if acc is not None and isfinite(sum(acc)):  # rates can overflow
                         return np.array(acc)
             except (AttributeError, TypeError, ValueError):  # no shape, not for eigenpy, complex tau
                 pass
@@ -639,7 +459,7 @@ class Phantom:
             return finite_result(self._forward(q, v, torque), ", ".join(names))
         with np.errstate(invalid="ignore", over="ignore"):  # reported by finite_result
             rhs = torque - self._batched(q, v, np.zeros_like(q))
-        mass = _rows(pin.crba, q.reshape(-1, 3), before=(self.model, self.data)).reshape(q.shape + (3,))
+        mass = rows(pin.crba, q.reshape(-1, 3), before=(self.model, self.data)).reshape(q.shape + (3,))
         np.linalg.cholesky(mass)  # LinAlgError unless every M is positive definite
         accelerations = np.linalg.solve(mass, rhs[..., None])[..., 0]
         return finite_result(accelerations, ", ".join(names))
@@ -657,14 +477,12 @@ class Phantom:
         and are projected: d tau/d theta = G^T (d tau_tree/d q) G, and likewise for dtheta.
         """
         coupling = self.coupling
-        if _one(theta) and _one(dtheta) and _one(ddtheta):  # the fast path; rates can overflow
-            try:  # eigenpy refuses some dtypes (TypeError): the checked path converts them
-                both = coupling.project(self._tree_derivatives(
-                    coupling.configuration(theta), coupling.tangent(dtheta), coupling.tangent(ddtheta)))
-                if _finite(both):
-                    return both[0], both[1]
-            except TypeError:
-                pass
+        if is_one(theta) and is_one(dtheta) and is_one(ddtheta):  # the fast path; rates can overflow
+            tree = attempt(self._tree_derivatives, coupling.configuration(theta), coupling.tangent(dtheta),
+                           coupling.tangent(ddtheta))
+            both = None if tree is None else coupling.project(tree)
+            if both is not None and finite(both):
+                return both[0], both[1]
         names = ("theta", "dtheta", "ddtheta")
         both = self._tree_batch(self._tree_derivatives, names, *self._states(names, theta, dtheta, ddtheta))
         return both[..., 0, :, :].copy(), both[..., 1, :, :].copy()

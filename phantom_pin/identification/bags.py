@@ -24,6 +24,7 @@ import numpy as np
 from phantom_pin import drivers, profiles
 from phantom_pin.exceptions import LogError, MissingDataError
 from phantom_pin.identification.io import MIN_DURATION, RATE_TOLERANCE, Log
+from phantom_pin.validation import uneven
 
 #: The message type read.
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -194,7 +195,7 @@ def _uniform(t: np.ndarray, q: np.ndarray, e: np.ndarray,
         raise LogError(f"{topic}: a gap of {1e3 * step[k]:.3g} ms after {t[k] - t[0]:.3f} s in a stream at "
                        f"{1 / median:.4g} Hz (messages lost): record again, or cut the bag before or after it",
                        argument="path")
-    if np.abs(step - step.mean()).max() <= RATE_TOLERANCE * step.mean():
+    if not uneven(step, RATE_TOLERANCE):
         return t, q, e, False
     grid = np.linspace(t[0], t[-1], len(t))
     q, e = (np.column_stack([np.interp(grid, t, x[:, j]) for j in range(6)]) for x in (q, e))

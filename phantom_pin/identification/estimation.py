@@ -28,8 +28,14 @@ from phantom_pin.identification import prior as priors
 from phantom_pin.identification.filtering import MIN_CYCLES, MIN_SPEED, Samples, filtered
 from phantom_pin.identification.fit import Curves, Fit
 from phantom_pin.identification.io import Log
+from phantom_pin.identification.least_squares import (
+    condition_number,
+    inverse_information,
+    marginal,
+    rms,
+    solve_gains,
+)
 from phantom_pin.identification.least_squares import fit as least_squares
-from phantom_pin.identification.least_squares import inverse_information, marginal, rms, solve_gains
 from phantom_pin.identification.prediction import judge
 from phantom_pin.identification.structures import STRUCTURES, Structure
 from phantom_pin.identification.timing import HOLD, TIMINGS, criterion, delay_argument, estimate_delay
@@ -128,7 +134,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     written = model.matrix @ x + model.offset
     fit = Fit(structure=model.name, names=model.base_names, units=model.units, beta=timed.beta, sigma=sigma,
               rms=rms(y - phi @ timed.beta, moving), written_rms=rms(y - phi @ written, moving),
-              torque_rms=rms(y, moving), condition=_condition(phi), samples=len(samples.theta), x=x,
+              torque_rms=rms(y, moving), condition=condition_number(phi.reshape(-1, phi.shape[-1])),
+              samples=len(samples.theta), x=x,
               written=written, overrides=model.overrides(x), comparison=_comparison(model, phantom, samples),
               gains=timed.gains, gains_estimated=timed.estimated, prior_beta=ready.beta0,
               log_beta=timed.log_beta[:p], log_sigma=log_sigma, log_rms=timed.log_rms,
@@ -247,13 +254,6 @@ def _projection(ready: _Regression, beta: np.ndarray, covariance: np.ndarray,
     root = (vectors / np.sqrt(np.maximum(values, 1e-300))).T / sigma   # may be singular to rounding)
     return model.nearest(beta, root, prior_weight), sigma
 
-
-def _condition(phi: np.ndarray) -> float:
-    """The condition number of the stacked regressor (N, 3, P) with its columns scaled to unit
-    norm (a diagnostic: the fit is judged by its predicted torques)."""
-    stacked = phi.reshape(-1, phi.shape[-1])
-    norms = np.linalg.norm(stacked, axis=0)
-    return float(np.linalg.cond(stacked / np.where(norms > 0, norms, 1.0)))
 
 
 def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[str, np.ndarray] | None:

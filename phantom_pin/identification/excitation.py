@@ -16,6 +16,7 @@ import numpy as np
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.identification.least_squares import condition_number as condition_number  # (lived here)
 from phantom_pin.identification.structures import General, Report, friction_block
 
 #: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
@@ -60,12 +61,6 @@ def continuous_effort(description: Description) -> np.ndarray:
     return np.array(description.config.actuation.effort)
 
 
-def condition_number(phi: np.ndarray) -> float:
-    """Condition number of a stacked base regressor after scaling its columns to unit norm."""
-    norms = np.linalg.norm(phi, axis=0)
-    return float(np.linalg.cond(phi / np.where(norms > 0, norms, 1.0)))
-
-
 @dataclasses.dataclass(frozen=True)
 class Excitation:
     trajectory: Fourier
@@ -81,19 +76,20 @@ def _check_arguments(**values: float) -> None:
     for name, value in values.items():
         if name in integers:
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < integers[name]:
-                raise InvalidInputError(f"{name}: expected an integer of at least {integers[name]}, got {value!r}")
+                raise InvalidInputError(f"expected an integer of at least {integers[name]}, got {value!r}",
+                                        argument=name)
         elif isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-            raise InvalidInputError(f"{name}: expected a finite number, got {value!r}")
+            raise InvalidInputError(f"expected a finite number, got {value!r}", argument=name)
     if values["period"] <= 0:
-        raise InvalidInputError(f"period: expected a positive number (s), got {values['period']!r}")
+        raise InvalidInputError(f"expected a positive number (s), got {values['period']!r}", argument="period")
     for name in ("margin", "amplitude_weight"):
         if values[name] < 0:
-            raise InvalidInputError(f"{name}: expected a number >= 0, got {values[name]!r}")
+            raise InvalidInputError(f"expected a number >= 0, got {values[name]!r}", argument=name)
     if not 0 < values["torque_share"] <= 1:
-        raise InvalidInputError(f"torque_share: expected a share in (0, 1], got {values['torque_share']!r}")
+        raise InvalidInputError(f"expected a share in (0, 1], got {values['torque_share']!r}", argument="torque_share")
 
 
-def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,  # noqa: C901 (closures of one problem)
+def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
              progress: Callable[[float], None] | None = None,
@@ -116,41 +112,61 @@ def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,  # noqa: C
     _check_arguments(period=period, harmonics=harmonics, samples=samples, margin=margin, torque_share=torque_share,
                      restarts=restarts, iterations=iterations, seed=seed, amplitude_weight=amplitude_weight)
     if progress is not None and not callable(progress):
-        raise InvalidInputError(f"progress: expected a callable (share) or None, got {progress!r}")
+        raise InvalidInputError(f"expected a callable (share) or None, got {progress!r}", argument="progress")
     if times is not None:
         times = np.asarray(times, dtype=float)
         if times.ndim != 1 or not len(times) or not np.isfinite(times).all():
-            raise InvalidInputError("times: expected a non-empty 1-D array of finite times (s)")
+            raise InvalidInputError("expected a non-empty 1-D array of finite times (s)", argument="times")
     if not isinstance(model, Phantom):
         raise InvalidInputError(f"expected a phantom_pin.Phantom (Phantom(description) for a Description), got a "
                                 f"{type(model).__name__}", argument="model")
-    phantom = model
-    description = phantom.description
-    limits = description.config.limits
-    effort = continuous_effort(description)
-    general = General(phantom)
-    beta = general.matrix @ general.prior                    # the configuration's own base parameters
-    typical = np.abs(general.matrix) @ general.scale         # each base parameter's typical size
-    t = np.linspace(0.0, period, samples, endpoint=False)
-    rng = np.random.default_rng(seed)
-    memo: dict[bytes, tuple] = {}
+    problem = _Problem(model, period, harmonics, samples, margin, torque_share, amplitude_weight, times)
+    best = _search(problem, restarts, iterations, seed, progress)
+    trajectory = Fourier.from_free(best, harmonics, period)
+    states, phi, torque = problem.evaluate(best, problem.checked, exact=True)
+    report = None
+    if model.description.config.report is not None:
+        report = condition_number(Report(problem.general.phantom).regressor_of(*states)[0].reshape(-1, 14))
+    return Excitation(trajectory, condition_number(phi), report, np.abs(torque).max(axis=0),
+                      float(problem.limits.slack(states[0]).min()))
 
-    def evaluate(free, at=t, exact=False):
-        """(states, Phi stacked (3N, P), torque (N, 3)) at the times ``at``: for the optimiser
-        with the Coulomb column smoothed (tanh(dtheta / SMOOTH_SPEED): the cost and the
+
+class _Problem:
+    """optimise's problem over the Fourier coefficients ``free``: the cost (conditioning and
+    amplitude of the general base regressor), the inequalities (stops' margin, torque share) at the
+    optimiser's ``samples`` points ``t``, and feasibility at the ``checked`` times too."""
+
+    def __init__(self, phantom: Phantom, period: float, harmonics: int, samples: int, margin: float,
+                 torque_share: float, amplitude_weight: float, times: np.ndarray | None) -> None:
+        description = phantom.description
+        self.period, self.harmonics, self.margin = period, harmonics, margin
+        self.torque_share, self.amplitude_weight = torque_share, amplitude_weight
+        self.limits = description.config.limits
+        self.effort = continuous_effort(description)
+        self.general = General(phantom)
+        self.beta = self.general.matrix @ self.general.prior                # the configuration's own base parameters
+        self.typical = np.abs(self.general.matrix) @ self.general.scale     # each base parameter's typical size
+        self.t = np.linspace(0.0, period, samples, endpoint=False)
+        self.checked = self.t if times is None else np.unique(np.mod(np.asarray(times, float), period))
+        self._memo: dict[bytes, tuple] = {}
+
+    def evaluate(self, free: np.ndarray, at: np.ndarray | None = None, exact: bool = False) -> tuple:
+        """(states, Phi stacked (3N, P), torque (N, 3)) at the times ``at`` (default ``t``): for the
+        optimiser with the Coulomb column smoothed (tanh(dtheta / SMOOTH_SPEED): the cost and the
         constraints stay differentiable for SLSQP), ``exact`` with the friction law itself."""
-        key = free.tobytes() + (b"exact" if exact else b"") + (b"" if at is t else b"checked")
-        if key not in memo:
-            memo.clear()
-            states = Fourier.from_free(free, harmonics, period)(at)
+        at = self.t if at is None else at
+        key = free.tobytes() + (b"exact" if exact else b"") + (b"" if at is self.t else b"checked")
+        if key not in self._memo:
+            self._memo.clear()
+            states = Fourier.from_free(free, self.harmonics, self.period)(at)
             rates = states[1]
             smooth = None if exact else friction_block(np.concatenate([rates, np.tanh(rates / SMOOTH_SPEED)], axis=-1))
-            phi, tau0 = general.regressor_of(*states, smooth)
-            memo[key] = states, phi.reshape(-1, len(beta)), phi @ beta + tau0
-        return memo[key]
+            phi, tau0 = self.general.regressor_of(*states, smooth)
+            self._memo[key] = states, phi.reshape(-1, len(self.beta)), phi @ self.beta + tau0
+        return self._memo[key]
 
-    def cost(free):
-        phi = evaluate(free)[1]
+    def cost(self, free: np.ndarray) -> float:
+        phi = self.evaluate(free)[1]
         # condition number, and (D-optimality) the mean log singular value of the regressor with
         # columns weighted by the typical sizes: rewards torque signals large against the noise.
         # Both from the eigenvalues of the small Gram matrix (the squared singular values), or
@@ -158,27 +174,34 @@ def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,  # noqa: C
         gram = phi.T @ phi
         norms = np.sqrt(np.diag(gram))
         unit = np.linalg.eigvalsh(gram / np.outer(norms, norms))
+        typical, weight = self.typical, self.amplitude_weight
         if unit[0] > 1e-10 * unit[-1]:
             weighted = np.linalg.eigvalsh(gram * np.outer(typical, typical) / len(phi))
-            return 0.5 * np.log(unit[-1] / unit[0]) - amplitude_weight * 0.5 * np.log(weighted).mean()
+            return 0.5 * np.log(unit[-1] / unit[0]) - weight * 0.5 * np.log(weighted).mean()
         size = np.linalg.svd(phi * typical / np.sqrt(len(phi)), compute_uv=False)
-        return np.log(condition_number(phi)) - amplitude_weight * np.log(size).mean()
+        return np.log(condition_number(phi)) - weight * np.log(size).mean()
 
-    def inequalities(free):
-        states, _, torque = evaluate(free)
-        return np.concatenate([limits.slack(states[0]).ravel() - margin,
-                               (torque_share * effort - np.abs(torque)).ravel() * 10])
+    def inequalities(self, free: np.ndarray) -> np.ndarray:
+        states, _, torque = self.evaluate(free)
+        return np.concatenate([self.limits.slack(states[0]).ravel() - self.margin,
+                               (self.torque_share * self.effort - np.abs(torque)).ravel() * 10])
 
-    checked = t if times is None else np.unique(np.mod(np.asarray(times, float), period))
-
-    def feasible(free):
+    def feasible(self, free: np.ndarray) -> bool:
         """The inequalities at the optimiser's points and at ``checked``."""
-        if inequalities(free).min() < -1e-9:
+        if self.inequalities(free).min() < -1e-9:
             return False
-        states, _, torque = evaluate(free, checked, exact=True)
-        return bool(limits.slack(states[0]).min() >= margin - 1e-9
-                    and (torque_share * effort - np.abs(torque)).min() >= -1e-12)
+        states, _, torque = self.evaluate(free, self.checked, exact=True)
+        return bool(self.limits.slack(states[0]).min() >= self.margin - 1e-9
+                    and (self.torque_share * self.effort - np.abs(torque)).min() >= -1e-12)
 
+
+def _search(problem: _Problem, restarts: int, iterations: int, seed: int,
+            progress: Callable[[float], None] | None) -> np.ndarray:
+    """The best feasible coefficients of SLSQP from ``restarts`` seeded random starts, each result
+    stepped back towards its start until feasible; InvalidInputError naming ``restarts`` if none is."""
+    import scipy.optimize  # here: 0.2-0.3 s that every command line start paid (the package imports this module)
+
+    rng = np.random.default_rng(seed)
     start_q0 = np.array([0.0, 0.35, 0.35])
     best, best_cost = None, np.inf
     done = [0]
@@ -188,29 +211,21 @@ def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,  # noqa: C
         if progress is not None:
             progress(done[0] / (iterations * restarts))
 
-    import scipy.optimize  # here: 0.2-0.3 s that every command line start paid (the package imports this module)
-
     for restart in range(restarts):
-        free0 = np.concatenate([start_q0, rng.normal(0, 0.05, 2 * 3 * (harmonics - 1))])
-        result = scipy.optimize.minimize(cost, free0, method="SLSQP", callback=step,
-                                         constraints=[{"type": "ineq", "fun": inequalities}],
+        free0 = np.concatenate([start_q0, rng.normal(0, 0.05, 2 * 3 * (problem.harmonics - 1))])
+        result = scipy.optimize.minimize(problem.cost, free0, method="SLSQP", callback=step,
+                                         constraints=[{"type": "ineq", "fun": problem.inequalities}],
                                          options={"maxiter": iterations, "ftol": 1e-6})
         done[0] = (restart + 1) * iterations
         # an unfinished run, or the points between the optimiser's, may leave the limits:
         # step back towards the (small) start
         for alpha in (1.0, 0.95, 0.9, 0.8, 0.6, 0.4, 0.2, 0.0):
             candidate = free0 + alpha * (result.x - free0)
-            if feasible(candidate):
-                if cost(candidate) < best_cost:
-                    best, best_cost = candidate, cost(candidate)
+            if problem.feasible(candidate):
+                if problem.cost(candidate) < best_cost:
+                    best, best_cost = candidate, problem.cost(candidate)
                 break
     if best is None:
-        raise InvalidInputError(f"restarts: no feasible trajectory found in {restarts} start(s); raise restarts "
-                                "(--restarts) or lower margin")
-    trajectory = Fourier.from_free(best, harmonics, period)
-    states, phi, torque = evaluate(best, checked, exact=True)
-    report = None
-    if description.config.report is not None:
-        report = condition_number(Report(general.phantom).regressor_of(*states)[0].reshape(-1, 14))
-    return Excitation(trajectory, condition_number(phi), report, np.abs(torque).max(axis=0),
-                      float(limits.slack(states[0]).min()))
+        raise InvalidInputError(f"no feasible trajectory found in {restarts} start(s); raise restarts "
+                                "(--restarts) or lower margin", argument="restarts")
+    return best

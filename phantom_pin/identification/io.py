@@ -18,7 +18,7 @@ import numpy as np
 
 from phantom_pin import drivers
 from phantom_pin.exceptions import LogError
-from phantom_pin.validation import as_states
+from phantom_pin.validation import as_states, fixed_rate, output_path, uneven
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
 TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3",
@@ -41,21 +41,22 @@ class Log:
         try:
             arrays = [np.asarray(x, dtype=float) for x in (self.t, self.theta, self.tau)]
         except (TypeError, ValueError):
-            raise LogError("log: t, theta and tau must be arrays of numbers") from None
+            raise LogError("t, theta and tau must be arrays of numbers", argument="log") from None
         t, theta, tau = arrays
         if t.ndim != 1 or len(t) < 2 or theta.shape != (len(t), 3) or tau.shape != (len(t), 3):
-            raise LogError(f"log: expected t (N,), theta (N, 3), tau (N, 3) with N >= 2, got {t.shape}, "
-                           f"{theta.shape}, {tau.shape}")
+            raise LogError(f"expected t (N,), theta (N, 3), tau (N, 3) with N >= 2, got {t.shape}, "
+                           f"{theta.shape}, {tau.shape}", argument="log")
         if not all(np.isfinite(x).all() for x in arrays):
-            raise LogError("log: t, theta and tau must be finite (no NaN or inf)")
+            raise LogError("t, theta and tau must be finite (no NaN or inf)", argument="log")
         if not (np.diff(t) > 0).all():
-            raise LogError("log: the times t must increase strictly")
+            raise LogError("the times t must increase strictly", argument="log")
         for name, value in zip(("t", "theta", "tau"), arrays):
             object.__setattr__(self, name, value)
 
     @property
     def rate(self) -> float:
-        return float((len(self.t) - 1) / (self.t[-1] - self.t[0]))
+        """The log's rate (Hz), (N - 1) / its duration."""
+        return fixed_rate(self.t)
 
 
 def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> None:
@@ -66,28 +67,18 @@ def write_log(path: Path | str, t: object, theta: object, tau: object, force: bo
     """Write a log: times ``t`` (N,) s, ``theta`` (N, 3) rad and ``tau`` (N, 3) N m, finite, as
     read_log reads it. An existing file is kept unless ``force``: LogError naming the argument."""
     if not isinstance(path, (str, Path)):
-        raise LogError(f"path: expected a file path, got {path!r}")
+        raise LogError(f"expected a file path, got {path!r}", argument="path")
     if not isinstance(force, bool):
-        raise LogError(f"force: expected True or False, got {force!r}")
-    path = Path(path)
-    if path.exists() and not force:
-        raise LogError(f"path: {path} exists; pass force=True to overwrite it")
-    if not path.resolve().parent.is_dir():
-        raise LogError(f"path: the folder {path.resolve().parent} does not exist")
+        raise LogError(f"expected True or False, got {force!r}", argument="force")
+    path = output_path(path, force, "path", error=LogError)
     try:
         times = np.asarray(t, dtype=float)
     except (TypeError, ValueError):
-        raise LogError(f"t: expected numbers (s), got {t!r:.60}") from None
+        raise LogError(f"expected numbers (s), got {t!r:.60}", argument="t") from None
     angles, _ = as_states(theta, "theta")
     torques, _ = as_states(tau, "tau")
-    if times.ndim != 1 or angles.shape != (len(times), 3) or torques.shape != (len(times), 3):
-        raise LogError(f"t, theta, tau: expected shapes (N,), (N, 3), (N, 3), got {times.shape}, "
-                       f"{angles.shape}, {torques.shape}")
-    if not np.isfinite(times).all():
-        raise LogError("t: contains NaN or inf")
-    if not (np.diff(times) > 0).all():
-        raise LogError("t: the times must increase strictly")
-    write_csv(path, LOG_COLUMNS, np.column_stack([times, angles, torques]))
+    log = Log(times, angles, torques)  # the log's one validation: shapes, finite, increasing (naming log)
+    write_csv(path, LOG_COLUMNS, np.column_stack([log.t, log.theta, log.tau]))
 
 
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, str]], dict[str, np.ndarray]]:
@@ -150,7 +141,7 @@ def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
     _, column = _read_table(path, TRAJECTORY_COLUMNS)
     t = column["t"]
     step = np.diff(t)
-    if len(t) < 2 or not (step > 0).all() or np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
+    if len(t) < 2 or not (step > 0).all() or uneven(step, RATE_TOLERANCE):
         raise LogError(f"{path}: the times must increase at a fixed rate")
     theta, dtheta, ddtheta, tau = (np.column_stack([column[f"{name}{j}"] for j in (1, 2, 3)])
                                    for name in ("theta", "dtheta", "ddtheta", "tau"))
@@ -190,9 +181,9 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     ``convention`` "report" or "openhaptics" (HD_CURRENT_JOINT_ANGLES, rad, and joint torques,
     mN m)."""
     if convention not in ("report", "openhaptics"):
-        raise LogError(f"convention: expected 'report' or 'openhaptics', got {convention!r}")
+        raise LogError(f"expected 'report' or 'openhaptics', got {convention!r}", argument="convention")
     if not isinstance(path, (str, Path)):
-        raise LogError(f"path: expected a file path, got {path!r}")
+        raise LogError(f"expected a file path, got {path!r}", argument="path")
     path = Path(path)
     lines, column = _read_table(path, LOG_COLUMNS)
     expected = "mN m" if convention == "openhaptics" else "N m"
@@ -211,7 +202,7 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
                        + (f" (line {lines[2 + int(np.argmin(step > 0))][0]})" if len(t) >= 2 else ""))
     if t[-1] - t[0] < MIN_DURATION:
         raise LogError(f"{path}: too short ({t[-1] - t[0]:.3g} s; at least {MIN_DURATION} s)")
-    if np.abs(step - step.mean()).max() > RATE_TOLERANCE * step.mean():
+    if uneven(step, RATE_TOLERANCE):
         raise LogError(f"{path}: not at a fixed rate (intervals {step.min():.4g}..{step.max():.4g} s)")
     theta = np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)])
     tau = np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)])

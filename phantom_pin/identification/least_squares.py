@@ -33,6 +33,13 @@ def rms(residual: np.ndarray, moving: np.ndarray | None = None) -> np.ndarray:
     return np.sqrt((residual**2 * moving).sum(axis=0) / np.maximum(moving.sum(axis=0), 1))
 
 
+def condition_number(phi: np.ndarray) -> float:
+    """Condition number of a stacked base regressor (N, P) after scaling its columns to unit norm
+    (a diagnostic of the excitation and of a fit: the fit is judged by its predicted torques)."""
+    norms = np.linalg.norm(phi, axis=0)
+    return float(np.linalg.cond(phi / np.where(norms > 0, norms, 1.0)))
+
+
 def fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
         prior: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, ...]:
     """Weighted least squares of y (N, 3; N m) on phi (N, 3, P) over the equations ``moving``

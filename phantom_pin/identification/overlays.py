@@ -26,7 +26,7 @@ def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -
     checked to give a physical model of that configuration (describe() and its physical check
     of every link): ParameterFileError otherwise, before anything is written."""
     if not isinstance(fit, Fit):
-        raise InvalidInputError(f"fit: expected a phantom_pin.identification.Fit (estimate), got {fit!r}")
+        raise InvalidInputError(f"expected a phantom_pin.identification.Fit (estimate), got {fit!r}", argument="fit")
     keys = identified_keys(fit.overrides, given, config, friction_keys(fit))
     notes = []
     values, sigma = fit.friction
@@ -44,7 +44,7 @@ def identified_keys(bodies: dict[str, float], given: dict | None, config: Config
     friction's, then ``bodies`` and ``friction``; checked to give a physical model of ``config``
     (describe() and its check of every link): ParameterFileError otherwise."""
     if given is not None and not isinstance(given, dict):
-        raise InvalidInputError(f"given: expected a dict of --params keys or None, got {given!r}")
+        raise InvalidInputError(f"expected a dict of --params keys or None, got {given!r}", argument="given")
     keys: dict[str, object] = {}
     if config is not None:
         if config.name in MODELS:

@@ -48,8 +48,8 @@ def report_of(config: Config) -> ReportParameters:
     """The report's numbers of ``config``; InvalidInputError unless it is written in the
     report's terms (the identification of the report's structure needs them)."""
     if config.report is None:
-        raise InvalidInputError(f"model: {config.name} is not written in the report's terms (its links are "
-                                "given in full); the report's structure cannot be identified on it")
+        raise InvalidInputError(f"{config.name} is not written in the report's terms (its links are "
+                                "given in full); the report's structure cannot be identified on it", argument="model")
     return config.report
 
 

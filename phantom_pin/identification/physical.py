@@ -57,7 +57,7 @@ def pseudo_inertia(pi: np.ndarray) -> np.ndarray:
     return out
 
 
-def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,  # noqa: C901 (one barrier method)
+def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,
             scale: np.ndarray, bodies: Sequence[tuple[np.ndarray, np.ndarray]], positive: Sequence[int],
             consistent: Callable[[np.ndarray], bool], fixed: Sequence[int] = (),
             prior_weight: float = 1e-3) -> np.ndarray:
@@ -74,40 +74,71 @@ def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: 
     optimum (module doc), stepped back towards the prior as far as ``consistent`` needs."""
     weights = np.diag(weights) if np.ndim(weights) == 1 else np.asarray(weights)
     prior, scale = np.asarray(prior, float), np.asarray(scale, float)
-    held = np.asarray(fixed, int)
-    free = np.setdiff1d(np.arange(len(prior)), held)
-    z0 = prior / scale
-    # the cost in z = x / scale over the free entries: 0.5 |K z - k|^2, K = [W matrix scale;
-    # pw 1]. Its singular value decomposition K = U S V^T whitens it, y = S V^T z: 0.5 |y - y_u|^2
-    # (no normal equations: the metric spans 1e-6 to 1e18)
-    d = weights @ matrix * scale
-    stacked = np.vstack([d[:, free], prior_weight * np.eye(len(free))])
-    rhs = np.concatenate([weights @ target - d[:, held] @ z0[held], prior_weight * z0[free]])
-    u, sizes, vt = np.linalg.svd(stacked, full_matrices=False)
-    to_z = vt.T / sizes                                            # z = to_z @ y
-    optimum = u.T @ rhs                                            # y_u
+    whitened = _Whitened(target, weights, matrix, prior, scale, np.asarray(fixed, int), prior_weight)
+    if consistent(whitened.full(whitened.optimum)):
+        return whitened.full(whitened.optimum)
+    barrier = _Barrier(whitened, bodies, positive)
+    x = whitened.full(_barrier_method(barrier, whitened))
+    if consistent(x):
+        return x
+    low, high = 0.0, 1.0          # the barrier's end lies within rounding of the boundary: step back
+    for _ in range(60):
+        middle = (low + high) / 2
+        if consistent(prior + middle * (x - prior)):
+            low = middle
+        else:
+            high = middle
+    return prior + low * (x - prior)
 
-    def full(y: np.ndarray) -> np.ndarray:
-        out = prior.copy()
-        out[free] = (to_z @ y) * scale[free]
+
+class _Whitened:
+    """nearest's cost in z = x / scale over the free entries: 0.5 |K z - k|^2, K = [W matrix scale;
+    pw 1]. Its singular value decomposition K = U S V^T whitens it, y = S V^T z: 0.5 |y - y_u|^2
+    (no normal equations: the metric spans 1e-6 to 1e18); ``optimum`` is y_u, ``to_z`` maps y to
+    z, ``full(y)`` is the parameters x of y (the fixed entries at the prior), ``at_prior`` the y
+    of the prior."""
+
+    def __init__(self, target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,
+                 scale: np.ndarray, held: np.ndarray, prior_weight: float) -> None:
+        self.prior, self.scale = prior, scale
+        self.free = free = np.setdiff1d(np.arange(len(prior)), held)
+        z0 = prior / scale
+        d = weights @ matrix * scale
+        stacked = np.vstack([d[:, free], prior_weight * np.eye(len(free))])
+        rhs = np.concatenate([weights @ target - d[:, held] @ z0[held], prior_weight * z0[free]])
+        u, sizes, vt = np.linalg.svd(stacked, full_matrices=False)
+        self.to_z = vt.T / sizes                                       # z = to_z @ y
+        self.optimum = u.T @ rhs                                       # y_u
+        self.at_prior = vt @ z0[free] * sizes
+
+    def full(self, y: np.ndarray) -> np.ndarray:
+        out = self.prior.copy()
+        out[self.free] = (self.to_z @ y) * self.scale[self.free]
         return out
 
-    if consistent(full(optimum)):
-        return full(optimum)
-    # each body's pseudo-inertia as C + sum_j y_j B_j
-    blocks = []
-    for a, b in bodies:
-        a = np.asarray(a, float)[:, free] * scale[free] @ to_z
-        if np.abs(a).max() > 0:
-            blocks.append((np.array([pseudo_inertia(column) for column in a.T]), pseudo_inertia(b)))
-    rows = to_z[[list(free).index(i) for i in positive if i in free]]      # z_i = rows @ y > 0
-    m = 4 * len(blocks) + len(rows)
+    def cost(self, y: np.ndarray) -> float:
+        return float(0.5 * (y - self.optimum) @ (y - self.optimum))
 
-    def barrier(y: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
-        """(-log det of every J - log z_i of the positive entries, its gradient, its Hessian);
-        None outside the domain."""
+
+class _Barrier:
+    """-log det of every body's pseudo-inertia J - log z_i of the positive entries, over y
+    (_Whitened); each J as C + sum_j y_j B_j. ``size``: the number of barrier terms (4 a body)."""
+
+    def __init__(self, whitened: _Whitened, bodies: Sequence[tuple[np.ndarray, np.ndarray]],
+                 positive: Sequence[int]) -> None:
+        free, scale, to_z = whitened.free, whitened.scale, whitened.to_z
+        self.blocks = []
+        for a, b in bodies:
+            a = np.asarray(a, float)[:, free] * scale[free] @ to_z
+            if np.abs(a).max() > 0:
+                self.blocks.append((np.array([pseudo_inertia(column) for column in a.T]), pseudo_inertia(b)))
+        self.rows = to_z[[list(free).index(i) for i in positive if i in free]]      # z_i = rows @ y > 0
+        self.size = 4 * len(self.blocks) + len(self.rows)
+
+    def __call__(self, y: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
+        """(the barrier, its gradient, its Hessian) at ``y``; None outside the domain."""
         value, gradient, curvature = 0.0, np.zeros(len(y)), np.zeros((len(y), len(y)))
-        for basis, constant in blocks:
+        for basis, constant in self.blocks:
             j = constant + np.tensordot(y, basis, axes=1)
             try:                       # outside the domain (J not positive definite, to rounding)
                 root = np.linalg.cholesky(j)
@@ -119,62 +150,60 @@ def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: 
             value -= 2 * np.log(np.diag(root)).sum()
             gradient -= np.trace(inverse_basis, axis1=1, axis2=2)
             curvature += np.einsum("iab,jba->ij", inverse_basis, inverse_basis)
-        if len(rows):
-            values = rows @ y
+        if len(self.rows):
+            values = self.rows @ y
             if (values <= 0).any():
                 return None
             value -= np.log(values).sum()
-            gradient -= rows.T @ (1 / values)
-            curvature += (rows.T / values**2) @ rows
+            gradient -= self.rows.T @ (1 / values)
+            curvature += (self.rows.T / values**2) @ self.rows
         return value, gradient, curvature
 
-    def cost(y: np.ndarray) -> float:
-        return float(0.5 * (y - optimum) @ (y - optimum))
 
-    y = vt @ z0[free] * sizes                                      # the prior: consistent
+def _barrier_method(barrier: _Barrier, whitened: _Whitened) -> np.ndarray:
+    """The y minimising weight x cost + barrier, the weight grown by GROWTH until the duality gap
+    (barrier.size / weight) is below GAP, from the prior (consistent)."""
+    y = whitened.at_prior
     # the first weight balances the barrier and the cost (m / the prior's cost), but no less than
     # 1e-12 of the barrier's curvature: the Newton system stays solvable in floating point
     at_prior = barrier(y)
     if at_prior is None:  # the prior is consistent (checked by the caller): inside the domain
         raise InvalidInputError("the prior is not physically consistent", argument="prior")
-    weight = max(m / max(cost(y), 1e-300), 1e-12 * np.abs(at_prior[2]).max())
+    weight = max(barrier.size / max(whitened.cost(y), 1e-300), 1e-12 * np.abs(at_prior[2]).max())
     while True:
-        for _ in range(NEWTON_STEPS):
-            evaluated = barrier(y)
-            if evaluated is None:  # the line search keeps y inside; rounding alone could leave
-                break
-            value, gradient, curvature = evaluated
-            g = weight * (y - optimum) + gradient
-            system = weight * np.eye(len(y)) + curvature
-            try:
-                step = -np.linalg.solve(system, g)
-            except np.linalg.LinAlgError:       # rounding, with a J near singular: least squares
-                step = -np.linalg.lstsq(system, g, rcond=None)[0]
-            if not np.isfinite(step).all():
-                break
-            decrement = -g @ step
-            if decrement < 1e-12:
-                break
-            here, alpha = weight * cost(y) + value, 1.0
-            while alpha > 1e-12:
-                trial = barrier(y + alpha * step)
-                if trial is not None and weight * cost(y + alpha * step) + trial[0] <= here - 0.25 * alpha * decrement:
-                    break
-                alpha *= 0.5
-            if alpha <= 1e-12:
-                break
-            y = y + alpha * step
-        if m / weight < GAP:
-            break
+        y = _newton(barrier, whitened.cost, whitened.optimum, y, weight)
+        if barrier.size / weight < GAP:
+            return y
         weight *= GROWTH
-    x = full(y)
-    if consistent(x):
-        return x
-    low, high = 0.0, 1.0          # the barrier's end lies within rounding of the boundary: step back
-    for _ in range(60):
-        middle = (low + high) / 2
-        if consistent(prior + middle * (x - prior)):
-            low = middle
-        else:
-            high = middle
-    return prior + low * (x - prior)
+
+
+def _newton(barrier: _Barrier, cost: Callable[[np.ndarray], float], optimum: np.ndarray, y: np.ndarray,
+            weight: float) -> np.ndarray:
+    """At most NEWTON_STEPS damped Newton steps on weight x cost + barrier from ``y``, each by a
+    backtracking line search that keeps y inside the domain."""
+    for _ in range(NEWTON_STEPS):
+        evaluated = barrier(y)
+        if evaluated is None:  # the line search keeps y inside; rounding alone could leave
+            break
+        value, gradient, curvature = evaluated
+        g = weight * (y - optimum) + gradient
+        system = weight * np.eye(len(y)) + curvature
+        try:
+            step = -np.linalg.solve(system, g)
+        except np.linalg.LinAlgError:       # rounding, with a J near singular: least squares
+            step = -np.linalg.lstsq(system, g, rcond=None)[0]
+        if not np.isfinite(step).all():
+            break
+        decrement = -g @ step
+        if decrement < 1e-12:
+            break
+        here, alpha = weight * cost(y) + value, 1.0
+        while alpha > 1e-12:
+            trial = barrier(y + alpha * step)
+            if trial is not None and weight * cost(y + alpha * step) + trial[0] <= here - 0.25 * alpha * decrement:
+                break
+            alpha *= 0.5
+        if alpha <= 1e-12:
+            break
+        y = y + alpha * step
+    return y

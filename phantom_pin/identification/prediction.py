@@ -31,6 +31,7 @@ import numpy as np
 
 from phantom_pin.config.sampling import random_states
 from phantom_pin.config.types import Limits
+from phantom_pin.identification.least_squares import rms
 
 #: The seeded states inside the stops the prediction is judged over (number, seed).
 STATES, SEED = 200, 0
@@ -115,11 +116,6 @@ def torque_sigma(phi: np.ndarray, covariance: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(np.einsum("njp,pq,njq->nj", phi, covariance, phi), 0.0))
 
 
-def _rms(values: np.ndarray, moving: np.ndarray | None = None) -> np.ndarray:
-    moving = np.ones(values.shape, bool) if moving is None else moving
-    return np.sqrt((values**2 * moving).sum(axis=0) / np.maximum(moving.sum(axis=0), 1))
-
-
 def poorly_excited(information: np.ndarray, typical: np.ndarray, names: tuple[str, ...],
                    threshold: float = POORLY, count: int = NAMED) -> tuple[tuple[str, float], ...]:
     """The directions of the base parameters that ``information`` (P, P: the log's, in the inverse
@@ -166,11 +162,11 @@ def judge(regressor_of: Callable[..., tuple[np.ndarray, np.ndarray]], limits: Li
     parameters' typical sizes; ``names`` theirs; ``spread`` the prior's."""
     theta, dtheta, ddtheta = random_states(limits, STATES, SEED)
     phi_s, tau0_s = regressor_of(theta, dtheta, ddtheta)
-    tau_s = _rms(phi_s @ written + tau0_s)
-    torque = _rms(y, moving)
-    return Prediction(log=_rms(torque_sigma(phi, covariance), moving) / torque,
-                      states=_rms(torque_sigma(phi_s, covariance)) / tau_s,
-                      fit_log=_rms(y - phi @ written, moving) / torque,
-                      prior_log=_rms(y - phi @ beta0, moving) / torque,
-                      prior_states=_rms(phi_s @ (beta0 - written)) / tau_s,
+    tau_s = rms(phi_s @ written + tau0_s)
+    torque = rms(y, moving)
+    return Prediction(log=rms(torque_sigma(phi, covariance), moving) / torque,
+                      states=rms(torque_sigma(phi_s, covariance)) / tau_s,
+                      fit_log=rms(y - phi @ written, moving) / torque,
+                      prior_log=rms(y - phi @ beta0, moving) / torque,
+                      prior_states=rms(phi_s @ (beta0 - written)) / tau_s,
                       directions=poorly_excited(information, typical, names), spread=spread)

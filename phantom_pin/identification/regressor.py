@@ -43,7 +43,7 @@ class Regressor:
 
     def __init__(self, phantom: Phantom) -> None:
         if not isinstance(phantom, Phantom):
-            raise InvalidInputError(f"phantom: expected a phantom_pin.Phantom, got {phantom!r}")
+            raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
         self.phantom = phantom
         self.coupling = self.phantom.coupling
         self.tree = self.coupling.tree

@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.checks import GAIN_BOUNDS, RefusedError, refusal
 from phantom_pin.identification.estimation import GAIN_EVIDENCE, GAIN_NOTED, NEEDS_GENERAL, Fit, estimate
@@ -23,6 +22,7 @@ from phantom_pin.identification.overlays import overlay
 
 __all__ = ["Identification", "RefusedError", "identify", "refusal"]
 from phantom_pin.identification.timing import TIMING_MARGIN
+from phantom_pin.validation import output_path
 
 
 @dataclasses.dataclass(frozen=True)
@@ -114,9 +114,7 @@ def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], f
                text: str | None = None) -> None:
     """An overlay file at ``path``: yaml_text(``comments``, ``keys``), or ``text`` if given; an
     existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
-    path = Path(path)
-    if path.exists() and not force:
-        raise InvalidInputError(f"{path} exists; force=True overwrites it", argument="path")
+    path = output_path(path, force, "path")
     path.write_text(yaml_text(comments, keys) if text is None else text, encoding="utf-8")
 
 

@@ -22,6 +22,7 @@ from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import Encoders, simulate
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log
+from phantom_pin.validation import fixed_rate
 
 
 def _per_joint(value: object, name: str, unit: str, least: float, strict: bool) -> np.ndarray:
@@ -53,14 +54,14 @@ def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, 
     true state (time s from the start, rad, rad/s; not the encoder's) and held, like the
     command, until the next sample. InvalidInputError naming the argument for bad input."""
     if not isinstance(device, Device):
-        raise InvalidInputError(f"device: expected a phantom_pin.Device, got {device!r}")
+        raise InvalidInputError(f"expected a phantom_pin.Device, got {device!r}", argument="device")
     noise = _per_joint(torque_noise, "torque_noise", "N m", 0.0, strict=False)
     gain = _per_joint(gains, "gains", "dimensionless", 0.0, strict=True)
     if disturbance is not None and not callable(disturbance):
         raise InvalidInputError(f"expected a callable (time, theta, dtheta) -> three torques (N m), or None, got "
                                 f"{disturbance!r}", argument="disturbance")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise InvalidInputError(f"seed: expected an integer >= 0, got {seed!r}")
+        raise InvalidInputError(f"expected an integer >= 0, got {seed!r}", argument="seed")
     try:
         t, theta, dtheta, tau = (np.asarray(x, float) for x in (t, theta, dtheta, tau))
     except (TypeError, ValueError):
@@ -72,13 +73,13 @@ def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, 
         raise InvalidInputError("t, theta, dtheta, tau: must be finite (no NaN or inf)")
     step = np.diff(t)
     if not (step > 0).all() or np.ptp(step) > 1e-6 * step.mean():
-        raise InvalidInputError("t: the times must increase at a fixed rate")
+        raise InvalidInputError("the times must increase at a fixed rate", argument="t")
     if quantization:
         device.require("encoder", "quantization")
     follow = tracking(t, theta, dtheta, tau)
     rng = np.random.default_rng(seed)
     commanded = np.zeros((len(t), 3))
-    rate = (len(t) - 1) / (t[-1] - t[0])
+    rate = fixed_rate(t)
     # what the controller sees: simulate's own encoder model (the true state stays the plant's,
     # for the disturbance)
     sense = Encoders(device, theta[0], dtheta[0], rate) if quantization else None

@@ -60,9 +60,10 @@ class Rest:
     def __post_init__(self) -> None:
         theta, tau = (np.asarray(x, dtype=float) for x in (self.theta, self.tau))
         if theta.ndim != 2 or theta.shape[1:] != (3,) or tau.shape != theta.shape or not len(theta):
-            raise LogError(f"rest: expected theta and tau of shape (N, 3), N >= 1, got {theta.shape}, {tau.shape}")
+            raise LogError(f"expected theta and tau of shape (N, 3), N >= 1, got {theta.shape}, {tau.shape}",
+                           argument="rest")
         if not (np.isfinite(theta).all() and np.isfinite(tau).all()):
-            raise LogError("rest: theta and tau must be finite")
+            raise LogError("theta and tau must be finite", argument="rest")
         object.__setattr__(self, "theta", theta)
         object.__setattr__(self, "tau", tau)
 

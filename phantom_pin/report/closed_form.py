@@ -68,7 +68,7 @@ def inverse_kinematics(position: object, params: Lengths, branch: str = "report"
     """
     p = params
     if branch not in ("report", "other"):
-        raise InvalidInputError(f"branch: expected 'report' or 'other', got {branch!r}")
+        raise InvalidInputError(f"expected 'report' or 'other', got {branch!r}", argument="branch")
     target, _ = as_states(position, "position")
     px, py, pz = target[..., 0], target[..., 1], target[..., 2]
     theta1 = np.arctan2(px, pz + p.l1)                              # eq 11
@@ -82,8 +82,8 @@ def inverse_kinematics(position: object, params: Lengths, branch: str = "report"
     if np.any(bad):
         first = np.asarray(target)[bad][0] if target.ndim > 1 else target
         raise UnreachableTargetError(
-            f"position: {np.array2string(first, precision=4)} m is outside the reachable "
-            f"shell {abs(p.l1 - p.l2):.4f} m <= distance from the shoulder <= {p.l1 + p.l2:.4f} m")
+            f"{np.array2string(first, precision=4)} m is outside the reachable "
+            f"shell {abs(p.l1 - p.l2):.4f} m <= distance from the shoulder <= {p.l1 + p.l2:.4f} m", argument="position")
     gamma = np.arccos(np.clip(cos_gamma, -1.0, 1.0))
     alpha = np.arccos(np.clip(cos_alpha, -1.0, 1.0))
     if branch == "report":

@@ -124,7 +124,7 @@ class Viewer:
         """
         p = as_state(position, "position")
         if np.linalg.norm(p) < 1e-3:
-            raise InvalidInputError("position: must be at least 1 mm away from the shoulder")
+            raise InvalidInputError("must be at least 1 mm away from the shoulder", argument="position")
         # meshcat's camera node is rotated so that three.js's y-up camera sees a z-up
         # world: its position is given as (x, z, -y).
         self.scene["/Cameras/default/rotated/<object>"].set_property("position", [p[0], p[2], -p[1]])
@@ -149,7 +149,7 @@ class Viewer:
             raise InvalidInputError(f"times, theta: expected shapes (N,) and (N, 3) with N >= 2, "
                                     f"got {t.shape} and {q.shape}")
         if not np.isfinite(t).all() or np.any(np.diff(t) <= 0):
-            raise InvalidInputError("times: expected finite, strictly increasing seconds")
+            raise InvalidInputError("expected finite, strictly increasing seconds", argument="times")
         if self.robot.model.nq == 3:
             if gimbal is not None:
                 raise InvalidInputError("this model has no stylus gimbal", argument="gimbal")
@@ -172,7 +172,7 @@ class Viewer:
         The arrow follows the tip in later show() and animate() calls."""
         f = as_state(force, "force")
         if not (np.isfinite(scale) and scale > 0):
-            raise InvalidInputError(f"scale: expected a positive number of m/N, got {scale!r}")
+            raise InvalidInputError(f"expected a positive number of m/N, got {scale!r}", argument="scale")
         magnitude = float(np.abs(f).max())  # scaled first: |f| of a tiny f underflows to 0
         direction = f / magnitude if magnitude else f
         length = magnitude * float(np.linalg.norm(direction)) * scale
@@ -214,7 +214,7 @@ class Viewer:
         zero. InvalidInputError naming ``gimbal`` for a model without one or a wrong shape."""
         t, q = self._motion(times, theta, gimbal)
         if not (isinstance(repetitions, int) and repetitions >= 1):
-            raise InvalidInputError(f"repetitions: expected a positive integer, got {repetitions!r}")
+            raise InvalidInputError(f"expected a positive integer, got {repetitions!r}", argument="repetitions")
         # Resample q(t) at the frame rate so that every key frame is a true posture
         # (the browser interpolates each link's pose between key frames).
         samples = np.append(np.arange(0.0, t[-1] - t[0], 1.0 / _FPS), t[-1] - t[0])
