@@ -163,3 +163,11 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
 
     config.option.loadscopereorder = True
     return GroupScheduling(config, log)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """A test that renders in chromium is slow too (a browser per page: 1-3 s of CPU each):
+    pytest -m "not slow" leaves them to CI."""
+    for item in items:
+        if item.get_closest_marker("chromium") is not None:
+            item.add_marker(pytest.mark.slow)

@@ -199,6 +199,7 @@ def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
         urllib.request.urlopen(url, timeout=5)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM])
 def test_show_stops_the_same_way_on_a_signal_right_after_the_url(stop):
     """The signal sent the moment the URL line arrives, twice: `show` exits 0 and takes its
@@ -344,6 +345,7 @@ def _peak_rss_mb(pid: int) -> float:
     return int(status.split("VmHWM:")[1].split()[0]) / 1024
 
 
+@pytest.mark.slow
 def test_huge_check_runs_in_bounded_memory_and_ctrl_c_gives_one_line():
     """check -n 2e7, the most it takes (2 TiB of states at once before, for 1e11): after 3 s of
     CPU (hundreds of its 10 000-state chunks) its peak memory is below 400 MB; Ctrl-C then ends

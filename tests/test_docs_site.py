@@ -101,6 +101,7 @@ def test_the_python_blocks_of_a_page_run(tmp_path, page):
     assert result.returncode == 0, f"{page}:\n{result.stderr[-3000:]}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("page", _pages_with("bash"))
 def test_the_bash_blocks_of_a_page_run(tmp_path, page):
     code = "\n".join(code for name, _, code in blocks("bash") if name == page)

@@ -184,6 +184,7 @@ def test_every_kind_of_force_message_is_run_over_loopback():
     assert sorted({_kind(name) for name in INSTALLED}) == sorted(_kind(name) for name in LOOPBACK)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", LOOPBACK)
 def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
     """The node and the simulated driver started together (the driver holds the stylus for HOLD
@@ -311,6 +312,7 @@ def test_the_documents_print_one_relay():
     assert RELAY_DOCUMENTS and len({relay_block(document) for document in RELAY_DOCUMENTS}) == 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("document", RELAY_DOCUMENTS[-1:])
 def test_the_documented_relay_carries_the_nodes_force_to_the_geomagic_driver(document, tmp_path, monkeypatch):
     """The relay block of ``document``, executed exactly as printed (a script of its own, as a user
@@ -364,6 +366,7 @@ def test_the_documented_relay_carries_the_nodes_force_to_the_geomagic_driver(doc
     assert len(received) > 100 and all(f in sent for f in received), (len(received), len(sent))
 
 
+@pytest.mark.slow
 def test_without_the_node_the_stylus_falls():
     """The simulated driver alone (sawsensablephantom): more than 10 mm down within 3 s of the release."""
     env = _environment(len(INSTALLED))

@@ -40,6 +40,7 @@ def test_the_committed_pictures_are_the_ones_the_script_writes():
     assert sorted(p.stem for p in (ROOT / "docs" / "pictures").glob("*.png")) == sorted(NAMES)
 
 
+@pytest.mark.slow
 @pytest.mark.chromium
 def test_the_script_renders_every_model_and_the_frames(tmp_path, capsys):
     pictures = _script()

@@ -145,6 +145,7 @@ def _stop(process: subprocess.Popen, sig: int) -> tuple[int, str]:
     return process.returncode, err
 
 
+@pytest.mark.slow
 def test_the_node_answers_a_1khz_driver_stream_over_loopback(touch):
     """2000 drivers' messages at 1 kHz: each answered on every topic with its stamp and frame,
     equal to the closed form (1e-12), the share left unanswered printed (the node keeps the
