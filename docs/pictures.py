@@ -25,9 +25,9 @@ import pinocchio as pin
 from PIL import Image, ImageDraw, ImageFont
 
 from phantom_pin import config, load, models
+from phantom_pin._validation import output_path
 from phantom_pin.drivers import openhaptics_origin
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.validation import output_path
 from phantom_pin.viewer import CAMERA_POSITION, Viewer
 from phantom_pin.viewer.screenshot import screenshot
 

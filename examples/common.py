@@ -12,7 +12,7 @@ import matplotlib
 matplotlib.use("Agg")  # headless: figures go to files
 
 from phantom_pin import PhantomPinError  # noqa: E402
-from phantom_pin.validation import output_path  # noqa: E402
+from phantom_pin._validation import output_path  # noqa: E402
 
 
 def parser(description: str) -> argparse.ArgumentParser:

@@ -60,9 +60,9 @@ import math
 
 import numpy as np
 
+from phantom_pin._validation import as_states, finite_result
 from phantom_pin.config import Config, read
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.validation import as_states, finite_result
 
 #: The names of the drivers' joint_states for theta1..theta3 (without prefix).
 JOINT_STATE_NAMES = ("waist", "shoulder", "elbow")

@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
+from phantom_pin._validation import output_path
 from phantom_pin.exceptions import MissingDependencyError
-from phantom_pin.validation import output_path
 
 #: Most points drawn per curve: a longer series is drawn at every k-th sample (its last kept),
 #: which keeps a 20 s run at 1 kHz to a page of about 0.55 MB (excite's default).

@@ -28,9 +28,9 @@ from functools import cache
 
 import numpy as np
 
+from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config.files import read_yaml
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
-from phantom_pin.paths import DESCRIPTION_DIR
 
 #: Where the profiles live: one YAML file per driver, named after its repository.
 PROFILES_DIR = DESCRIPTION_DIR / "config" / "drivers"

@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import types
 
+from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config.models import DEFAULT, MODELS
-from phantom_pin.paths import DESCRIPTION_DIR
 
 PACKAGE_PATH = str(DESCRIPTION_DIR)
 REPOSITORY_PATH = str(DESCRIPTION_DIR.parent.parent)

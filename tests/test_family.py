@@ -17,9 +17,9 @@ import pytest
 import yaml
 
 from phantom_pin import config, describe, load
+from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config import MODELS, models
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.paths import DESCRIPTION_DIR
 
 PREFIXES = ("", "left_")
 

@@ -255,7 +255,7 @@ def test_a_folder_one_cannot_write_in_is_refused_before_any_work(tmp_path, cli, 
     """The one output check of every writer (validation.output_path, which the command line's
     output() calls) asks the folder's permission before any work: --output names the folder.
     (os.access is stubbed: root may write anywhere.)"""
-    monkeypatch.setattr("phantom_pin.validation.os.access", lambda *_: False)
+    monkeypatch.setattr("phantom_pin._validation.os.access", lambda *_: False)
     args = [str(tmp_path / "log.csv") if a == "LOG" else a for a in command.split()]
     code, out, err = cli(*args, "-o", str(tmp_path / "out.yaml" if "identify" in args else tmp_path / "out.csv"))
     assert code == 2 and f"--output: cannot write in {tmp_path}" in err and out == "", err

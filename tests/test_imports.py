@@ -3,7 +3,7 @@
 
 The graph is read from the source (ast), one edge per ``import phantom_pin.x`` or ``from
 phantom_pin.x import y`` (to phantom_pin.x.y where y is a module), wherever it stands in the
-file. A package's own __init__ re-exporting its modules is not an edge of its modules."""
+file, a package's __init__ included (it hands its modules' names on: edges to them)."""
 
 import ast
 import subprocess
@@ -40,10 +40,7 @@ def _imports(name: str, path: Path) -> set[str]:
                 continue
             for alias in node.names:
                 found.add(f"{base}.{alias.name}" if f"{base}.{alias.name}" in MODULES else base)
-    # a package's __init__ imports its own modules to re-export them: not an edge of theirs
-    return {target for target in found if target in MODULES and target != name
-            and not (path.name == "__init__.py" and target.startswith(name + "."))
-            and not (name.startswith(target + ".") and MODULES[target].name == "__init__.py")}
+    return {target for target in found if target in MODULES and target != name}
 
 
 GRAPH = {name: _imports(name, path) for name, path in MODULES.items()}
@@ -59,18 +56,41 @@ def test_the_import_graph_has_no_cycle():
     assert set(order) == set(MODULES)
 
 
-def test_the_layers_point_down():
-    """The model layer (config, description, dynamics, report) imports neither the device, the
-    identification nor the command line; the device not the identification."""
-    upper = {"phantom_pin.config": ("device", "identification", "cli", "dynamics", "description", "viewer"),
-             "phantom_pin.description": ("device", "identification", "cli", "dynamics", "viewer"),
-             "phantom_pin.dynamics": ("device", "identification", "cli", "viewer"),
-             "phantom_pin.report": ("device", "identification", "cli", "viewer"),
-             "phantom_pin.device": ("identification", "cli", "viewer")}
-    wrong = [f"{name} -> {target}" for name, targets in GRAPH.items() for target in targets
-             for layer, above in upper.items() if name.startswith(layer)
-             and any(target.startswith(f"phantom_pin.{a}") for a in above)]
-    assert not wrong
+#: Every module's layer (DEVELOPERS.md, "Map of the package"), by the longest matching prefix
+#: of its name after ``phantom_pin.``: a module imports from its own layer or below only.
+LAYERS = {"exceptions": 0, "_validation": 0, "_paths": 0, "_integration": 0, "_progress": 0, "inertial": 0,
+          "report": 1, "config": 2, "description": 3, "dynamics": 4, "drivers": 4, "profiles": 4,
+          "device": 5, "verification": 5, "plots": 5, "identification": 6, "forces": 6, "codegen": 6,
+          "viewer": 6, "robot_descriptions": 6, "ros2": 7, "sim_driver": 7, "cli": 8, "": 9}
+
+
+def _layer(name: str) -> int | None:
+    """The layer of a module, None where LAYERS names none."""
+    short = name.removeprefix("phantom_pin").removeprefix(".")
+    keys = [key for key in LAYERS if short == key or (key and short.startswith(key + "."))]
+    return LAYERS[max(keys, key=len)] if keys else None
+
+
+def test_every_module_has_a_layer_and_the_layers_point_down():
+    """Every module (each package's __init__ too) is in LAYERS, and imports nothing above its
+    layer: the model (report, config, description, dynamics) neither the device nor the
+    identification, nor the ROS 2 node nor the command line."""
+    assert not [name for name in MODULES if _layer(name) is None]
+    wrong = [f"{name} ({_layer(name)}) -> {target} ({_layer(target)})" for name, targets in GRAPH.items()
+             for target in targets if (_layer(target) or 0) > (_layer(name) or 0)]
+    assert not wrong, wrong
+
+
+def test_the_internal_modules_are_private():
+    """The internal helpers have a leading underscore and no public package hands them on."""
+    internal = {name for name in MODULES if name.rpartition(".")[2].startswith("_") and not
+                name.endswith("__init__") and name.rpartition(".")[2] != "__main__"}
+    assert {"phantom_pin._validation", "phantom_pin._paths", "phantom_pin._integration",
+            "phantom_pin._progress"} <= internal
+    import importlib
+    for name in MODULES:
+        exported = getattr(importlib.import_module(name), "__all__", ())
+        assert not [n for n in exported if n.startswith("_") and not n.endswith("__")], name
 
 
 def test_every_module_imports_in_a_fresh_interpreter_leaves_first():

@@ -1,11 +1,11 @@
-"""phantom_pin.progress: a bar on stderr for long work, only on a terminal, never with --quiet."""
+"""phantom_pin._progress: a bar on stderr for long work, only on a terminal, never with --quiet."""
 
 import io
 import time
 
-from phantom_pin import progress
+from phantom_pin import _progress as progress
+from phantom_pin._progress import Progress
 from phantom_pin.cli import main
-from phantom_pin.progress import Progress
 
 
 class Terminal(io.StringIO):

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
+from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config import MODELS
-from phantom_pin.paths import DESCRIPTION_DIR
 
 #: Debian's python, which has ament_package (python3-ament-package, with ament-cmake).
 SYSTEM_PYTHON = "/usr/bin/python3"

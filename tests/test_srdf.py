@@ -12,8 +12,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config import MODELS, models
-from phantom_pin.paths import DESCRIPTION_DIR
 from test_interop import inside_stops
 
 

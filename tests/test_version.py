@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 
 import phantom_pin
-from phantom_pin.paths import DESCRIPTION_DIR
+from phantom_pin._paths import DESCRIPTION_DIR
 
 ROOT = Path(__file__).resolve().parent.parent
 

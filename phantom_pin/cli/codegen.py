@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from phantom_pin._progress import Progress
 from phantom_pin.cli.common import Once, output, overrides, source
-from phantom_pin.progress import Progress
 
 
 def codegen(args: argparse.Namespace) -> int:

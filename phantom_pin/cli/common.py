@@ -16,11 +16,11 @@ from pathlib import Path
 from typing import Any
 
 from phantom_pin import plots
+from phantom_pin._validation import output_path, within_box
 from phantom_pin.config import DEFAULT, models, read_overrides
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.validation import output_path, within_box
 
 #: The options that choose the model, accepted before or after the command (dest: option).
 MODEL_OPTIONS = {"model": "--model", "config": "--config", "params": "--params", "set": "--set"}

@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers, plots
+from phantom_pin._progress import Progress
+from phantom_pin._validation import fixed_rate
 from phantom_pin.cli.common import (
     Once,
     add_gimbal,
@@ -33,8 +35,6 @@ from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import io
-from phantom_pin.progress import Progress
-from phantom_pin.validation import fixed_rate
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization", "gimbal")} | {

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers, plots, profiles
+from phantom_pin._progress import Progress
 from phantom_pin.cli.common import (
     Once,
     add_plot_option,
@@ -30,7 +31,6 @@ from phantom_pin.identification import page as identification_page
 from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.result import RefusedError, identify, refusal, write_yaml
 from phantom_pin.identification.structures import General
-from phantom_pin.progress import Progress
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
 CONVENTIONS = ("report", "openhaptics")

@@ -12,6 +12,8 @@ from typing import Any
 import numpy as np
 
 from phantom_pin import verification
+from phantom_pin._progress import Progress
+from phantom_pin._validation import within_box
 from phantom_pin.cli import device
 from phantom_pin.cli.common import (
     Once,
@@ -34,8 +36,6 @@ from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import LogError, PhantomPinError
 from phantom_pin.identification import io
-from phantom_pin.progress import Progress
-from phantom_pin.validation import within_box
 
 THREE = {"nargs": 3, "type": float}
 #: The columns show --trajectory reads (s, rad: the report's theta), and a stylus gimbal's

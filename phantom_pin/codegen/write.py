@@ -6,7 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from phantom_pin.validation import output_path
+from phantom_pin._validation import output_path
 
 
 def write_header(text: str, path: str | Path, force: bool = False, name: str = "path",

@@ -7,8 +7,8 @@ import dataclasses
 import os
 from pathlib import Path
 
+from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.paths import DESCRIPTION_DIR
 
 
 @dataclasses.dataclass(frozen=True)

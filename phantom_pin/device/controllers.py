@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from phantom_pin.validation import fixed_rate
+from phantom_pin._validation import fixed_rate
 
 #: The PD gains of the tracking controller (N m/rad, N m s/rad).
 KP, KD = 5.0, 0.05

@@ -8,13 +8,13 @@ from typing import cast
 
 import numpy as np
 
+from phantom_pin._validation import as_states, finite_result, same_batch
 from phantom_pin.config import Config
 from phantom_pin.config.types import STOP_COORDINATES, Motor
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.report import closed_form
-from phantom_pin.validation import as_states, finite_result, same_batch
 
 
 class Device:

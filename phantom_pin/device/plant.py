@@ -5,7 +5,7 @@ located by regula falsi (docs/simulation.md says why each part is what it is; DE
 measurements behind its speed).
 
 States are three Python floats of joint angles (rad) and three of rates (rad/s), as lists;
-torques three floats (N m) at the joints. Floats, an unrolled RK4 (phantom_pin.integration),
+torques three floats (N m) at the joints. Floats, an unrolled RK4 (phantom_pin._integration),
 a solve per friction mode and the torque that holds a stuck joint remembered from one step's
 end for the next step's start are what make the plant as fast as MuJoCo's loop.
 """
@@ -21,10 +21,10 @@ from typing import Literal, cast, overload
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin._integration import rk4_step
 from phantom_pin.device.device import Device
 from phantom_pin.device.run import MAX_STEPS
 from phantom_pin.dynamics.model import solve_spd
-from phantom_pin.integration import rk4_step
 
 #: RK4 substep h (while a stop is engaged) is chosen so that h * OMEGA <= OSCILLATION_SCALE and
 #: h * RATE <= DAMPING_SCALE, OMEGA and RATE the fastest natural frequency (rad/s) and damping

@@ -11,9 +11,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from phantom_pin._validation import as_state
 from phantom_pin.device.device import Device
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.validation import as_state
 
 #: Most samples one call may produce (duration * rate + 1).
 MAX_SAMPLES = 1_000_000

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin._validation import wrap_angle
 from phantom_pin.config.types import Kinematics
 from phantom_pin.dynamics.fast import solve_spd
 from phantom_pin.exceptions import UnreachableTargetError
-from phantom_pin.validation import wrap_angle
 
 #: Newton iterations and position tolerance (m).
 ITERATIONS, TOLERANCE = 60, 1e-13

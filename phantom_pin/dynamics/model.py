@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin._validation import as_states, finite_result, same_batch, within_box
 from phantom_pin.config import MODELS, Config
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, description_of
@@ -31,7 +32,6 @@ from phantom_pin.dynamics.fast import solve_spd as solve_spd  # (where it lived 
 from phantom_pin.dynamics.ik import SEEDS, solve_ik
 from phantom_pin.dynamics.models import models
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.validation import as_states, finite_result, same_batch, within_box
 
 
 class Phantom:

@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 
 from phantom_pin import drivers, profiles
+from phantom_pin._validation import uneven
 from phantom_pin.exceptions import LogError, MissingDataError
 from phantom_pin.identification.io import MIN_DURATION, RATE_TOLERANCE, Log
-from phantom_pin.validation import uneven
 
 #: The message type read.
 JOINT_STATE = "sensor_msgs/msg/JointState"

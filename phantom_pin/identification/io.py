@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin import drivers
+from phantom_pin._validation import as_states, fixed_rate, output_path, uneven
 from phantom_pin.exceptions import LogError
-from phantom_pin.validation import as_states, fixed_rate, output_path, uneven
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
 TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3",

@@ -20,9 +20,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from phantom_pin._validation import as_states, same_batch
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.validation import as_states, same_batch
 
 #: Pinocchio's order of the standard parameters of one body (pin.Inertia.toDynamicParameters).
 INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")

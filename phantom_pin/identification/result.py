@@ -21,8 +21,8 @@ from phantom_pin.identification.io import Log
 from phantom_pin.identification.overlays import overlay
 
 __all__ = ["Identification", "RefusedError", "identify", "refusal"]
+from phantom_pin._validation import output_path
 from phantom_pin.identification.timing import TIMING_MARGIN
-from phantom_pin.validation import output_path
 
 
 @dataclasses.dataclass(frozen=True)

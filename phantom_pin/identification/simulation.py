@@ -17,12 +17,12 @@ from collections.abc import Callable
 
 import numpy as np
 
+from phantom_pin._validation import fixed_rate
 from phantom_pin.device.controllers import tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import Encoders, simulate
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.io import Log
-from phantom_pin.validation import fixed_rate
 
 
 def _per_joint(value: object, name: str, unit: str, least: float, strict: bool) -> np.ndarray:

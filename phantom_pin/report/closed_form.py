@@ -15,9 +15,9 @@ from typing import Protocol
 
 import numpy as np
 
+from phantom_pin._validation import as_states, finite_result, same_batch, wrap_angle
 from phantom_pin.exceptions import InvalidInputError, UnreachableTargetError
 from phantom_pin.report.parameters import ReportParameters
-from phantom_pin.validation import as_states, finite_result, same_batch, wrap_angle
 
 #: Relative slack on the law-of-cosines arguments before a target counts as unreachable.
 _ACOS_SLACK = 1e-12

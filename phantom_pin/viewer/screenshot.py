@@ -12,8 +12,8 @@ import subprocess
 import tempfile
 from pathlib import Path
 
+from phantom_pin._validation import output_path
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.validation import output_path
 
 #: Milliseconds of the page's (virtual) clock before the screenshot: the viewer's scene commands
 #: run in order within it.

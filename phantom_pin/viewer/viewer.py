@@ -22,9 +22,9 @@ import umsgpack
 from meshcat.animation import Animation
 from pinocchio.visualize import MeshcatVisualizer
 
+from phantom_pin._validation import as_state, as_states, output_path
 from phantom_pin.dynamics.loader import load
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.validation import as_state, as_states, output_path
 from phantom_pin.viewer.server import MeshcatServer
 
 #: Camera position (m, base_link) from which the whole workspace is in view. meshcat
