@@ -26,7 +26,7 @@ from phantom_pin.config import DEFAULT
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import bags, excitation, filtering, io, prior, static, timing
+from phantom_pin.identification import bags, excitation, io, prior, selection, static, timing
 from phantom_pin.identification import page as identification_page
 from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.result import RefusedError, identify, refusal, write_yaml
@@ -57,7 +57,7 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
 #: The options of the trajectory fit, which rest postures do not take (dest, option, default).
 TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
                    ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", "held"),
-                   ("min_speed", "--min-speed", filtering.MIN_SPEED), ("cutoff", "--cutoff", 20.0),
+                   ("min_speed", "--min-speed", None), ("cutoff", "--cutoff", 20.0),
                    ("accept", "--accept", False), ("report", "--report", None))
 
 
@@ -157,10 +157,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
                           help="held: each logged torque is a command applied until the next sample (a servo "
                                "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
-    identify.add_argument("--min-speed", type=float, default=filtering.MIN_SPEED, metavar="RAD_PER_S",
+    identify.add_argument("--min-speed", type=float, default=None, metavar="RAD_PER_S",
                           help="fit a joint's torques only where its rate stays above this over the filter's span "
-                               f"(default {filtering.MIN_SPEED:g} rad/s: near rest a joint sticks); 0.05 for a "
-                               "friction with a Stribeck peak after breakaway (docs/identification.md, step 4)")
+                               "(near rest a joint sticks; default: chosen from the log of "
+                               + ", ".join(f"{v:g}" for v in selection.MIN_SPEEDS) + " rad/s on held-out quarters "
+                               "of it, docs/identification.md, step 4)")
     identify.add_argument("--fixed-gains", action="store_true",
                           help="take the log's torques as they are (default: estimate each joint's torque gain "
                                "relative to joint 1, correct the model for it and report it)")

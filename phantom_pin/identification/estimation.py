@@ -37,6 +37,7 @@ from phantom_pin.identification.least_squares import (
 )
 from phantom_pin.identification.least_squares import fit as least_squares
 from phantom_pin.identification.prediction import judge
+from phantom_pin.identification.selection import choose_min_speed
 from phantom_pin.identification.structures import STRUCTURES, Structure
 from phantom_pin.identification.timing import HOLD, TIMINGS, criterion, delay_argument, estimate_delay
 
@@ -58,7 +59,8 @@ NEEDS_GENERAL = 1.2
 class _Regression:
     """A log made ready for the fit: its filtered ``samples``, the structure's ``model``, the
     regressor ``phi`` (N, 3, P) zeroed outside the fitted equations ``moving`` (N, 3), the known
-    torques ``tau0`` (N, 3; N m) and the prior (beta_0, P) or None (prior_spread inf)."""
+    torques ``tau0`` (N, 3; N m), the prior (beta_0, P) or None (prior_spread inf), the friction
+    speed threshold ``min_speed`` (rad/s) and, where it was chosen, each one's held-out residual."""
 
     samples: Samples
     model: Structure
@@ -67,6 +69,8 @@ class _Regression:
     moving: np.ndarray
     beta0: np.ndarray
     prior: tuple[np.ndarray, np.ndarray] | None
+    min_speed: float = MIN_SPEED
+    min_speed_scores: dict[float, float] = dataclasses.field(default_factory=dict)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,7 +95,7 @@ class _Timed:
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
              timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
-             gains: bool = True, min_speed: float = MIN_SPEED, refuse: bool = False) -> Fit:
+             gains: bool = True, min_speed: float | None = MIN_SPEED, refuse: bool = False) -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
     the prior, its friction law the friction columns): the base parameters of ``structure``
     ("general": the rigid body in full; "report": the report's structure, for a model in the
@@ -103,7 +107,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     ``delay`` (s): how long after the positions they belong to the torques were logged, or
     None to estimate it (timing.py). ``gains``: estimate each joint's torque gain relative to
     joint 1 (``Fit.gains``), or take the log's torques as they are (False). ``min_speed``
-    (rad/s): a joint's equation is fitted where its rate stays above it (filtering.MIN_SPEED).
+    (rad/s): a joint's equation is fitted where its rate stays above it (filtering.MIN_SPEED);
+    None: chosen from the log on held-out parts of it (selection.py; ``Fit.min_speed``).
     ``refuse``: raise LogError at the problems found before any fit (checks.before_fit: the
     torques' unit or a joint's sign) instead of fitting and listing them in ``Fit.problems``.
     ``progress(share)`` is called as stages end.
@@ -143,7 +148,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
                                ready.beta0, information, priors.typical(model.matrix, model.scale),
                                model.base_names, spread),
               delay=timed.delay, delay_estimated=delay is None, timing=timing, timing_residual=timed.residuals,
-              ratios=phantom.config.actuation.ratios,
+              ratios=phantom.config.actuation.ratios, min_speed=ready.min_speed,
+              min_speed_scores=ready.min_speed_scores,
               curves=Curves(log.t[samples.index], samples.dtheta, samples.tau, phi @ written + ready.tau0,
                             samples.friction @ x[-6:], moving))
     problems = checks.problems(fit, model, phi, (timed.samples.tau - ready.tau0) * moving, log, phantom)
@@ -160,7 +166,8 @@ def _arguments(log: object, phantom: object, cutoff: object, structure: object, 
         raise InvalidInputError(f"expected a phantom_pin.identification.Log (read_log), got {log!r}", argument="log")
     if not isinstance(phantom, Phantom):
         raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
-    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight), ("min_speed", min_speed)):
+    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)) + (
+            () if min_speed is None else (("min_speed", min_speed),)):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
             raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
     spread = priors.spread_argument(prior_spread)
@@ -184,23 +191,26 @@ def _arguments(log: object, phantom: object, cutoff: object, structure: object, 
 
 
 def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timing: str, spread: float,
-                delay: float, min_speed: float, refuse: bool) -> _Regression:
+                delay: float, min_speed: float | None, refuse: bool) -> _Regression:
     """Stage 1: the log filtered, the regressor, the prior, and the refusals that need no fit
     (with ``refuse``, the torques' size and sign as well)."""
     model = STRUCTURES[structure](phantom)
+    beta0, spread_covariance = priors.base_prior(model.matrix, model.offset, model.prior, model.scale,
+                                                 spread if np.isfinite(spread) else 1.0)
+    prior = (beta0, spread_covariance) if np.isfinite(spread) else None
+    scores: dict[float, float] = {}
+    if min_speed is None:
+        min_speed, scores = choose_min_speed(log, phantom, model, cutoff, timing, delay, prior)
     samples = filtered(log, cutoff, phantom.config.actuation.friction, timing, delay, min_speed)
     checks.refuse_motion(samples.moving, cutoff, min_speed)
     phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     moving = samples.moving                  # the equations fitted: joints clear of rest
     phi = phi * moving[..., None]
-    beta0, spread_covariance = priors.base_prior(model.matrix, model.offset, model.prior, model.scale,
-                                                 spread if np.isfinite(spread) else 1.0)
     if refuse:
         found = checks.before_fit((samples.tau - tau0) * moving, phi @ (model.matrix @ model.prior + model.offset))
         if found:
             raise checks.RefusedError(found)
-    return _Regression(samples, model, phi, tau0, moving, beta0,
-                       (beta0, spread_covariance) if np.isfinite(spread) else None)
+    return _Regression(samples, model, phi, tau0, moving, beta0, prior, min_speed, scores)
 
 
 def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gains: bool) -> _Timed:

@@ -53,7 +53,10 @@ class Fit:
     ``timing`` the torque timing fitted (timing.TIMINGS); ``timing_residual``: each timing's
     weighted residual (the sum over the joints of the residual's mean square over the
     torque's, at zero delay when it is estimated, else at the given one), the smaller fitting
-    the log better. ``curves``: the samples fitted, measured and predicted (Curves)."""
+    the log better. ``curves``: the samples fitted, measured and predicted (Curves).
+    ``min_speed`` (rad/s): the friction speed threshold fitted with; ``min_speed_scores``: each
+    threshold's held-out weighted residual where it was chosen from the log (selection.py), else
+    empty."""
 
     structure: str
     names: tuple[str, ...]
@@ -83,6 +86,8 @@ class Fit:
     timing_residual: dict[str, float] = dataclasses.field(default_factory=dict)
     ratios: tuple[float, float, float] | None = None
     curves: Curves | None = None
+    min_speed: float = 0.01          # filtering.MIN_SPEED (not imported: fit.py stays below filtering)
+    min_speed_scores: dict[float, float] = dataclasses.field(default_factory=dict)
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:

@@ -16,7 +16,6 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.checks import GAIN_BOUNDS, RefusedError, refusal
 from phantom_pin.identification.estimation import GAIN_EVIDENCE, GAIN_NOTED, NEEDS_GENERAL, Fit, estimate
-from phantom_pin.identification.filtering import MIN_SPEED
 from phantom_pin.identification.io import Log
 from phantom_pin.identification.overlays import overlay
 
@@ -46,7 +45,7 @@ class Identification:
         lines = [f"{self.rows} samples at {self.rate:.6g} Hz, {fit.samples} used (filtered at {self.cutoff:g} Hz); "
                  f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
                  "(a diagnostic: the fit is judged by its predicted torques)"]
-        lines += timing_lines(fit) + gain_lines(fit) + fit.prediction.lines()
+        lines += timing_lines(fit) + [speed_line(fit)] + gain_lines(fit) + fit.prediction.lines()
         lines.append("residual RMS per joint [N m]: " + ", ".join(
             f"{r:.3g} ({100 * r / s:.2f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms))
             + "; of the written parameters: " + ", ".join(f"{r:.3g}" for r in fit.written_rms))
@@ -87,7 +86,7 @@ class Identification:
                  "# (docs/identification.md). SI units.",
                  f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
                  "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms)]
-        lines += [f"# {line}" for line in timing_lines(fit) + gain_lines(fit)]
+        lines += [f"# {line}" for line in timing_lines(fit) + [speed_line(fit)] + gain_lines(fit)]
         lines += [f"# warning: {w}" for w in (timing_warning(fit), gain_warning(fit)) if w is not None]
         lines += [f"# {line}" for line in fit.prediction.lines()]
         lines += [f"# warning: {line}" for line in fit.prediction.warnings()]
@@ -120,7 +119,7 @@ def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], f
 
 def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str = "general",
              timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
-             gains: bool = True, min_speed: float = MIN_SPEED, accept: bool = False,
+             gains: bool = True, min_speed: float | None = None, accept: bool = False,
              given: dict[str, object] | None = None, source: str = "a log",
              progress: Callable[[float], None] | None = None) -> Identification:
     """Identify the device of ``log`` (read_log: theta rad, tau N m in the report's convention)
@@ -135,6 +134,15 @@ def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str
         raise RefusedError(fit.problems)
     keys, notes = overlay(fit, given, phantom.config)  # checked: a physical model, or nothing written
     return Identification(fit, keys, notes, source, log.rate, log.t.size, cutoff)
+
+
+def speed_line(fit: Fit) -> str:
+    """The friction speed threshold fitted with: given, or chosen on held-out parts of the log."""
+    if not fit.min_speed_scores:
+        return f"friction speed threshold: {fit.min_speed:g} rad/s (given; a joint's equation is fitted above it)"
+    return (f"friction speed threshold: {fit.min_speed:g} rad/s, chosen on held-out quarters of the log (weighted "
+            "residual: " + ", ".join(f"{speed:g} rad/s {100 * np.sqrt(score / 3):.3g} %" for speed, score in
+                                     fit.min_speed_scores.items()) + " of the torque RMS)")
 
 
 def timing_lines(fit: Fit) -> list[str]:
