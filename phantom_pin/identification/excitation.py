@@ -177,7 +177,8 @@ class _Problem:
         typical, weight = self.typical, self.amplitude_weight
         if unit[0] > 1e-10 * unit[-1]:
             weighted = np.linalg.eigvalsh(gram * np.outer(typical, typical) / len(phi))
-            return 0.5 * np.log(unit[-1] / unit[0]) - weight * 0.5 * np.log(weighted).mean()
+            if weighted[0] > 0:   # else rounding took the smallest below zero: the singular values below
+                return 0.5 * np.log(unit[-1] / unit[0]) - weight * 0.5 * np.log(weighted).mean()
         size = np.linalg.svd(phi * typical / np.sqrt(len(phi)), compute_uv=False)
         return np.log(condition_number(phi)) - weight * np.log(size).mean()
 
