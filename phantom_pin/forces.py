@@ -35,6 +35,8 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.profiles import Profile
 
+__all__ = ["Renderer", "Frames", "Rendered"]
+
 #: Three numbers: a sequence or a (3,) array.
 Vector = Sequence[float] | np.ndarray
 #: The smallest singular value of J_p (m/rad) below which the inverse is damped: 2 mm/rad, a

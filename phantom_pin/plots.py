@@ -27,6 +27,8 @@ import numpy as np
 from phantom_pin._validation import output_path
 from phantom_pin.exceptions import MissingDependencyError
 
+__all__ = ["Curve", "Limit", "Panel", "figure_svg", "page", "run_page", "write_page", "thinned", "require_matplotlib"]
+
 #: Most points drawn per curve: a longer series is drawn at every k-th sample (its last kept),
 #: which keeps a 20 s run at 1 kHz to a page of about 0.55 MB (excite's default).
 MAX_POINTS = 2000

@@ -32,6 +32,8 @@ from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config.files import read_yaml
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 
+__all__ = ["Profile", "JointStates", "ForceCommand", "StateTopic", "Qos", "load", "names", "relayed"]
+
 #: Where the profiles live: one YAML file per driver, named after its repository.
 PROFILES_DIR = DESCRIPTION_DIR / "config" / "drivers"
 #: OpenHaptics' angle i = _SIGN[i] * theta_i (phantom_pin.drivers).

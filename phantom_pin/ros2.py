@@ -57,6 +57,8 @@ from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.forces import Frames, Renderer, Vector
 from phantom_pin.profiles import Profile, Qos
 
+__all__ = ["Bridge", "DriverBridge", "Output", "make_node", "spin", "run", "message_type", "fill_force"]
+
 #: The topics, by role: the input and the five outputs (module doc), relative names.
 TOPICS = {"joint_states": "joint_states", "wrench": "wrench", "gravity_torque": "gravity_torque",
           "gravity_torque_openhaptics": "gravity_torque_openhaptics", "tip_pose": "tip_pose",

@@ -35,6 +35,8 @@ from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.profiles import Profile, StateTopic
 from phantom_pin.ros2 import _qos, message_type, run
 
+__all__ = ["DriverSimulation", "make_node", "loop", "spin"]
+
 #: The servo loop's period (s): OpenHaptics' 1 kHz.
 PERIOD = 1e-3
 #: The most servo ticks one pass of the real-time loop catches up (a machine too busy to keep

@@ -26,6 +26,8 @@ from phantom_pin._validation import uneven
 from phantom_pin.exceptions import LogError, MissingDataError
 from phantom_pin.identification.io import MIN_DURATION, RATE_TOLERANCE, Log
 
+__all__ = ["Recording", "read_bag", "is_bag"]
+
 #: The message type read.
 JOINT_STATE = "sensor_msgs/msg/JointState"
 #: An interval between stamps longer than this many times the median interval is a gap.

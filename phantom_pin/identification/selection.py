@@ -24,6 +24,8 @@ from phantom_pin.identification.io import Log
 from phantom_pin.identification.least_squares import fit as least_squares
 from phantom_pin.identification.structures import Structure
 
+__all__ = ["choose_min_speed"]
+
 #: The thresholds tried (rad/s), and the parts of the log each is judged on.
 MIN_SPEEDS, FOLDS = (0.01, 0.02, 0.05, 0.1), 4
 #: A threshold whose held-out residual is within this share of the best's counts as as good.

@@ -33,6 +33,8 @@ from phantom_pin.identification import prior as priors
 from phantom_pin.identification.io import Log
 from phantom_pin.identification.structures import General, Structure
 
+__all__ = ["Rest", "Gravity", "rest_of", "estimate_gravity"]
+
 #: Seeded postures that give the gravity directions, and the check's (number, seed).
 GRAVITY_POSTURES, CHECK_POSTURES, SEED = 2000, 500, 0
 #: A singular value of the gravity regressor below this share of the largest is no direction.
