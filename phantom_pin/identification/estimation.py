@@ -32,6 +32,7 @@ from phantom_pin.identification.least_squares import (
     condition_number,
     inverse_information,
     marginal,
+    metric_root,
     rms,
     solve_gains,
 )
@@ -199,10 +200,11 @@ def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timin
                                                  spread if np.isfinite(spread) else 1.0)
     prior = (beta0, spread_covariance) if np.isfinite(spread) else None
     scores: dict[float, float] = {}
-    if min_speed is None:
-        min_speed, scores = choose_min_speed(log, phantom, model, cutoff, timing, delay, prior)
-    samples = filtered(log, cutoff, phantom.config.actuation.friction, timing, delay, min_speed)
-    checks.refuse_motion(samples.moving, cutoff, min_speed)
+    if min_speed is None:          # each threshold's filtered log checked there, the chosen one's kept
+        min_speed, scores, samples = choose_min_speed(log, phantom, model, cutoff, timing, delay, prior)
+    else:
+        samples = filtered(log, cutoff, phantom.config.actuation.friction, timing, delay, min_speed)
+        checks.refuse_motion(samples.moving, cutoff, min_speed)
     phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     moving = samples.moving                  # the equations fitted: joints clear of rest
     phi = phi * moving[..., None]
@@ -259,10 +261,7 @@ def _projection(ready: _Regression, beta: np.ndarray, covariance: np.ndarray,
         loose = ", ".join(model.base_names[k].split(" = ")[0][:40] for k in np.flatnonzero(~np.isfinite(sigma))[:3])
         raise LogError(f"not exciting enough for the log alone: it leaves {loose} unconstrained; identify with "
                        "the prior (a finite prior_spread)", argument="prior_spread")
-    correlation = covariance / np.outer(sigma, sigma)
-    values, vectors = np.linalg.eigh(correlation)      # root^T root = covariance^-1 (no Cholesky: it
-    root = (vectors / np.sqrt(np.maximum(values, 1e-300))).T / sigma   # may be singular to rounding)
-    return model.nearest(beta, root, prior_weight), sigma
+    return model.nearest(beta, metric_root(covariance), prior_weight), sigma
 
 
 

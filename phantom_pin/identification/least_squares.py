@@ -92,6 +92,15 @@ def inverse_information(information: np.ndarray) -> np.ndarray:
     return covariance
 
 
+def metric_root(covariance: np.ndarray, relative_floor: float = 0.0) -> np.ndarray:
+    """A root W with W^T W = covariance^-1 (P, P), from the eigenvectors of the correlation (no
+    Cholesky: it may be singular to rounding), its eigenvalues floored at ``relative_floor`` of
+    the largest (and 1e-300); the standard deviations must be finite."""
+    sigma = np.sqrt(np.diag(covariance))
+    values, vectors = np.linalg.eigh(covariance / np.outer(sigma, sigma))
+    return (vectors / np.sqrt(np.maximum(values, max(1e-300, relative_floor * values.max())))).T / sigma
+
+
 def marginal(information: np.ndarray, p: int) -> np.ndarray:
     """The information of the first ``p`` parameters with the others estimated alongside: the
     Schur complement of the others' block (their covariance block's inverse)."""

@@ -19,7 +19,7 @@ import numpy as np
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import LogError
 from phantom_pin.identification import checks
-from phantom_pin.identification.filtering import filtered
+from phantom_pin.identification.filtering import Samples, filtered
 from phantom_pin.identification.io import Log
 from phantom_pin.identification.least_squares import fit as least_squares
 from phantom_pin.identification.structures import Structure
@@ -33,30 +33,35 @@ TIE = 0.02
 
 
 def choose_min_speed(log: Log, phantom: Phantom, model: Structure, cutoff: float, timing: str, delay: float,
-                     prior: tuple[np.ndarray, np.ndarray] | None) -> tuple[float, dict[float, float]]:
-    """(the threshold chosen, rad/s; each threshold's held-out weighted residual: the module doc)
-    of ``log`` on ``model`` (a Structure of ``phantom``) filtered at ``cutoff`` Hz with the
-    torques at ``timing`` and ``delay`` s; ``prior``: (beta_0, P) or None. LogError where no
-    threshold leaves enough motion."""
+                     prior: tuple[np.ndarray, np.ndarray] | None) -> tuple[float, dict[float, float], Samples]:
+    """(the threshold chosen, rad/s; each threshold's held-out weighted residual: the module doc;
+    the log filtered for the chosen one) of ``log`` on ``model`` (a Structure of ``phantom``)
+    filtered at ``cutoff`` Hz with the torques at ``timing`` and ``delay`` s; ``prior``:
+    (beta_0, P) or None. LogError (the smallest threshold's) where none leaves enough motion."""
     law = phantom.config.actuation.friction
-    moving, samples = {}, None
+    candidates: dict[float, Samples] = {}
+    refused: LogError | None = None
     for speed in MIN_SPEEDS:
         candidate = filtered(log, cutoff, law, timing, delay, speed)
         try:
             checks.refuse_motion(candidate.moving, cutoff, speed)
-        except LogError:
+        except LogError as error:
+            refused = refused or error
             continue
-        moving[speed], samples = candidate.moving, samples or candidate
-    if samples is None:
-        checks.refuse_motion(filtered(log, cutoff, law, timing, delay, MIN_SPEEDS[0]).moving, cutoff, MIN_SPEEDS[0])
-        raise AssertionError("unreachable: refuse_motion raised")       # pragma: no cover
+        candidates[speed] = candidate
+    if not candidates:
+        assert refused is not None
+        raise refused
+    moving = {speed: candidate.moving for speed, candidate in candidates.items()}
+    samples = next(iter(candidates.values()))         # all alike but for moving
     phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     y = samples.tau - tau0
     judged = moving[max(moving)]                                           # where every threshold fits
     part = np.minimum((np.arange(len(y)) * FOLDS) // len(y), FOLDS - 1)
     scores = {speed: _held_out(phi, y, mask, judged, part, prior) for speed, mask in moving.items()}
     best = min(scores.values())
-    return min(speed for speed, score in scores.items() if score <= (1 + TIE) * best), scores
+    chosen = min(speed for speed, score in scores.items() if score <= (1 + TIE) * best)
+    return chosen, scores, candidates[chosen]
 
 
 def _held_out(phi: np.ndarray, y: np.ndarray, mask: np.ndarray, judged: np.ndarray, part: np.ndarray,

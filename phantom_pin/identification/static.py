@@ -31,6 +31,7 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.io import Log
+from phantom_pin.identification.least_squares import metric_root
 from phantom_pin.identification.structures import General, Structure
 
 __all__ = ["Rest", "Gravity", "rest_of", "estimate_gravity"]
@@ -230,10 +231,7 @@ def _scaled(a: np.ndarray, y: np.ndarray, gamma0: np.ndarray,
 
 def _projection(model: Structure, beta: np.ndarray, covariance: np.ndarray, prior_weight: float) -> np.ndarray:
     """The physical parameters nearest to ``beta`` in the metric of ``covariance`` (physical.nearest)."""
-    sigma = np.sqrt(np.diag(covariance))
-    values, vectors = np.linalg.eigh(covariance / np.outer(sigma, sigma))
-    root = (vectors / np.sqrt(np.maximum(values, 1e-12 * values.max()))).T / sigma
-    return model.nearest(beta, root, prior_weight)
+    return model.nearest(beta, metric_root(covariance, 1e-12), prior_weight)
 
 
 def _fewest(a: np.ndarray, prior: np.ndarray, rank: int) -> tuple[int, ...]:
