@@ -150,7 +150,7 @@ def main() -> None:
     parser.add_argument("--model", default="premium_1_5")
     parser.add_argument("--rounds", type=int, default=15)
     args = parser.parse_args()
-    phantom = Phantom(args.model)
+    phantom = Phantom.from_model(args.model)
     theta, dtheta, ddtheta = random_states(phantom.config.limits, STATES, seed=30)
     tree = phantom.coupling.tree
     mimic = []

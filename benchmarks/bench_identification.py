@@ -69,7 +69,7 @@ def main_() -> None:
     truth_random = DEVICE.phantom.inverse_dynamics(*random)
     for structure in ("general", "report"):
         fit = estimate(log, model, structure=structure)
-        device = Device(describe(overrides=overlay(fit)[0]))
+        device = Device(Phantom(describe(overrides=overlay(fit)[0])))
         trajectory = rms(device.phantom.inverse_dynamics(q, v, a) + device.friction(v) - truth_trajectory,
                          truth_trajectory)
         states_error = rms(device.phantom.inverse_dynamics(*random) - truth_random, truth_random)

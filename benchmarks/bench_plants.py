@@ -15,10 +15,10 @@ import time
 
 import numpy as np
 
-from phantom_pin import Device, describe, simulate
+from phantom_pin import Device, Phantom, describe, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 
-DEVICE = Device(describe())
+DEVICE = Device(Phantom(describe()))
 GRAVITY = DEVICE.phantom.gravity
 START = np.array([0.0, 0.3, 0.4])
 DURATION = 2.0

@@ -305,8 +305,9 @@ class Figures:
 
     def __init__(self, setup: Setup, iterations: int, restarts: int) -> None:
         self.setup, self.iterations, self.restarts = setup, iterations, restarts
-        self.device, self.truth = Device(setup.truth), Phantom(setup.truth)
-        self.uneven = Device(setup.uneven)           # the same rigid body, each joint's own friction
+        self.truth = Phantom(setup.truth)
+        self.device = Device(self.truth)
+        self.uneven = Device(Phantom(setup.uneven))         # the same rigid body, each joint's own friction
         self.logs: dict[tuple, io.Log] = {}
         held_out = optimise(setup.prior, iterations=5, restarts=1, seed=7).trajectory(np.arange(500) / 100.0)
         self.held_out = {"trajectory": held_out, "states": random_states(setup.prior.config.limits, 500, 7)}

@@ -24,7 +24,7 @@ import numpy as np
 import pinocchio as pin
 from PIL import Image, ImageDraw, ImageFont
 
-from phantom_pin import config, load, models
+from phantom_pin import config, describe, load, models
 from phantom_pin._validation import output_path
 from phantom_pin.drivers import openhaptics_origin
 from phantom_pin.exceptions import PhantomPinError
@@ -65,7 +65,7 @@ def _render(viewer: Viewer, png: Path, force: bool) -> Path:
 
 def model_picture(name: str, png: Path, force: bool = False) -> Path:
     """``name`` in its SRDF posture ``zero`` (the report's zero configuration), written to ``png``."""
-    with Viewer(load(name)) as viewer:
+    with Viewer(load(describe(name))) as viewer:
         viewer.set_camera(_camera(name))
         viewer.show(config.read(name).limits.postures["zero"])
         return _render(viewer, png, force)
@@ -74,7 +74,7 @@ def model_picture(name: str, png: Path, force: bool = False) -> Path:
 def frame_poses(name: str = "touch") -> dict[str, pin.SE3]:
     """The figure's frames in base_link (m): base_link itself, report_s (the URDF's fixed frame)
     and OpenHaptics' (frame s's axes, its origin at -openhaptics_origin in frame s)."""
-    robot = load(name)
+    robot = load(describe(name))
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, robot.q0)
     s = pin.SE3(data.oMf[robot.model.getFrameId("report_s")])
@@ -114,7 +114,7 @@ def frames_picture(png: Path, force: bool = False, name: str = "touch") -> Path:
     legend, written to ``png``."""
     output_path(png, force, "png")  # before rendering: nothing is written on a refusal
     poses = frame_poses(name)
-    with Viewer(load(name)) as viewer:
+    with Viewer(load(describe(name))) as viewer:
         viewer.set_camera(_camera(name))
         viewer.show(FRAMES_THETA)
         for label, marker, _ in FRAMES:

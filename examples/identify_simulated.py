@@ -39,25 +39,25 @@ def main(argv: list[str] | None) -> None:
     parser.add_argument("--iterations", type=int, default=30, help="excitation optimiser iterations")
     args = parser.parse_args(argv)
     path = common.output(args, "identify_simulated.png")
-    model = Phantom(describe())                               # the report's model: the prior
-    device = Device(describe("premium_1_5_cad", overrides={"actuation.friction.viscous": VISCOUS,
-                                                           "actuation.friction.coulomb": COULOMB}))
-    design = optimise(model, iterations=args.iterations, restarts=1)
+    phantom = Phantom(describe())                             # the report's model: the prior
+    device = Device(Phantom(describe("premium_1_5_cad", overrides={"actuation.friction.viscous": VISCOUS,
+                                                                   "actuation.friction.coulomb": COULOMB})))
+    design = optimise(phantom, iterations=args.iterations, restarts=1)
     print(f"excitation: condition number {design.condition:.3g} (general), {design.report_condition:.3g} (report)")
     log = run_device(device, design, args.duration, 0)
-    fits = {structure: estimate(log, model, structure=structure) for structure in ("general", "report")}
+    fits = {structure: estimate(log, phantom, structure=structure) for structure in ("general", "report")}
     for structure, fit in fits.items():
         print(f"{structure}: residual RMS per joint [N m] " + " ".join(f"{r:.3g}" for r in fit.rms)
               + "".join(f"; problem: {p}" for p in fit.problems))
     print(recommendation(fits["general"]) or "the report's structure suffices")
     # the held-out motion: each model's inverse dynamics and friction against the device's
     t = np.arange(5001) / 1000
-    theta, dtheta, ddtheta = optimise(model, iterations=1, restarts=1, seed=7).trajectory(t)
+    theta, dtheta, ddtheta = optimise(phantom, iterations=1, restarts=1, seed=7).trajectory(t)
     truth = device.phantom.inverse_dynamics(theta, dtheta, ddtheta) + device.friction(dtheta)
-    predictions = {"report's parameters": model.inverse_dynamics(theta, dtheta, ddtheta)
-                   + model.config.actuation.friction.torque(dtheta)}
+    predictions = {"report's parameters": phantom.inverse_dynamics(theta, dtheta, ddtheta)
+                   + phantom.config.actuation.friction.torque(dtheta)}
     for structure, fit in fits.items():
-        identified = Device(describe(overrides=overlay(fit)[0]))
+        identified = Device(Phantom(describe(overrides=overlay(fit)[0])))
         predictions[f"identified ({structure})"] = identified.phantom.inverse_dynamics(theta, dtheta, ddtheta) \
             + identified.friction(dtheta)
     errors = {name: float(np.sqrt(((p - truth) ** 2).mean() / (truth**2).mean())) for name, p in predictions.items()}

@@ -1,5 +1,12 @@
 """phantom_pin: the PHANToM haptic arms as URDF/MJCF descriptions, Pinocchio models and the
-report's equations, from one typed configuration per device (phantom_pin.models())."""
+report's equations, from one typed configuration per device (phantom_pin.models()).
+
+One way to make each object: ``Phantom(description)`` (``Phantom()`` the default model;
+``Phantom.from_model(name)``, ``Phantom.from_folder(path)``), ``Device(phantom)``
+(``Device.from_model(name)``), ``load(description)`` (``load_files(loader)`` for a PhantomLoader's
+files), each Description from ``describe(name or folder, overrides=...)``. A Phantom is passed as
+``phantom`` and a Device as ``device`` wherever a function takes one (``check(phantom)``,
+``simulate(..., device=)``, ``identification.optimise(phantom)``)."""
 
 from importlib.metadata import PackageNotFoundError, version
 
@@ -7,7 +14,8 @@ from phantom_pin import drivers
 from phantom_pin.config import Config, models
 from phantom_pin.description.build import Description, describe
 from phantom_pin.device import Device, SimulationResult, simulate
-from phantom_pin.dynamics.loader import PhantomLoader, load
+from phantom_pin.device.mujoco_plant import simulate_mujoco
+from phantom_pin.dynamics.loader import PhantomLoader, load, load_files
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import (
                                     InvalidInputError,
@@ -19,13 +27,14 @@ from phantom_pin.exceptions import (
 )
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
+from phantom_pin.verification import check
 
 try:
     __version__ = version("phantom_pin")
 except PackageNotFoundError:  # a source tree on sys.path, not installed
     __version__ = "unknown"
 
-__all__ = ["__version__", "Phantom", "Device", "simulate", "SimulationResult", "load", "PhantomLoader", "Description",
-           "describe", "models", "Config", "ReportParameters", "closed_form", "drivers", "PhantomPinError",
-           "InvalidInputError", "ParameterFileError", "UnreachableTargetError", "MissingDataError",
-           "MissingDependencyError"]
+__all__ = ["__version__", "Phantom", "Device", "simulate", "simulate_mujoco", "SimulationResult", "load", "load_files",
+           "PhantomLoader", "Description", "describe", "check", "models", "Config", "ReportParameters", "closed_form",
+           "drivers", "PhantomPinError", "InvalidInputError", "ParameterFileError", "UnreachableTargetError",
+           "MissingDataError", "MissingDependencyError"]

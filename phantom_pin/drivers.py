@@ -176,19 +176,20 @@ def _rigid(pose: np.ndarray, argument: str) -> None:
                                 "last row 0 0 0 1)", argument=argument)
 
 
-def openhaptics_origin(model: object = None) -> np.ndarray:
+def openhaptics_origin(phantom: object = None) -> np.ndarray:
     """Frame s's origin (the zero posture's gimbal centre) in OpenHaptics' coordinates (m),
     (3,): ``openhaptics_shoulder`` of the model's gimbal.yaml less the shoulder's position in
-    frame s, (0, l2, -l1). ``model``: a Config, or anything carrying one as ``.config`` (Phantom,
-    Description), of a model with a gimbal; None: the shipped Touch's (an ESTIMATE: the
-    module's doc). InvalidInputError naming ``model`` for a model without a gimbal.yaml."""
-    if model is None:
+    frame s, (0, l2, -l1). ``phantom``: a Phantom of a model with a gimbal (or anything carrying
+    its Config as ``.config``, a Description; or the Config itself); None: the shipped Touch's (an
+    ESTIMATE: the module's doc). InvalidInputError naming ``phantom`` for a model without a
+    gimbal.yaml."""
+    if phantom is None:
         return _touch_origin().copy()
-    config = getattr(model, "config", model)
+    config = getattr(phantom, "config", phantom)
     if not isinstance(config, Config) or config.gimbal is None:
-        raise InvalidInputError(f"expected the Config (or Phantom) of a model with a stylus gimbal "
-                                f"(gimbal.yaml, whose openhaptics_shoulder places OpenHaptics' origin), got {model!r}",
-                                argument="model")
+        raise InvalidInputError(f"expected the Phantom (or Config) of a model with a stylus gimbal (gimbal.yaml, "
+                                f"whose openhaptics_shoulder places OpenHaptics' origin), got {phantom!r}",
+                                argument="phantom")
     k = config.kinematics
     return np.array(config.gimbal.openhaptics_shoulder) - [0.0, k.l2, -k.l1]
 

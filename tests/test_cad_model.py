@@ -1,7 +1,7 @@
 """The configuration premium_1_5_cad (mahilab/Phantom's CAD mass properties) against an
 independent SymPy derivation in mahilab's own DH frames (tests/cad_reference.py), at seeded
 states inside the stops: (a) a numeric model built by hand in Pinocchio from the YAML of
-robots/phantom_description/config/premium_1_5_cad, (b) phantom_pin.Phantom("premium_1_5_cad")."""
+robots/phantom_description/config/premium_1_5_cad, (b) phantom_pin.Phantom.from_model("premium_1_5_cad")."""
 
 from pathlib import Path
 
@@ -105,7 +105,7 @@ def test_phantom_premium_1_5_cad_matches_the_reference(reference):
     from phantom_pin import Phantom
 
     thetas, ref_m, ref_n = reference
-    phantom = Phantom("premium_1_5_cad")
+    phantom = Phantom.from_model("premium_1_5_cad")
     assert _relative(np.array([phantom.mass_matrix(t) for t in thetas]), ref_m) < TOLERANCE
     assert _relative(np.array([phantom.gravity(t) for t in thetas]), ref_n) < TOLERANCE
 

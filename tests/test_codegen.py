@@ -267,7 +267,7 @@ def test_servo_loop_example_closes_the_loop_like_simulate(name, tmp_path):
                    check=True, capture_output=True, text=True)
     run = subprocess.run([str(tmp_path / "servo")], check=True, capture_output=True, text=True).stdout
     log = np.array([[float(x) for x in line.split()] for line in run.splitlines()])
-    phantom = Phantom(name)
+    phantom = Phantom.from_model(name)
     rest, stiffness, damping = np.array([0.3, 0.5, 0.9]), 1.0, 0.05  # as in servo_loop.c
 
     def controller(t, theta, dtheta):

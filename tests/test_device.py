@@ -33,11 +33,27 @@ def device(phantom):
 def test_device_wraps_the_phantom_and_builds_one_by_default(phantom):
     assert Device(phantom).phantom is phantom
     assert Device().phantom.config == phantom.config
-    with pytest.raises(InvalidInputError, match="phantom"):
-        Device(42)
-    # a text is a model name: one that names none is refused, naming the models and from_folder
-    with pytest.raises(InvalidInputError, match="expected a model name .*premium_1_5.*Phantom.from_folder"):
-        Device("not a phantom")
+    touch = Device.from_model("touch")
+    assert touch.config.name == "touch" and touch.phantom.description is Phantom.from_model("touch").description
+    with pytest.raises(InvalidInputError) as error:
+        Device.from_model("nope")
+    assert error.value.argument == "name"
+
+
+def test_the_plain_call_refuses_what_is_not_a_phantom(tmp_path):
+    """Device(name), Device(description), Device(folder) and anything else but a Phantom are
+    refused with InvalidInputError naming ``phantom`` and the call that makes the device."""
+    from phantom_pin import describe
+
+    description = describe("touch")
+    for bad, call in (("touch", "Device.from_model('touch')"), (description, "Device(Phantom(description))"),
+                      (tmp_path, "Device(Phantom.from_folder(path))"),
+                      (str(tmp_path), "Device(Phantom.from_folder(path))"),
+                      (42, "Device.from_model(name)"), ("not a phantom", "Device.from_model(name)")):
+        with pytest.raises(InvalidInputError) as error:
+            Device(bad)
+        assert error.value.argument == "phantom" and call in error.value.detail, (bad, error.value.detail)
+    assert len(str(error.value)) < 300  # a Description is named, not printed with its texts
 
 
 # -- stops -----------------------------------------------------------------------------
@@ -234,8 +250,9 @@ def test_device_reads_its_config_folder(tmp_path, phantom):
     (folder / "actuation.yaml").write_text(text.replace("  viscous: 5.0e-4", "  viscous: 2.0e-3", 1))
     device = Device(Phantom.from_folder(folder))
     np.testing.assert_allclose(device.friction([1.0, 0.0, 0.0]), [2e-3 + COULOMB, 0, 0], rtol=1e-14)
-    with pytest.raises(InvalidInputError, match=r"Device\(Phantom.from_folder\(path\)\)"):
+    with pytest.raises(InvalidInputError, match=r"Device\(Phantom.from_folder\(path\)\)") as error:
         Device(folder)
+    assert error.value.argument == "phantom"
     with pytest.raises(TypeError):
         Device(phantom, folder)
     with pytest.raises(TypeError, match="config_dir"):

@@ -127,7 +127,7 @@ def test_counts_per_radian_are_the_encoder_and_the_ratios(device):
     np.testing.assert_allclose(device.counts_per_radian, ENCODER_CPR * QUADRATURE * RATIOS / (2 * math.pi),
                                rtol=1e-15)
     with pytest.raises(MissingDataError) as raised:
-        _ = Device("touch").counts_per_radian
+        _ = Device.from_model("touch").counts_per_radian
     assert raised.value.argument == "counts_per_radian"
 
 
@@ -182,7 +182,7 @@ def test_the_device_names_the_bad_argument_in_the_field(device, call, name):
 
 def test_quantization_without_an_encoder_names_the_option():
     with pytest.raises(MissingDataError) as raised:
-        simulate([0.2, 0.6, 0.8], 0.01, device=Device("touch"), quantization=True)
+        simulate([0.2, 0.6, 0.8], 0.01, device=Device.from_model("touch"), quantization=True)
     assert raised.value.argument == "quantization"
 
 

@@ -158,13 +158,13 @@ def test_the_frames_page_says_what_the_urdf_and_the_drivers_module_do():
     import numpy as np
     import pinocchio as pin
 
-    from phantom_pin import drivers, load
+    from phantom_pin import describe, drivers, load
 
     text = " ".join((ROOT / "docs" / "frames.md").read_text().split())
     assert "x left, y up, z forward: base_link's (y, z, x)" in text
     assert "39 mm from the gimbal's centre" in text
     assert "θ = (−a1, a2, a3)" in text and "τ = (−T1, T2, T3) / 1000" in text
-    robot = load("touch")
+    robot = load(describe("touch"))
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, pin.neutral(robot.model))
 

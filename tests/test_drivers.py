@@ -2,7 +2,7 @@
 
 - Ubitrack's forward kinematics of OpenHaptics' joint angles (Ubitrack/component_haptic_calibration,
   src/utHaptics/Function/PhantomForwardKinematics.h lines 101-103, without calibration offsets),
-  against Phantom("touch")'s tip in the report's frame s;
+  against Phantom.from_model("touch")'s tip in the report's frame s;
 - the ROS joint_states of fsuarez6/phantom_omni (omni_state.cpp: waist = -a1, shoulder = a2,
   elbow = a3 - a2) and of jhu-saw/sawSensablePhantom (mtsSensableHD.cpp: q[0] = -q[0]; q[2] -= q[1]);
 - SensAble's CommandJointTorque sample: torque (mN m) = k (0 - angle) is a restoring spring;
@@ -37,7 +37,7 @@ def ubitrack(a: np.ndarray) -> np.ndarray:
 
 def test_openhaptics_angles_put_the_touch_tip_where_ubitrack_computes_it(angles):
     theta = drivers.theta_from_openhaptics(angles)
-    tip = Phantom("touch").forward_kinematics(theta)[:, :3, 3]
+    tip = Phantom.from_model("touch").forward_kinematics(theta)[:, :3, 3]
     np.testing.assert_allclose(tip, ubitrack(angles), rtol=0, atol=1e-12)
     assert np.abs(ubitrack(angles)[:, 0]).max() > 0.05  # the sign of angle 1 matters here
 
@@ -88,7 +88,7 @@ def test_openhaptics_torques_do_the_same_work_and_its_spring_restores_theta(angl
 def test_gravity_goes_to_openhaptics_in_mN_m():
     """The torque that holds the Touch still, as OpenHaptics commands it: joint 1 carries no
     gravity; joints 2 and 3 keep their sign and are 1000 times the N m."""
-    phantom = Phantom("touch")
+    phantom = Phantom.from_model("touch")
     theta = np.array([0.4, 0.7, 0.9])
     command = drivers.openhaptics_torque_from_tau(phantom.gravity(theta))
     np.testing.assert_allclose(command[1:], 1000 * phantom.gravity(theta)[1:], rtol=1e-15)

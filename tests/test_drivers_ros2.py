@@ -42,7 +42,7 @@ def _installed(name: str) -> bool:
 
 INSTALLED = [name for name in profiles.names() if _installed(name)]
 THETA0 = np.array([0.2, 0.6, 0.5])   # rad: gravity beats the static friction there (test_sim_driver)
-REPORT = Phantom("touch").config.report
+REPORT = Phantom.from_model("touch").config.report
 #: The bad wrench each profile's test sends, and the field its warning names.
 BAD_WRENCH = {"sawsensablephantom": ("base_link", (float("nan"), 0.0, 0.0), "force"),
               "touch_ros2_control": ("nowhere", (0.0, 0.0, 0.1), "frame_id"),

@@ -137,7 +137,7 @@ def test_every_scene_steps_one_second_under_pseudo_random_control_without_a_warn
 
 @pytest.mark.parametrize("name", models())
 def test_load_gives_the_three_report_joints_the_frames_and_the_srdf_postures(name):
-    robot = load(name)
+    robot = load(describe(name))
     limits = yaml.safe_load((MODELS[name].config / "joint_limits.yaml").read_text())
     gimbal_file = MODELS[name].config / "gimbal.yaml"
     # a stylus gimbal's passive joints follow theta (the Touch's): its ranges are gimbal.yaml's
@@ -160,12 +160,13 @@ def test_load_gives_the_three_report_joints_the_frames_and_the_srdf_postures(nam
 
 @pytest.mark.parametrize("name", models())
 def test_every_tip_follows_eq10_with_its_own_lengths(name):
-    """The tip in report_s, by Pinocchio on the committed URDF, against eq. 10 (the report's
-    g_st position: x = s1 (l1 c2 + l2 s3), y = l2 - l2 c3 + l1 s2, z = -l1 + c1 (l1 c2 + l2 s3))
-    with l1, l2 from the model's kinematics.yaml, at 500 seeded postures inside its stops (1e-12 m)."""
+    """The tip in report_s, by Pinocchio on the model's URDF (describe()'s, equal to the committed one),
+    against eq. 10 (the report's g_st position: x = s1 (l1 c2 + l2 s3), y = l2 - l2 c3 + l1 s2,
+    z = -l1 + c1 (l1 c2 + l2 s3)) with l1, l2 from the model's kinematics.yaml, at 500 seeded
+    postures inside its stops (1e-12 m)."""
     lengths = yaml.safe_load((MODELS[name].config / "kinematics.yaml").read_text())
     l1, l2 = lengths["l1"], lengths["l2"]
-    robot = load(name)
+    robot = load(describe(name))
     data = robot.model.createData()
     thetas = sample_postures(config.read(name).limits, 500, np.random.default_rng(3), draws=2000)
     assert len(thetas) == 500

@@ -21,7 +21,7 @@ PROFILES = profiles.names()
 
 @pytest.fixture(scope="module")
 def touch() -> Phantom:
-    return Phantom("touch")
+    return Phantom.from_model("touch")
 
 
 def message(profile: profiles.Profile) -> SimpleNamespace:

@@ -139,7 +139,8 @@ def test_the_friction_torque_is_each_joints_law():
                 for row in rates.tolist()]
     np.testing.assert_allclose(law.torque(rates), expected, rtol=1e-15, atol=0)
     np.testing.assert_allclose(law.torque(rates[3]), expected[3], rtol=1e-15, atol=0)
-    np.testing.assert_allclose(Device(describe(overrides=OVERRIDES)).friction(rates), expected, rtol=1e-15, atol=0)
+    device = Device(Phantom(describe(overrides=OVERRIDES)))
+    np.testing.assert_allclose(device.friction(rates), expected, rtol=1e-15, atol=0)
     assert [law.joint(j) for j in range(3)] == list(zip(VISCOUS, COULOMB, strict=True))
     assert not law.uniform and Friction((1.0,) * 3, (2.0,) * 3).uniform
     with pytest.raises(InvalidInputError, match="dtheta"):
@@ -151,7 +152,7 @@ def test_the_plant_slides_and_sticks_each_joint_by_its_own_law(overridden):
     tau - each joint's law (to 1e-12 relative); at rest under gravity compensation plus 0.01 N m
     on joint 1 (which carries no gravity), joint 1 breaks away with its Coulomb torque 0.008 N m
     and sticks with the shipped 0.01 N m that holds exactly that much at most (and with 0.015)."""
-    device = Device(overridden)
+    device = Device(Phantom(overridden))
     plant = Plant(device, friction=True, hard_stops=False, saturation=False, contact_step=1e-3)
     rng = np.random.default_rng(2)
     for _ in range(10):
@@ -163,7 +164,7 @@ def test_the_plant_slides_and_sticks_each_joint_by_its_own_law(overridden):
     q = [0.2, 0.5, 0.7]
     push = device.phantom.gravity(np.array(q)) + [0.01, 0.0, 0.0]
     assert plant.acceleration(q, [0.0] * 3, push.tolist())[0] > 0             # 0.01 > 0.008: it slides
-    stuck = Plant(Device(describe(overrides={**OVERRIDES, "actuation.friction.coulomb.joint1": 0.0101})),
+    stuck = Plant(Device(Phantom(describe(overrides={**OVERRIDES, "actuation.friction.coulomb.joint1": 0.0101}))),
                   friction=True, hard_stops=False, saturation=False, contact_step=1e-3)
     assert list(stuck.acceleration(q, [0.0] * 3, push.tolist())) == [0.0, 0.0, 0.0]
 
@@ -174,7 +175,7 @@ def test_simulate_dissipates_each_joints_viscous_power():
     1e-4 of it); with the joints' coefficients rotated it is off by more than 10 %."""
     overrides = {**{k: v for k, v in OVERRIDES.items() if "viscous" in k},
                  **{f"actuation.friction.coulomb.{j}": 0.0 for j in JOINTS}}
-    device = Device(describe(overrides=overrides))
+    device = Device(Phantom(describe(overrides=overrides)))
     result = simulate([0.0, 0.3, 0.5], 0.5, dtheta0=[6.0, -3.0, 4.0], rate=1e4, hard_stops=False,
                       saturation=False, device=device)
     theta, dtheta = result.theta, result.dtheta

@@ -24,7 +24,7 @@ JOINTS = ("joint4", "joint5", "joint6")
 
 @pytest.fixture(scope="module")
 def touch() -> Phantom:
-    return Phantom("touch")
+    return Phantom.from_model("touch")
 
 
 def states(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -65,7 +65,7 @@ def test_the_gimbal_links_are_the_integrals_of_their_stated_solids():
 
 def test_the_models_without_a_public_gimbal_have_none(touch):
     for name in ("premium_1_5", "premium_1_5_cad"):
-        phantom = Phantom(name)
+        phantom = Phantom.from_model(name)
         assert phantom.config.gimbal is None and phantom.gimbal_joints == () and phantom.stylus_model is None
         with pytest.raises(InvalidInputError, match="no stylus gimbal") as error:
             phantom.stylus_pose(np.zeros(3), np.zeros(3))
@@ -229,10 +229,10 @@ def test_the_viewer_draws_the_stylus_where_its_pose_puts_it(tmp_path):
     import pinocchio as pin
 
     from helpers import light_grey, patch, render
-    from phantom_pin import load
+    from phantom_pin import describe, load
     from phantom_pin.viewer import Viewer
 
-    robot = load("touch")
+    robot = load(describe("touch"))
     theta, near, away = np.array([0.0, 0.5, 0.7]), np.zeros(3), np.array([1.5, 0.0, 0.0])
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, np.concatenate([theta, near]))

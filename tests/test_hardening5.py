@@ -372,10 +372,10 @@ def test_a_continuous_torque_equal_to_the_stall_torque_is_refused():
 
 
 def _plant(overrides=None, **options):
-    from phantom_pin import Device, describe
+    from phantom_pin import Device, Phantom, describe
     from phantom_pin.device.plant import Plant
 
-    device = Device(describe(overrides=overrides or {}))
+    device = Device(Phantom(describe(overrides=overrides or {})))
     settings = {"friction": True, "hard_stops": False, "saturation": False, "contact_step": 1e-3} | options
     return device, Plant(device, **settings)
 

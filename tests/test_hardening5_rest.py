@@ -104,7 +104,7 @@ def six():
 
 @pytest.fixture(scope="module")
 def touch():
-    return Phantom("touch")
+    return Phantom.from_model("touch")
 
 
 def _held_states(n, seed):
@@ -213,7 +213,7 @@ def test_simulate_holds_the_gimbal_where_it_is_asked_and_keeps_the_energy(six):
     error); evaluated at locked_at instead it drifts by more than 1e-4 of it, so the run used
     HELD. Gimbal angles outside the gimbal's range are refused by name."""
     result = simulate([0.2, 0.3, 0.5], 0.5, None, friction=False, hard_stops=False, saturation=False,
-                      device=Device(Phantom("touch")), gimbal=HELD, substeps=4)
+                      device=Device(Phantom.from_model("touch")), gimbal=HELD, substeps=4)
     energy = np.array([six.energy(q, HELD, v) for q, v in zip(result.theta, result.dtheta)])
     kinetic = max(0.5 * v @ six.mass(q, HELD) @ v for q, v in zip(result.theta, result.dtheta))
     assert kinetic > 1e-3
@@ -221,7 +221,7 @@ def test_simulate_holds_the_gimbal_where_it_is_asked_and_keeps_the_energy(six):
     elsewhere = np.array([six.energy(q, None, v) for q, v in zip(result.theta, result.dtheta)])
     assert np.abs(elsewhere - elsewhere[0]).max() > 1e-4 * kinetic
     with pytest.raises(InvalidInputError, match=r"^gimbal: joint6 at 9.0 rad is outside its range"):
-        simulate([0.2, 0.3, 0.5], 0.01, device=Device(Phantom("touch")), gimbal=[0.0, 0.0, 9.0])
+        simulate([0.2, 0.3, 0.5], 0.01, device=Device(Phantom.from_model("touch")), gimbal=[0.0, 0.0, 9.0])
 
 
 def test_fk_and_dynamics_take_gimbal_angles(cli, six):
@@ -280,7 +280,7 @@ def _trajectory(path, record=None, model="touch"):
     w = 2 * np.pi * np.array([0.4, 0.6, 0.5])
     theta = np.array([0.0, 0.3, 0.5]) + 0.1 * np.sin(np.outer(t, w))
     dtheta, ddtheta = 0.1 * w * np.cos(np.outer(t, w)), -0.1 * w**2 * np.sin(np.outer(t, w))
-    tau = Phantom(model).inverse_dynamics(theta, dtheta, ddtheta)
+    tau = Phantom.from_model(model).inverse_dynamics(theta, dtheta, ddtheta)
     lines = ["t,theta1,theta2,theta3,dtheta1,dtheta2,dtheta3,ddtheta1,ddtheta2,ddtheta3,tau1,tau2,tau3"]
     lines += [] if record is None else [record]
     lines += [",".join(map(repr, row)) for row in np.column_stack([t, theta, dtheta, ddtheta, tau]).tolist()]

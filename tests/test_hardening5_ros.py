@@ -114,7 +114,7 @@ def test_gimbal_joint_states_with_a_prefix_read_their_own_names():
 
 @pytest.fixture(scope="module")
 def touch() -> Phantom:
-    return Phantom("touch")
+    return Phantom.from_model("touch")
 
 
 @pytest.mark.parametrize("names", [
@@ -187,7 +187,7 @@ def test_the_bridge_of_a_model_without_a_gimbal_answers_from_the_closed_form():
     (eqs 10, 93-94) and the URDF's mimic tags written out here: the drivers' names (their yaw,
     pitch, roll ignored, there being no gimbal), the model's, 1e-12 (N m, m)."""
     config = read("premium_1_5")
-    bridge = ros2.Bridge(Phantom("premium_1_5"))
+    bridge = ros2.Bridge(Phantom.from_model("premium_1_5"))
     l1, l2 = config.kinematics.l1, config.kinematics.l2
     base_from_s = np.eye(4)                      # the macro's report_s: at (l1, 0, -l2), axes (y, z, x)
     base_from_s[:3, :3] = [[0, 0, 1], [1, 0, 0], [0, 1, 0]]
@@ -322,7 +322,7 @@ def test_the_origin_is_gimbal_yamls_shoulder_less_the_shoulder_in_frame_s():
                                                           + 2 * report.l1 * report.l2 * math.sin(theta[2] - theta[1]))
                    ) < 1e-12
     assert np.abs(drivers.openhaptics_origin() - (np.array(stated) - shoulder)).max() < 1e-15
-    assert np.array_equal(drivers.openhaptics_origin(Phantom("touch")), drivers.openhaptics_origin())
+    assert np.array_equal(drivers.openhaptics_origin(Phantom.from_model("touch")), drivers.openhaptics_origin())
     moved = describe("touch", overrides={"openhaptics_shoulder.2": -0.2})
     assert np.abs(drivers.openhaptics_origin(moved) - drivers.openhaptics_origin() - [0, 0, -0.2 - stated[2]]
                   ).max() < 1e-15
@@ -333,8 +333,8 @@ def test_the_origin_is_gimbal_yamls_shoulder_less_the_shoulder_in_frame_s():
     with pytest.raises(ParameterFileError, match="openhaptics_shoulder"):
         describe("touch", overrides={"openhaptics_shoulder.2": -157})
     with pytest.raises(InvalidInputError) as error:
-        drivers.openhaptics_origin(Phantom("premium_1_5"))
-    assert error.value.argument == "model"
+        drivers.openhaptics_origin(Phantom.from_model("premium_1_5"))
+    assert error.value.argument == "phantom"
     with pytest.raises(InvalidInputError) as error:
         drivers.pose_from_openhaptics_transform(np.eye(4).ravel(), origin=[[0, 0, 0]])
     assert error.value.argument == "origin"

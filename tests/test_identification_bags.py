@@ -39,7 +39,7 @@ def exact_log(rate, duration=12.0, seed=1, t=None):
     theta = np.array([0.0, 0.3, 0.45]) + a * np.sin(arg).sum(-1)
     dtheta, ddtheta = a * (w * np.cos(arg)).sum(-1), -a * (w**2 * np.sin(arg)).sum(-1)
     law = TOUCH.actuation.friction
-    tau = (Phantom("touch").inverse_dynamics(theta, dtheta, ddtheta) + np.array(law.viscous) * dtheta
+    tau = (Phantom.from_model("touch").inverse_dynamics(theta, dtheta, ddtheta) + np.array(law.viscous) * dtheta
            + np.array(law.coulomb) * np.sign(dtheta))
     return io.Log(t, theta, tau)
 

@@ -33,7 +33,7 @@ def delayed(log, samples):
 @pytest.fixture(scope="module")
 def device():
     description = describe(overrides=truth_overrides())
-    return Device(description), Phantom(description)
+    return Device(Phantom(description)), Phantom(description)
 
 
 @pytest.fixture(scope="module")

@@ -13,13 +13,13 @@ import pinocchio as pin
 import pytest
 
 from helpers import CONFIG, REPORT
-from phantom_pin import Device, closed_form, describe, load
+from phantom_pin import Device, Phantom, closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics.coupling import Coupling
-from phantom_pin.dynamics.loader import PhantomLoader
+from phantom_pin.dynamics.loader import PhantomLoader, load_files
 from phantom_pin.identification import constants, io, simulation
 from phantom_pin.identification import parameterization as pz
 
@@ -70,7 +70,7 @@ def identified(tmp_path_factory):
     assert main(["excite", "-o", str(trajectory), "--duration", "10", "--iterations", "15",
                  "--restarts", "1"]) == 0
     t, theta, dtheta, _, tau = io.read_trajectory(trajectory)
-    device = Device(describe(overrides=truth_overrides()))
+    device = Device(Phantom(describe(overrides=truth_overrides())))
     log = simulation.track(device, t, theta, dtheta, tau, torque_noise=TORQUE_NOISE, seed=1)
     counts = device.encoder_counts(log.theta)           # the log holds the encoder's angles
     np.testing.assert_array_equal(device.encoder_theta(counts), log.theta)
@@ -96,7 +96,7 @@ def test_overlay_is_accepted_by_phantom_and_mujoco(identified, tmp_path):
     report = overlaid(identified / "id.yaml").config.report
     loader = type("Identified", (PhantomLoader,), {"urdf_path": identified / "id.urdf",
                                                    "srdf_path": identified / "id.srdf"})
-    robot = load(loader)
+    robot = load_files(loader)
     arm = MujocoArm(mujoco.MjModel.from_xml_path(str(identified / "id.mjcf")),
                     Coupling((identified / "id.urdf").read_text()))
     for q in sample(20, 13):
@@ -113,7 +113,7 @@ def test_identified_urdf_predicts_held_out_torques(identified):
     check_urdf(urdf, "the identified URDF")
     loader = type("Identified", (PhantomLoader,), {"urdf_path": identified / "id.urdf",
                                                    "srdf_path": identified / "id.srdf"})
-    robot = load(loader)
+    robot = load_files(loader)
     rng = np.random.default_rng(11)
     theta = sample(500, 12)
     dtheta, ddtheta = rng.normal(0, 2, (500, 3)), rng.normal(0, 20, (500, 3))

@@ -46,7 +46,7 @@ def device_overrides() -> dict:
     return keys
 
 
-DEVICE = Device(describe(overrides=device_overrides()))
+DEVICE = Device(Phantom(describe(overrides=device_overrides())))
 
 
 def cli(*arguments) -> tuple[int, str, str]:
@@ -78,8 +78,8 @@ def run(tmp_path_factory):
     code, report, err = cli("identify", folder / "log.csv", "-o", folder / "report.yaml", "--structure", "report")
     assert code == 0, err
     return SimpleNamespace(folder=folder, log=log, general=general, report=report,
-                           identified=Device(describe(overrides=read_overrides(folder / "general.yaml"))),
-                           structured=Device(describe(overrides=read_overrides(folder / "report.yaml"))))
+                           identified=Device(Phantom(describe(overrides=read_overrides(folder / "general.yaml")))),
+                           structured=Device(Phantom(describe(overrides=read_overrides(folder / "report.yaml")))))
 
 
 def test_the_general_model_predicts_a_held_out_trajectory_within_half_a_percent(run):
@@ -254,7 +254,7 @@ def test_a_joints_torque_gain_is_found_corrected_and_reported(run, case, tmp_pat
     errors = {}
     for flag in ((), ("--fixed-gains",)):
         code, _, err = cli("identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml", "--force", *flag)
-        identified = Device(describe(overrides=read_overrides(tmp_path / "id.yaml")))
+        identified = Device(Phantom(describe(overrides=read_overrides(tmp_path / "id.yaml"))))
         errors[flag] = rms(identified.phantom.inverse_dynamics(theta, dtheta, ddtheta) - truth, truth)
         if not flag:
             friction = identified.friction(dtheta) - DEVICE.friction(dtheta)

@@ -53,7 +53,7 @@ def lab_log(device, duration, amplitude, seed):
 def truth_log(duration, amplitude, seed):
     """lab_log of the device of truth_overrides(), simulated once per arguments (the wide log is
     test_identification_delay's too; conftest.GROUPS keeps both modules on one worker)."""
-    return lab_log(Device(describe(overrides=truth_overrides())), duration, amplitude, seed)
+    return lab_log(Device(Phantom(describe(overrides=truth_overrides()))), duration, amplitude, seed)
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +150,7 @@ def test_excites_trajectory_gives_the_fit_of_the_log_alone():
     t = np.arange(10001) / RATE
     theta, dtheta, ddtheta = excitation.optimise(PRIOR, iterations=15, restarts=1).trajectory(t)
     tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + CONFIG.actuation.friction.torque(dtheta)
-    log = simulation.track(Device(description), t, theta, dtheta, tau, torque_noise=0.005, seed=3)
+    log = simulation.track(Device(Phantom(description)), t, theta, dtheta, tau, torque_noise=0.005, seed=3)
     fit = estimation.estimate(log, PRIOR)
     shift = np.abs(fit.beta - fit.log_beta) / fit.log_sigma
     print("largest shift / sigma:", shift.max())
@@ -215,7 +215,8 @@ def test_the_cad_device_identified_on_the_report_model_is_never_worse_than_the_p
     the log alone: up to 291 %) and is within 0.5 % from the wide one, where it is the log alone's
     within 0.05 % of the torque RMS."""
     description = describe("premium_1_5_cad")
-    device, truth = Device(description), Phantom(description)
+    truth = Phantom(description)
+    device = Device(truth)
     _, theta, dtheta, ddtheta = sum_of_sines(20, 0.4, 99)
     held = {"trajectory": (theta[::10], dtheta[::10], ddtheta[::10]), "states": random_states(CONFIG.limits, 500, 7)}
     narrow, wide = (estimation.estimate(lab_log(device, duration, amplitude, 1), PRIOR)

@@ -45,7 +45,7 @@ def test_the_threshold_is_chosen_and_the_touch_comes_back_exact(touch_log, cli):
     assert overlay["actuation.friction.viscous.joint3"] == pytest.approx(5e-4, rel=0.005)
     assert overlay["actuation.friction.coulomb.joint3"] == pytest.approx(0.02, rel=0.005)
     assert "corrected in the written model" not in out and "torque constant" not in err, err
-    identified, device = Phantom(describe("touch", overrides=overlay)), Phantom("touch")
+    identified, device = Phantom(describe("touch", overrides=overlay)), Phantom.from_model("touch")
     theta, dtheta, ddtheta = random_states(device.config.limits, 200, 5)
     truth = device.inverse_dynamics(theta, dtheta, ddtheta)
     error = np.sqrt(((identified.inverse_dynamics(theta, dtheta, ddtheta) - truth) ** 2).mean(0) / (truth**2).mean(0))

@@ -13,7 +13,7 @@ from phantom_pin.identification import io, static
 from phantom_pin.identification.structures import General
 
 PRIOR = Phantom()                                  # the report's model: what identify starts from
-TRUTH = Phantom("premium_1_5_cad")                 # the device: another arm
+TRUTH = Phantom.from_model("premium_1_5_cad")                 # the device: another arm
 DEVICE = Device()
 CHECK = sample_postures(PRIOR.config.limits, 500, np.random.default_rng(99))   # not the fit's own postures
 

@@ -10,7 +10,7 @@ from phantom_pin.device.controllers import tracking
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import simulation
 
-DEVICE = Device(describe())
+DEVICE = Device(Phantom(describe()))
 RATE = 1000.0
 
 

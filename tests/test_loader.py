@@ -10,7 +10,7 @@ import yaml
 import yourdfpy
 
 from helpers import CONFIG_DIR, REPORT, SRDF_PATH, URDF_PATH, relative_error
-from phantom_pin.dynamics.loader import PhantomLoader, load
+from phantom_pin.dynamics.loader import PhantomLoader, load, load_files
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 from phantom_pin.report import closed_form
 
@@ -99,9 +99,9 @@ def test_bad_loader_attributes_raise_named_errors():
         ref_posture = "standing"
 
     with pytest.raises(ParameterFileError, match="srdf_path"):
-        load(NoFile)
+        load_files(NoFile)
     with pytest.raises(InvalidInputError, match="ref_posture: 'standing'"):
-        load(NoPosture)
+        load_files(NoPosture)
 
 
 @pytest.mark.parametrize("attribute, text, message", [
@@ -116,14 +116,14 @@ def test_malformed_urdf_or_srdf_raise_a_named_parameter_file_error(tmp_path, att
     path.write_bytes(text if isinstance(text, bytes) else text.encode())
     loader = type("Bad", (PhantomLoader,), {attribute: path})
     with pytest.raises(ParameterFileError, match=message) as error:
-        load(loader)
+        load_files(loader)
     assert "\n" not in str(error.value)
 
 
 def test_a_folder_goes_through_describe(tmp_path):
-    """load() takes a loader class, a model name or a Description; a folder given directly is
-    refused naming the way (load(describe(folder))), which gives the model of the same files:
-    its gravity at a posture is the default model's (the folder is its copy), to 1e-12."""
+    """load() takes a Description (None: the default model); a folder given directly is refused
+    naming the way (load(describe(folder))), which gives the model of the same files: its gravity
+    at a posture is the default model's (the folder is its copy), to 1e-12."""
     import shutil
 
     import numpy as np
@@ -137,8 +137,42 @@ def test_a_folder_goes_through_describe(tmp_path):
     for bad in (folder, str(folder)):
         with pytest.raises(InvalidInputError, match=r"load\(describe\(folder\)\)") as error:
             load(bad)
-        assert error.value.argument == "source"
-    mine, shipped = load(describe(folder)), load("premium_1_5")
+        assert error.value.argument == "description"
+    mine, shipped = load(describe(folder)), load()
     q = np.array([0.1, 0.4, 0.9])
     np.testing.assert_allclose(pin.computeGeneralizedGravity(mine.model, mine.data, q),
                                pin.computeGeneralizedGravity(shipped.model, shipped.data, q), rtol=0, atol=1e-12)
+
+
+def test_load_refuses_what_is_not_a_description_naming_the_call():
+    """A model name, a PhantomLoader class, a Phantom or anything else but a Description given
+    to load() is refused with InvalidInputError naming ``description`` and the call that loads
+    it; load_files() refuses anything but a PhantomLoader class, naming ``loader``."""
+    from phantom_pin import InvalidInputError, Phantom, describe, load
+
+    for bad, call in (("touch", "load(describe('touch'))"), (PhantomLoader, "load_files(loader)"),
+                      (Phantom(), "load(phantom.description)"), (3, "load_files(loader)")):
+        with pytest.raises(InvalidInputError) as error:
+            load(bad)
+        assert error.value.argument == "description" and call in error.value.detail, (bad, error.value.detail)
+    for bad, call in ((describe("touch"), "load(description)"), ("touch", "load(describe(name or folder))"),
+                      (PhantomLoader(), ""), (None, "")):
+        with pytest.raises(InvalidInputError) as error:
+            load_files(bad)
+        assert error.value.argument == "loader" and call in error.value.detail, (bad, error.value.detail)
+
+
+def test_load_and_load_files_of_the_same_files_are_the_same_robot():
+    """load() (the default model's committed texts, with its Config's gravity) and load_files()
+    (PhantomLoader: the same files read from disk, Pinocchio's gravity) give the same model:
+    the same joints, postures, armature and gravity torques (the Config's g is Pinocchio's 9.81)."""
+    import numpy as np
+    import pinocchio as pin
+
+    described, files = load(), load_files()
+    assert list(described.model.names) == list(files.model.names)
+    np.testing.assert_array_equal(described.q0, files.q0)
+    np.testing.assert_array_equal(described.model.armature, files.model.armature)
+    q = np.array([0.1, 0.4, 0.9])
+    np.testing.assert_array_equal(pin.computeGeneralizedGravity(described.model, described.data, q),
+                                  pin.computeGeneralizedGravity(files.model, files.data, q))

@@ -237,33 +237,49 @@ def test_inverse_kinematics_behind_the_shoulder_gives_plus_pi_like_the_closed_fo
         np.testing.assert_allclose(theta[1:], [0.2, 0.3], atol=1e-9)
 
 
-def test_one_input_type_per_way_of_making_a_phantom(tmp_path):
-    """Phantom() / Phantom(name) / Phantom(description), and the named constructors for the
-    same and for a folder; a folder given to the plain call is refused naming from_folder. The
-    results compute the same gravity as the closed form of the same configuration (1e-12)."""
+def test_one_way_to_make_each_phantom(tmp_path):
+    """Phantom() / Phantom(description), and the named constructors for a model name and a folder:
+    each computes the same gravity as the closed form of the same configuration (1e-12)."""
     import shutil
 
     from phantom_pin import describe
-    from phantom_pin.exceptions import InvalidInputError
 
     folder = tmp_path / "mine"
     shutil.copytree(CONFIG_DIR, folder)
     theta = np.array([0.1, 0.4, 0.9])
     reference = cf.gravity(theta, REPORT)
-    for phantom in (Phantom(), Phantom("premium_1_5"), Phantom(describe("premium_1_5")),
-                    Phantom.from_model("premium_1_5"), Phantom.from_folder(folder),
-                    Phantom.from_description(describe(folder))):
+    for phantom in (Phantom(), Phantom(describe("premium_1_5")), Phantom(describe(folder)),
+                    Phantom.from_model("premium_1_5"), Phantom.from_folder(folder), Phantom.from_folder(str(folder))):
         np.testing.assert_allclose(phantom.gravity(theta), reference, rtol=0, atol=1e-12 * np.abs(reference).max())
-    for bad, argument in ((folder, "source"), (str(folder), "source")):
-        with pytest.raises(InvalidInputError, match="Phantom.from_folder") as error:
+    assert not hasattr(Phantom, "from_description")  # the plain call is that constructor
+
+
+def test_the_plain_call_refuses_what_a_named_constructor_makes(tmp_path):
+    """A model name, a folder (a Path or its text) or anything but a Description given to
+    Phantom(...) is refused with InvalidInputError naming ``description`` and the call that makes
+    it; from_model refuses a folder and from_folder a model name, each naming the other."""
+    from phantom_pin import describe
+    from phantom_pin.exceptions import InvalidInputError
+
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    for bad, call in (("touch", "Phantom.from_model('touch')"), ("premium_1_5", "Phantom.from_model('premium_1_5')"),
+                      (folder, "Phantom.from_folder(path)"), (str(folder), "Phantom.from_folder(path)"),
+                      (42, "Phantom.from_model(name)"), (describe, "Phantom.from_folder(path)")):
+        with pytest.raises(InvalidInputError) as error:
             Phantom(bad)
-        assert error.value.argument == argument
-    with pytest.raises(InvalidInputError) as error:
-        Phantom.from_model("nope")
-    assert error.value.argument == "name"
-    with pytest.raises(InvalidInputError) as error:
-        Phantom.from_description("premium_1_5")
-    assert error.value.argument == "description"
+        assert error.value.argument == "description" and call in error.value.detail, (bad, error.value.detail)
+    for bad in ("nope", 3, None, folder):
+        with pytest.raises(InvalidInputError) as error:
+            Phantom.from_model(bad)
+        assert error.value.argument == "name"
+    with pytest.raises(InvalidInputError, match=r"Phantom\.from_model\('touch'\)") as error:
+        Phantom.from_folder("touch")
+    assert error.value.argument == "folder"
+    for bad in (tmp_path / "absent", 3, None):
+        with pytest.raises(InvalidInputError) as error:
+            Phantom.from_folder(bad)
+        assert error.value.argument == "folder"
 
 
 def test_a_prefixed_description_gives_the_same_phantom():
@@ -274,10 +290,10 @@ def test_a_prefixed_description_gives_the_same_phantom():
 
     theta = np.array([0.2, 0.6, 0.9])
     for name in ("premium_1_5", "touch"):
-        plain, left = Phantom(name), Phantom(describe(name, prefix="left_"))
+        plain, left = Phantom.from_model(name), Phantom(describe(name, prefix="left_"))
         np.testing.assert_array_equal(left.forward_kinematics(theta), plain.forward_kinematics(theta))
         np.testing.assert_allclose(left.gravity(theta), plain.gravity(theta), rtol=1e-14, atol=1e-16)
-    touch, left = Phantom("touch"), Phantom(describe("touch", prefix="left_"))
+    touch, left = Phantom.from_model("touch"), Phantom(describe("touch", prefix="left_"))
     gimbal = np.array([0.3, -0.2, 0.5])
     np.testing.assert_allclose(left.stylus_tip_pose(theta, gimbal), touch.stylus_tip_pose(theta, gimbal),
                                rtol=0, atol=1e-15)

@@ -12,7 +12,7 @@ from phantom_pin import ParameterFileError, Phantom
 from phantom_pin.cli import main
 from phantom_pin.config.files import FILES, apply_overrides, read_documents
 from phantom_pin.description.physical import check_urdf
-from phantom_pin.dynamics.loader import PhantomLoader, load
+from phantom_pin.dynamics.loader import PhantomLoader, load_files
 from phantom_pin.inertial import TRIANGLE_SLACK
 
 #: Overrides that write a non-physical link (the issue's list), and the link they break.
@@ -59,7 +59,7 @@ def test_load_refuses_a_non_physical_urdf(tmp_path):
     urdf.write_text(URDF_PATH.read_text().replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>'))
     loader = type("Negative", (PhantomLoader,), {"urdf_path": urdf, "srdf_path": SRDF_PATH})
     with pytest.raises(ParameterFileError, match="urdf_path: .*forearm_link: mass must be positive"):
-        load(loader)
+        load_files(loader)
 
 
 def test_shipped_urdf_and_pure_frames_pass():

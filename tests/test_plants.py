@@ -6,10 +6,10 @@ bounds below are the measured agreement (in the comments), with some margin."""
 import numpy as np
 import pytest
 
-from phantom_pin import Device, InvalidInputError, describe, simulate
+from phantom_pin import Device, InvalidInputError, Phantom, describe, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 
-DEVICE = Device(describe())
+DEVICE = Device(Phantom(describe()))
 GRAVITY = DEVICE.phantom.gravity
 START = np.array([0.0, 0.3, 0.4])                  # rad
 COULOMB = np.array(DEVICE.config.actuation.friction.coulomb)   # N m, each joint's breakaway torque
@@ -59,7 +59,7 @@ def test_a_free_fall_onto_the_stops_agrees(theta0, stops):
     with the shipped stops (MuJoCo's default limits: 0.33), and within 0.054 rad with stops ten
     times stiffer and damper (before the MJCF took K and B, its limits stayed those fitted to the
     shipped stops: 0.33 rad)."""
-    device = Device(describe(overrides=stops)) if stops else DEVICE
+    device = Device(Phantom(describe(overrides=stops))) if stops else DEVICE
     ours = simulate(np.array(theta0), 1.5, None, device=device)
     mujoco = simulate_mujoco(np.array(theta0), 1.5, None, device=device)
     assert np.abs(ours.theta - mujoco.theta).max() < 0.065

@@ -30,7 +30,7 @@ DRIVER = ("waist", "shoulder", "elbow", "yaw", "pitch", "roll")
 
 @pytest.fixture(scope="module")
 def touch() -> Phantom:
-    return Phantom("touch")
+    return Phantom.from_model("touch")
 
 
 def driver_states(n: int, seed: int) -> np.ndarray:

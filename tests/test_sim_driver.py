@@ -22,7 +22,7 @@ RELEASES = [np.array([0.2, 0.6, 0.5]), np.array([-0.3, 0.9, 0.2])]
 
 @pytest.fixture(scope="module")
 def device() -> Device:
-    return Device(Phantom("touch"))
+    return Device(Phantom.from_model("touch"))
 
 
 def tip(device: Device, theta) -> np.ndarray:

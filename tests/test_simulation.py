@@ -235,9 +235,9 @@ def test_work_beyond_a_few_minutes_is_refused_at_once(duration, rate, stiffness,
     stiff stop is refused within a second, naming the argument and the stiffest term."""
     import time
 
-    from phantom_pin import Device, describe
+    from phantom_pin import Device, Phantom, describe
 
-    device = Device(describe(overrides={"stops.stiffness": stiffness})) if stiffness else None
+    device = Device(Phantom(describe(overrides={"stops.stiffness": stiffness}))) if stiffness else None
     start = time.monotonic()
     with pytest.raises(InvalidInputError, match=f"^{argument}: .* RK4 steps .* more than 8e\\+06"):
         simulate(START, duration, rate=rate, device=device)
@@ -300,9 +300,9 @@ def test_the_default_substeps_resolve_a_stiff_stop(stiffness):
     default substeps (from the stop's natural frequency, a joint on its own stop and the
     coupled one: 3 K) stay within 5e-7 rad of 8 times as many (measured 1.3e-7 and 1.5e-7;
     with K in place of 3 K, 1.3e-6 and 2.2e-6)."""
-    from phantom_pin import Device, describe
+    from phantom_pin import Device, Phantom, describe
 
-    device = Device(describe(overrides={"stops.stiffness": stiffness, "stops.damping": 0.0}))
+    device = Device(Phantom(describe(overrides={"stops.stiffness": stiffness, "stops.damping": 0.0})))
     theta0 = [0.0, -1.40, -0.45]
     run = simulate(theta0, 0.3, device=device, friction=False)
     finer = simulate(theta0, 0.3, device=device, friction=False, substeps=8 * run.substeps)

@@ -84,12 +84,12 @@ def test_torque_limits_render_chai3ds_force_along_each_joints_longest_lever():
     for joint, lever in zip(("joint1", "joint2", "joint3"), levers):
         assert limits[joint] == four_digits(MAX_FORCE * lever)
     theta = np.random.default_rng(4).uniform(-np.pi, np.pi, (20000, 3))
-    columns = np.linalg.norm(Device("touch").tip_jacobian(theta), axis=-2).max(axis=0)
+    columns = np.linalg.norm(Device.from_model("touch").tip_jacobian(theta), axis=-2).max(axis=0)
     assert np.all(columns <= np.array(levers) + 1e-12) and np.all(columns > np.array(levers) * 0.999)
 
 
 def test_the_touch_is_the_reports_arm_at_its_size():
-    phantom = Phantom("touch")
+    phantom = Phantom.from_model("touch")
     kinematics = phantom.config.kinematics
     assert (kinematics.l1, kinematics.l2) == (L1, L2)
     theta = sample_postures(phantom.config.limits, 200, np.random.default_rng(5), draws=800)
@@ -104,7 +104,7 @@ def test_the_touch_is_the_reports_arm_at_its_size():
 
 @pytest.fixture(scope="module")
 def touch() -> Device:
-    return Device("touch")
+    return Device.from_model("touch")
 
 
 def test_a_device_without_motor_data_says_what_it_lacks(touch):
@@ -202,8 +202,9 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     x = np.array([getattr(truth, s) for s in ("ma", "Iaxx", "Iayy", "Iazz", "mc", "Icxx", "Icyy", "Iczz", "mbe")]
                  + [truth.mbe * truth.l5] + [getattr(truth, s) for s in ("Ibexx", "Ibeyy", "Ibezz", "mdf")]
                  + [truth.mdf * truth.l6] + [getattr(truth, s) for s in ("Idfxx", "Idfyy", "Idfzz", "Ibaseyy")] + [0.0])
-    device = Device(describe("touch", overrides={**pz.overrides(x, estimate), "actuation.friction.viscous": VISCOUS,
-                                                 "actuation.friction.coulomb": COULOMB}))
+    device = Device(Phantom(describe("touch", overrides={**pz.overrides(x, estimate),
+                                                         "actuation.friction.viscous": VISCOUS,
+                                                         "actuation.friction.coulomb": COULOMB})))
     log = simulation.track(device, t, theta, dtheta, tau, torque_noise=TORQUE_NOISE, quantization=False, seed=1)
     np.testing.assert_allclose(closed_form.mass_matrix(theta[::500], truth) + stylus_mass(theta[::500]),
                                device.phantom.mass_matrix(theta[::500]), rtol=0, atol=1e-12)  # the device is the truth
@@ -219,7 +220,7 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     rng = np.random.default_rng(21)
     theta = sample_postures(estimate.limits, 300, rng, draws=1200)
     dtheta, ddtheta = rng.uniform(-2, 2, theta.shape), rng.uniform(-20, 20, theta.shape)
-    stylus = Phantom("touch").inverse_dynamics(theta, dtheta, ddtheta) - closed_form.inverse_dynamics(
+    stylus = Phantom.from_model("touch").inverse_dynamics(theta, dtheta, ddtheta) - closed_form.inverse_dynamics(
         theta, dtheta, ddtheta, estimate.report)  # the locked stylus's share, the same on every device here
     truth_tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, truth) + stylus
 

@@ -13,7 +13,7 @@ import pytest
 import umsgpack
 
 from helpers import RAISED, RESTING, dark, frame_pose, patch, red, render
-from phantom_pin import config, load
+from phantom_pin import config, describe, load
 from phantom_pin.config import MODELS
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
@@ -144,7 +144,7 @@ FPS = 30
 
 @pytest.fixture(scope="module")
 def touch_viewer():
-    with Viewer(load("touch")) as v:
+    with Viewer(load(describe("touch"))) as v:
         yield v
 
 

@@ -104,8 +104,9 @@ class Description:
     the named model it is (phantom_pin.config.Model), or None for a folder of one's own;
     ``prefix`` of every name; ``urdf`` and ``srdf``: the texts xacro generates (every link
     passed the one physical check); ``mjcf`` and ``scene``: the MuJoCo texts, the scene
-    including the robot as ``robot_file``. Phantom, load(), Device, simulate, the
-    identification, the viewer and the CLI all take a Description. It is immutable; what a
+    including the robot as ``robot_file``. ``Phantom(description)`` and ``load(description)``
+    take it, and everything else the Phantom made of it (``Device(phantom)``, the identification,
+    the viewer's ``load``) or, in the CLI, the Description itself. It is immutable; what a
     consumer computes once per description lives with that consumer, keyed by it
     (phantom_pin.identification.cache).
     """

@@ -11,8 +11,7 @@ import numpy as np
 from phantom_pin._validation import as_states, finite_result, same_batch
 from phantom_pin.config import Config
 from phantom_pin.config.types import STOP_COORDINATES, Motor
-from phantom_pin.description.build import Description
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.model import Phantom, constructor, shown
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.report import closed_form
 
@@ -20,9 +19,11 @@ from phantom_pin.report import closed_form
 class Device:
     """The PHANToM as a device: a Phantom plus its stops, friction, motors, encoders.
 
-    ``Device()`` wraps ``Phantom()``; ``Device(phantom)`` wraps a Phantom you built;
-    ``Device(source)`` wraps ``Phantom(source)`` for a model name or a Description (a folder
-    of one's own: ``Device(Phantom.from_folder(path))``). The device numbers
+    ``Device(phantom)`` wraps a Phantom (``Device()`` the default one, ``Phantom()``);
+    ``Device.from_model(name)`` a named model's (``Device(Phantom.from_model(name))``). A
+    Description or a folder of one's own goes through its Phantom:
+    ``Device(Phantom(description))``, ``Device(Phantom.from_folder(path))``; anything else given
+    to the plain call is refused with InvalidInputError naming ``phantom`` and that call. The device numbers
     (``config.actuation`` and ``config.limits.stops``) come from the Phantom's own
     configuration, so the transmission ratios, and hence the currents and the armature, agree.
 
@@ -45,13 +46,12 @@ class Device:
     ``ratios`` (3,), or None without public transmission ratios.
     """
 
-    def __init__(self, phantom: Phantom | Description | str | None = None) -> None:
-        if not isinstance(phantom, Phantom):
-            if phantom is not None and not isinstance(phantom, (Description, str)):
-                raise InvalidInputError(f"expected a phantom_pin.Phantom, a Description, a model name or None, got "
-                                        f"{phantom!r} (a configuration folder: Device(Phantom.from_folder(path)))",
-                                        argument="phantom")
-            phantom = Phantom(phantom)
+    def __init__(self, phantom: Phantom | None = None) -> None:
+        if phantom is None:
+            phantom = Phantom()
+        elif not isinstance(phantom, Phantom):
+            raise InvalidInputError(f"expected a phantom_pin.Phantom or None, got {shown(phantom)}; "
+                                    f"{constructor('Device', phantom)}", argument="phantom")
         self.phantom = phantom
         self.config: Config = phantom.config
         actuation = self.config.actuation
@@ -60,6 +60,12 @@ class Device:
         encoder = actuation.encoder
         self._counts_per_radian = None if encoder is None or self.ratios is None else \
             self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
+
+    @classmethod
+    def from_model(cls, name: str) -> Device:
+        """The named model ``name``'s device (phantom_pin.models()): ``Device(Phantom.from_model(name))``.
+        InvalidInputError naming ``name`` for anything else."""
+        return cls(Phantom.from_model(name))
 
     def require(self, section: str, needed_by: str) -> None:
         """MissingDataError naming ``needed_by`` unless the configuration has its ``section`` of

@@ -1,4 +1,5 @@
-"""load(): a description as a pinocchio RobotWrapper, in example-robot-data's style."""
+"""load(): a Description as a pinocchio RobotWrapper, in example-robot-data's style; load_files(): a
+PhantomLoader's URDF/SRDF pair of files."""
 
 from __future__ import annotations
 
@@ -8,15 +9,16 @@ import pinocchio as pin
 
 from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config import DEFAULT, MODELS, Config
-from phantom_pin.description.build import Description, description_of
+from phantom_pin.description.build import Description, shipped
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics.build import build_model, has_rotors, load_rotor_parameters
 from phantom_pin.dynamics.build import gravity_of as gravity_of  # (where it lived before)
+from phantom_pin.dynamics.model import Phantom, shown
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 
 
 class PhantomLoader:
-    """What load() reads: declared attributes only, as example-robot-data's loaders.
+    """What load_files() reads: declared attributes only, as example-robot-data's loaders.
 
     Subclass and override an attribute to load a URDF/SRDF pair of your own (for
     example one written by ``phantom-pin urdf --set ...``).
@@ -39,48 +41,74 @@ def _first_line(error: Exception) -> str:
     return lines[0] if lines else type(error).__name__
 
 
-def load(source: type[PhantomLoader] | Description | str = PhantomLoader) -> pin.RobotWrapper:
-    """The PHANToM as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
-    joint1..3 = the report's theta1..3 in rad), with ``visual_model``,
-    ``collision_model`` (every pair but the SRDF's disabled ones), the SRDF postures in
-    ``model.referenceConfigurations``, ``q0`` = the ``ref_posture`` (rad) and
+def load(description: Description | None = None) -> pin.RobotWrapper:
+    """The PHANToM of a Description as a RobotWrapper: ``model`` is the mimic model (nq = nv = 3,
+    joint1..3 = the report's theta1..3 in rad) with the configuration's gravity, with
+    ``visual_model``, ``collision_model`` (every pair but the SRDF's disabled ones), the SRDF
+    postures in ``model.referenceConfigurations``, ``q0`` = the ``resting`` posture (rad) and
     ``model.armature`` = the reflected rotor inertias (kg m^2). World = ``base_link``
     (REP-103: x forward, z up, origin at the shoulder).
 
-    ``source`` is a PhantomLoader (sub)class, whose files are read (the default: the
-    premium_1_5 model's committed files), a model name (phantom_pin.models(): its committed
-    files), or a Description (phantom_pin.describe; a configuration folder of one's own is
-    ``load(describe(folder))``), whose texts are used with PhantomLoader's other attributes.
-    The URDF must pass physical.check_urdf. Raises ParameterFileError naming
-    ``urdf_path`` or ``srdf_path`` for a missing, malformed or non-physical file.
+    ``description``: phantom_pin.describe(name or folder, overrides=...), or None for the default
+    model (premium_1_5, its committed files, as Phantom()). A model name is
+    ``load(describe(name))``, a folder ``load(describe(folder))``, a Phantom's
+    ``load(phantom.description)`` and a URDF/SRDF pair of files ``load_files(loader)``: anything
+    else is refused with InvalidInputError naming ``description`` and that call.
     """
-    if isinstance(source, Path) or (isinstance(source, str) and source not in MODELS):
-        raise InvalidInputError(f"expected a PhantomLoader class, a model name ({', '.join(MODELS)}) or a "
-                                f"Description, got {source!r}; for a configuration folder use "
-                                "load(describe(folder))", argument="source")
-    if isinstance(source, (Description, str)):
-        description = description_of(source, "source")
-        loader, urdf, srdf = PhantomLoader, description.urdf, description.srdf  # checked by describe()
-        urdf_name, srdf_name = "source: the description's URDF", "source: the description's SRDF"
-        config: Config | None = description.config
-    elif isinstance(source, type) and issubclass(source, PhantomLoader):
-        loader = source
-        texts = []
-        for name in ("urdf_path", "srdf_path"):
-            path = Path(getattr(loader, name))
-            if not path.is_file():
-                raise ParameterFileError(f"{path} is not a file", argument=name)
-            try:
-                texts.append(path.read_text(encoding="utf-8"))
-            except UnicodeDecodeError as error:
-                raise ParameterFileError(f"{path} is not a text file", argument=name) from error
-        urdf, srdf = texts
-        urdf_name, srdf_name = f"urdf_path: {loader.urdf_path}", f"srdf_path: {loader.srdf_path}"
-        check_urdf(urdf, urdf_name)
-        config = None  # a URDF file of one's own keeps Pinocchio's g and its rotors
-    else:
-        raise InvalidInputError(f"expected a PhantomLoader class, a model name, a configuration "
-                                f"folder or a Description, got {source!r}", argument="source")
+    if description is None:
+        description = shipped()
+    elif not isinstance(description, Description):
+        raise InvalidInputError(f"expected a phantom_pin.Description or None, got {shown(description)}; "
+                                f"{_load_call(description)}", argument="description")
+    return _robot(PhantomLoader, description.urdf, description.srdf,  # checked by describe()
+                  "description: the description's URDF", "description: the description's SRDF", description.config)
+
+
+def _load_call(given: object) -> str:
+    """The call that loads what load() was ``given`` and refused, for the refusal's message."""
+    if isinstance(given, type) and issubclass(given, PhantomLoader):
+        return "a PhantomLoader's files are load_files(loader)"
+    if isinstance(given, str) and given in MODELS:
+        return f"a named model is load(describe({given!r}))"
+    if isinstance(given, (str, Path)):
+        return "a configuration folder is load(describe(folder))"
+    if isinstance(given, Phantom):
+        return "a Phantom's is load(phantom.description)"
+    return "a model name or a folder is load(describe(name or folder)), a URDF/SRDF pair load_files(loader)"
+
+
+def load_files(loader: type[PhantomLoader] = PhantomLoader) -> pin.RobotWrapper:
+    """The RobotWrapper (as load()'s) of the files a PhantomLoader (sub)class names: its
+    ``urdf_path`` and ``srdf_path`` (the default: the premium_1_5 model's committed files), its
+    ``package_dirs``, ``ref_posture`` (``q0``) and ``has_rotor_parameters``. A URDF of one's own
+    keeps Pinocchio's gravity (9.81 m/s^2) and its SRDF's rotors. The URDF must pass
+    physical.check_urdf. Raises ParameterFileError naming ``urdf_path`` or ``srdf_path`` for a
+    missing, malformed or non-physical file; InvalidInputError naming ``loader`` for anything but
+    a PhantomLoader class (a Description is load(description))."""
+    if not (isinstance(loader, type) and issubclass(loader, PhantomLoader)):
+        hint = "; a Description is load(description)" if isinstance(loader, Description) else \
+            "; a model name or a folder is load(describe(name or folder))" if isinstance(loader, (str, Path)) else ""
+        raise InvalidInputError(f"expected a PhantomLoader class (or subclass), got {shown(loader)}{hint}",
+                                argument="loader")
+    texts = []
+    for name in ("urdf_path", "srdf_path"):
+        path = Path(getattr(loader, name))
+        if not path.is_file():
+            raise ParameterFileError(f"{path} is not a file", argument=name)
+        try:
+            texts.append(path.read_text(encoding="utf-8"))
+        except UnicodeDecodeError as error:
+            raise ParameterFileError(f"{path} is not a text file", argument=name) from error
+    urdf, srdf = texts
+    urdf_name, srdf_name = f"urdf_path: {loader.urdf_path}", f"srdf_path: {loader.srdf_path}"
+    check_urdf(urdf, urdf_name)
+    return _robot(loader, urdf, srdf, urdf_name, srdf_name, None)  # no configuration: Pinocchio's g, its rotors
+
+
+def _robot(loader: type[PhantomLoader], urdf: str, srdf: str, urdf_name: str, srdf_name: str,
+           config: Config | None) -> pin.RobotWrapper:
+    """The RobotWrapper of checked URDF and SRDF texts (named ``label: what`` in errors) with
+    ``loader``'s other attributes and ``config``'s gravity and rotors (None: Pinocchio's, the SRDF's)."""
     package_dirs = [str(p) for p in loader.package_dirs]
     try:
         model = build_model(urdf, config)

@@ -130,7 +130,7 @@ def before_fit(y: np.ndarray, prior: np.ndarray) -> list[str]:
     return joints + unit if (correlation >= FOLLOWS).all() or joints else []
 
 
-def problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Log, phantom: Phantom) -> list[str]:
+def problems(fit: Fit, structure: Structure, phi: np.ndarray, y: np.ndarray, log: Log, phantom: Phantom) -> list[str]:
     """Why ``fit`` should not be written (module doc), most telling first; ``phi`` (N, 3, P) the
     regressor over the fitted equations, ``y`` the logged torques less the known ones (N m,
     before the gains' correction)."""
@@ -149,8 +149,9 @@ def problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Lo
         found.append("the fit leaves " + ", ".join(f"{100 * s:.0f} %" for s in share) + " of the torque RMS "
                      f"(at most {100 * MAX_RESIDUAL_SHARE:.0f} %): the torques do not follow the motion; check "
                      "that theta and tau are the same samples, in rad and N m")
-    joints, unit, wrong = torque_problems(y, phi @ (model.matrix @ model.prior + model.offset), np.full(3, follows))
-    found = joints + found + unit + _fitted(fit, model)
+    expected = phi @ (structure.matrix @ structure.prior + structure.offset)
+    joints, unit, wrong = torque_problems(y, expected, np.full(3, follows))
+    found = joints + found + unit + _fitted(fit, structure)
     for j in (1, 2) if len(wrong) < 3 and follows else ():    # the gains of joints whose size is plausible
         if j in wrong or GAIN_BOUNDS[0] <= fit.gains[j] <= GAIN_BOUNDS[1]:
             continue
@@ -163,12 +164,12 @@ def problems(fit: Fit, model: Structure, phi: np.ndarray, y: np.ndarray, log: Lo
     return found
 
 
-def _fitted(fit: Fit, model: Structure) -> list[str]:
+def _fitted(fit: Fit, structure: Structure) -> list[str]:
     """The problems of the estimate itself: negative friction, a projection that moves a base
     parameter far (MAX_SHIFT_SIGMA and SHIFT_SHARE) or flips its sign."""
     found = []
     values, sigma = fit.friction
-    negative = [name for name, v, s in zip(model.names[-6:], values, sigma) if v < -3 * s]
+    negative = [name for name, v, s in zip(structure.names[-6:], values, sigma) if v < -3 * s]
     if negative:
         found.append(f"negative friction ({', '.join(negative)}): check the torque signs, units and "
                      "transmission ratios (friction is written as 0 or more)")
@@ -177,7 +178,7 @@ def _fitted(fit: Fit, model: Structure) -> list[str]:
     if far.size:
         k = far[np.argmax((moved / fit.sigma)[far])]
         flipped = np.sign(fit.written[k]) != np.sign(fit.beta[k])
-        name = model.base_names[k].split(" = ")[0]
+        name = structure.base_names[k].split(" = ")[0]
         name = name if len(name) <= 40 else name[:40].rsplit(" ", 1)[0] + " ..."
         found.append(f"the nearest physical parameters move beta{k + 1} ({name}) from "
                      f"{fit.beta[k]:.4g} to {fit.written[k]:.4g} {fit.units[k]} ({moved[k] / fit.sigma[k]:.3g} "

@@ -58,13 +58,13 @@ NEEDS_GENERAL = 1.2
 
 @dataclasses.dataclass(frozen=True)
 class _Regression:
-    """A log made ready for the fit: its filtered ``samples``, the structure's ``model``, the
+    """A log made ready for the fit: its filtered ``samples``, its ``structure``, the
     regressor ``phi`` (N, 3, P) zeroed outside the fitted equations ``moving`` (N, 3), the known
     torques ``tau0`` (N, 3; N m), the prior (beta_0, P) or None (prior_spread inf), the friction
     speed threshold ``min_speed`` (rad/s) and, where it was chosen, each one's held-out residual."""
 
     samples: Samples
-    model: Structure
+    structure: Structure
     phi: np.ndarray
     tau0: np.ndarray
     moving: np.ndarray
@@ -130,30 +130,30 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     stage(0.4)
     timed = _timing_and_gains(ready, timing, delay, gains)
     stage(0.5)
-    model, phi, moving, p = ready.model, ready.phi, ready.moving, ready.phi.shape[-1]
+    chosen, phi, moving, p = ready.structure, ready.phi, ready.moving, ready.phi.shape[-1]
     log_sigma = np.sqrt(np.diag(inverse_information(timed.information)))[:p]
     covariance, information = timed.covariance[:p, :p], marginal(timed.information, p)
     x, sigma = _projection(ready, timed.beta, covariance, prior_weight)
     stage(0.7)
     samples = dataclasses.replace(timed.samples, tau=timed.samples.tau * timed.gains)   # in joint 1's torque scale
     y = (samples.tau - ready.tau0) * moving
-    written = model.matrix @ x + model.offset
-    fit = Fit(structure=model.name, names=model.base_names, units=model.units, beta=timed.beta, sigma=sigma,
+    written = chosen.matrix @ x + chosen.offset
+    fit = Fit(structure=chosen.name, names=chosen.base_names, units=chosen.units, beta=timed.beta, sigma=sigma,
               rms=rms(y - phi @ timed.beta, moving), written_rms=rms(y - phi @ written, moving),
               torque_rms=rms(y, moving), condition=condition_number(phi.reshape(-1, phi.shape[-1])),
               samples=len(samples.theta), x=x,
-              written=written, overrides=model.overrides(x), comparison=_comparison(model, phantom, samples),
+              written=written, overrides=chosen.overrides(x), comparison=_comparison(chosen, phantom, samples),
               gains=timed.gains, gains_estimated=timed.estimated, prior_beta=ready.beta0,
               log_beta=timed.log_beta[:p], log_sigma=log_sigma, log_rms=timed.log_rms,
-              prediction=judge(model.regressor_of, phantom.config.limits, phi, y, moving, written, covariance,
-                               ready.beta0, information, priors.typical(model.matrix, model.scale),
-                               model.base_names, spread),
+              prediction=judge(chosen.regressor_of, phantom.config.limits, phi, y, moving, written, covariance,
+                               ready.beta0, information, priors.typical(chosen.matrix, chosen.scale),
+                               chosen.base_names, spread),
               delay=timed.delay, delay_estimated=delay is None, timing=timing, timing_residual=timed.residuals,
               ratios=phantom.config.actuation.ratios, min_speed=ready.min_speed,
               min_speed_scores=ready.min_speed_scores,
               curves=Curves(log.t[samples.index], samples.dtheta, samples.tau, phi @ written + ready.tau0,
                             samples.friction @ x[-6:], moving))
-    problems = checks.problems(fit, model, phi, (timed.samples.tau - ready.tau0) * moving, log, phantom)
+    problems = checks.problems(fit, chosen, phi, (timed.samples.tau - ready.tau0) * moving, log, phantom)
     stage(1.0)
     return dataclasses.replace(fit, problems=tuple(problems))
 
@@ -255,19 +255,19 @@ def _projection(ready: _Regression, beta: np.ndarray, covariance: np.ndarray,
     """Stage 5: the structure's physical parameters nearest to ``beta`` in the metric of
     ``covariance`` (physical.nearest), and beta's standard deviations; LogError where the log
     alone (no prior) leaves a direction unconstrained."""
-    model = ready.model
+    structure = ready.structure
     sigma = np.sqrt(np.diag(covariance))
     if not np.isfinite(sigma).all():
-        loose = ", ".join(model.base_names[k].split(" = ")[0][:40] for k in np.flatnonzero(~np.isfinite(sigma))[:3])
+        loose = ", ".join(structure.base_names[k].split(" = ")[0][:40] for k in np.flatnonzero(~np.isfinite(sigma))[:3])
         raise LogError(f"not exciting enough for the log alone: it leaves {loose} unconstrained; identify with "
                        "the prior (a finite prior_spread)", argument="prior_spread")
-    return model.nearest(beta, metric_root(covariance), prior_weight), sigma
+    return structure.nearest(beta, metric_root(covariance), prior_weight), sigma
 
 
 
-def _comparison(model: Structure, phantom: Phantom, samples: Samples) -> tuple[str, np.ndarray] | None:
+def _comparison(structure: Structure, phantom: Phantom, samples: Samples) -> tuple[str, np.ndarray] | None:
     """The other structure's least-squares residual RMS per joint (N m), if it applies."""
-    other = "report" if model.name == "general" else "general"
+    other = "report" if structure.name == "general" else "general"
     if other == "report" and phantom.config.report is None:
         return None
     phi, tau0 = STRUCTURES[other](phantom).regressor_of(samples.theta, samples.dtheta, samples.ddtheta,

@@ -89,7 +89,7 @@ def _check_arguments(**values: float) -> None:
         raise InvalidInputError(f"expected a share in (0, 1], got {values['torque_share']!r}", argument="torque_share")
 
 
-def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,
+def optimise(phantom: Phantom, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
              restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
              progress: Callable[[float], None] | None = None,
@@ -107,7 +107,7 @@ def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,
     ``times`` (s, the file's samples; default: the same points), stepping back towards the
     start until the stops' margin and the torque share hold there too, and its condition
     numbers, peak torque and nearest approach are those at ``times``. ``progress(share)`` is
-    called with the share of the SLSQP iterations done. ``model``: the Phantom whose
+    called with the share of the SLSQP iterations done. ``phantom``: the Phantom whose
     configuration is excited."""
     _check_arguments(period=period, harmonics=harmonics, samples=samples, margin=margin, torque_share=torque_share,
                      restarts=restarts, iterations=iterations, seed=seed, amplitude_weight=amplitude_weight)
@@ -117,15 +117,15 @@ def optimise(model: Phantom, period: float = 5.0, harmonics: int = 5,
         times = np.asarray(times, dtype=float)
         if times.ndim != 1 or not len(times) or not np.isfinite(times).all():
             raise InvalidInputError("expected a non-empty 1-D array of finite times (s)", argument="times")
-    if not isinstance(model, Phantom):
+    if not isinstance(phantom, Phantom):
         raise InvalidInputError(f"expected a phantom_pin.Phantom (Phantom(description) for a Description), got a "
-                                f"{type(model).__name__}", argument="model")
-    problem = _Problem(model, period, harmonics, samples, margin, torque_share, amplitude_weight, times)
+                                f"{type(phantom).__name__}", argument="phantom")
+    problem = _Problem(phantom, period, harmonics, samples, margin, torque_share, amplitude_weight, times)
     best = _search(problem, restarts, iterations, seed, progress)
     trajectory = Fourier.from_free(best, harmonics, period)
     states, phi, torque = problem.evaluate(best, problem.checked, exact=True)
     report = None
-    if model.description.config.report is not None:
+    if phantom.description.config.report is not None:
         report = condition_number(Report(problem.general.phantom).regressor_of(*states)[0].reshape(-1, 14))
     return Excitation(trajectory, condition_number(phi), report, np.abs(torque).max(axis=0),
                       float(problem.limits.slack(states[0]).min()))

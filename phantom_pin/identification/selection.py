@@ -32,10 +32,10 @@ MIN_SPEEDS, FOLDS = (0.01, 0.02, 0.05, 0.1), 4
 TIE = 0.02
 
 
-def choose_min_speed(log: Log, phantom: Phantom, model: Structure, cutoff: float, timing: str, delay: float,
+def choose_min_speed(log: Log, phantom: Phantom, structure: Structure, cutoff: float, timing: str, delay: float,
                      prior: tuple[np.ndarray, np.ndarray] | None) -> tuple[float, dict[float, float], Samples]:
     """(the threshold chosen, rad/s; each threshold's held-out weighted residual: the module doc;
-    the log filtered for the chosen one) of ``log`` on ``model`` (a Structure of ``phantom``)
+    the log filtered for the chosen one) of ``log`` on ``structure`` (a Structure of ``phantom``)
     filtered at ``cutoff`` Hz with the torques at ``timing`` and ``delay`` s; ``prior``:
     (beta_0, P) or None. LogError (the smallest threshold's) where none leaves enough motion."""
     law = phantom.config.actuation.friction
@@ -54,7 +54,7 @@ def choose_min_speed(log: Log, phantom: Phantom, model: Structure, cutoff: float
         raise refused
     moving = {speed: candidate.moving for speed, candidate in candidates.items()}
     samples = next(iter(candidates.values()))         # all alike but for moving
-    phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
+    phi, tau0 = structure.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     y = samples.tau - tau0
     judged = moving[max(moving)]                                           # where every threshold fits
     part = np.minimum((np.arange(len(y)) * FOLDS) // len(y), FOLDS - 1)

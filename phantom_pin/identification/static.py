@@ -145,10 +145,10 @@ def estimate_gravity(rest: Rest, phantom: Phantom, prior_spread: float = priors.
     if not np.isfinite(spread):
         raise InvalidInputError("rest postures determine gravity only: the prior holds the rest (a finite spread)",
                                 argument="prior_spread")
-    model = General(phantom)
-    basis = _directions(model, phantom)
-    beta0, prior = priors.base_prior(model.matrix, model.offset, model.prior, model.scale, spread)
-    phi, known = _gravity(model, rest.theta)
+    structure = General(phantom)
+    basis = _directions(structure, phantom)
+    beta0, prior = priors.base_prior(structure.matrix, structure.offset, structure.prior, structure.scale, spread)
+    phi, known = _gravity(structure, rest.theta)
     a, y = phi @ basis, rest.tau - known
     gamma0, gamma_prior = basis.T @ beta0, basis.T @ prior @ basis
     determined = _rank(a / np.sqrt(np.diag(gamma_prior)))
@@ -160,28 +160,28 @@ def estimate_gravity(rest: Rest, phantom: Phantom, prior_spread: float = priors.
     gain = prior @ basis @ np.linalg.inv(gamma_prior)          # beta | gamma: the prior's regression
     beta = beta0 + gain @ (gamma - gamma0)
     covariance = prior - gain @ basis.T @ prior + gain @ gamma_covariance @ gain.T
-    x = _projection(model, beta, covariance, prior_weight)
-    written = model.matrix @ x + model.offset
-    check = _gravity(model, sample_postures(phantom.config.limits, CHECK_POSTURES, np.random.default_rng(SEED)))[0]
+    x = _projection(structure, beta, covariance, prior_weight)
+    written = structure.matrix @ x + structure.offset
+    check = _gravity(structure, sample_postures(phantom.config.limits, CHECK_POSTURES, np.random.default_rng(SEED)))[0]
     size = np.sqrt(((check @ written) ** 2).mean(axis=0))
     size = np.where(size > 1e-9 * size.max(), size, np.nan)          # joint 1 carries no gravity: no share
     sigma = np.sqrt(np.einsum("nip,pq,niq->ni", check @ basis, gamma_covariance, check @ basis))
     residual = np.sqrt(((y - a @ (basis.T @ written)) ** 2).mean(axis=0))
     return Gravity(beta, covariance, x, written, basis.shape[1], determined, scale, scale_sigma, residual,
                    np.sqrt((sigma**2).mean(axis=0)) / size, _fewest(a, gamma_prior, determined),
-                   _suggested(model, phantom, basis, a, gamma_prior))
+                   _suggested(structure, phantom, basis, a, gamma_prior))
 
 
-def _gravity(model: Structure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _gravity(structure: Structure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(Phi_g (N, 3, P), the known torques (N, 3; N m)) at rest at the postures ``theta`` (rad)."""
     zero = np.zeros_like(theta)
-    return model.regressor_of(theta, zero, zero, np.zeros((len(theta), 3, 6)))
+    return structure.regressor_of(theta, zero, zero, np.zeros((len(theta), 3, 6)))
 
 
-def _directions(model: Structure, phantom: Phantom) -> np.ndarray:
+def _directions(structure: Structure, phantom: Phantom) -> np.ndarray:
     """The base parameters' gravity directions (P, r): the right singular vectors of Phi_g over
     GRAVITY_POSTURES seeded postures inside the stops."""
-    phi, _ = _gravity(model, sample_postures(phantom.config.limits, GRAVITY_POSTURES, np.random.default_rng(SEED)))
+    phi, _ = _gravity(structure, sample_postures(phantom.config.limits, GRAVITY_POSTURES, np.random.default_rng(SEED)))
     _, sizes, vt = np.linalg.svd(phi.reshape(-1, phi.shape[-1]), full_matrices=False)
     return vt[sizes > RANK_TOLERANCE * sizes[0]].T
 
@@ -229,9 +229,9 @@ def _scaled(a: np.ndarray, y: np.ndarray, gamma0: np.ndarray,
     return s, sigma, s * gamma0, sigma**2 * np.outer(gamma0, gamma0) + s**2 * shape
 
 
-def _projection(model: Structure, beta: np.ndarray, covariance: np.ndarray, prior_weight: float) -> np.ndarray:
+def _projection(structure: Structure, beta: np.ndarray, covariance: np.ndarray, prior_weight: float) -> np.ndarray:
     """The physical parameters nearest to ``beta`` in the metric of ``covariance`` (physical.nearest)."""
-    return model.nearest(beta, metric_root(covariance, 1e-12), prior_weight)
+    return structure.nearest(beta, metric_root(covariance, 1e-12), prior_weight)
 
 
 def _fewest(a: np.ndarray, prior: np.ndarray, rank: int) -> tuple[int, ...]:
@@ -244,13 +244,13 @@ def _fewest(a: np.ndarray, prior: np.ndarray, rank: int) -> tuple[int, ...]:
     return tuple(sorted(chosen))
 
 
-def _suggested(model: Structure, phantom: Phantom, basis: np.ndarray, a: np.ndarray,
+def _suggested(structure: Structure, phantom: Phantom, basis: np.ndarray, a: np.ndarray,
                prior: np.ndarray) -> np.ndarray:
     """SUGGESTED postures inside the stops (of seeded candidates) that most raise the smallest
     singular value of the gravity regressor ``a`` (N, 3, r; in the directions ``basis``) scaled
     by the prior's spread, each chosen after the ones before."""
     candidates = sample_postures(phantom.config.limits, 200, np.random.default_rng(SEED + 1), margin=0.05)
-    rows = _gravity(model, candidates)[0] @ basis / np.sqrt(np.diag(prior))
+    rows = _gravity(structure, candidates)[0] @ basis / np.sqrt(np.diag(prior))
     stacked, chosen = a / np.sqrt(np.diag(prior)), list[int]()
     for _ in range(SUGGESTED):
         k = max((k for k in range(len(candidates)) if k not in chosen),
