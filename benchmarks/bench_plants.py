@@ -25,7 +25,7 @@ DURATION = 2.0
 
 
 def wall_controller():
-    """examples/virtual_wall.py's 1000 N/m wall under a 1 N push (tests/test_plants.py)."""
+    """examples/virtual_wall.py's 1000 N/m wall under a 1 N push (tests/device/test_mujoco_plant.py)."""
     phantom, normal = DEVICE.phantom, np.array([0.0, 1.0, 0.0])
     surface = phantom.forward_kinematics(START)[:3, 3]
 

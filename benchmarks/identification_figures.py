@@ -6,7 +6,7 @@ prior, the estimated delay), judged on the WRITTEN model against the device.
 
 Measured on the shared 2-core machine (x86_64, Python 3.11): the full table (81 rows) in 12 min 48 s
 of wall time (11 min 15 s of CPU); --quick (5 rows) in 13-24 s. Not run in CI: its --quick clean
-row is checked by tests/test_identification_figures.py.
+row is checked by tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
 - ``cad``: the Premium 1.5 built from independent CAD mass properties (``premium_1_5_cad``: full

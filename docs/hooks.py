@@ -8,7 +8,7 @@
   README (its numbers' sources and how it differs from a plain import) and every line of its
   YAML that says ESTIMATE, with file and line: read from where they live, never copied.
 
-tests/test_docs_site.py imports this file to check that every subcommand and option appears.
+tests/integration/test_docs_site.py imports this file to check that every subcommand and option appears.
 """
 
 from __future__ import annotations

@@ -64,7 +64,7 @@ def check(phantom: Phantom, states: int = 1000, seed: int = 0,
     parameters are the report's, the closed form against the appendix's printed Tau1-Tau3
     (error over the printed rounding, tolerance 1). ``progress(done)`` gets the states done.
     A model with a stylus gimbal (the Touch) is checked without it (description.gimbal.arm_only):
-    the report has none; tests/test_gimbal.py checks the gimbal's load against its own laws.
+    the report has none; tests/description/test_gimbal.py checks the gimbal's load against its own laws.
 
     Raises InvalidInputError naming ``states`` outside 1..MAX_STATES, and naming ``phantom``
     for anything but a Phantom (a model name: check(Phantom.from_model(name))) or a model not
@@ -83,8 +83,8 @@ def check(phantom: Phantom, states: int = 1000, seed: int = 0,
         given = (" with the --params/--set overrides (links in full, as identify's general overlay writes them)"
                  if phantom.config.overridden else "")
         raise InvalidInputError(f"the model {phantom.config.name}{given} is not written in the report's terms, "
-                                f"so the closed form does not apply (tests/test_cad_model.py checks a model in full "
-                                f"against an independent derivation)", argument="phantom")
+                                "so the closed form does not apply (tests/config/test_cad_model.py checks a model in "
+                                "full against an independent derivation)", argument="phantom")
     if phantom.config.gimbal is not None:  # the report's arm has no stylus: check the arm alone
         phantom = Phantom(arm_only(phantom.description))
     worst = {name: [0.0, 0.0] for name in METHODS}  # max |ours - reference|, max |reference|

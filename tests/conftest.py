@@ -99,30 +99,32 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 #: --dist loadgroup; every other test is handed out one by one): a group name for each test
 #: whose node id contains the key. A module whose module-scoped fixture (or a cache of its
 #: helpers, shared with another module) is expensive computes it once, not once per worker
-#: (test_codegen: its headers, generated once per arguments; the SymPy derivations of
+#: (codegen/test_generate.py: its headers, generated once per arguments; the SymPy derivations of
 #: cad_reference and phantom_pin.report.derivation); the ROS 2 node tests over loopback run one
 #: at a time.
 GROUPS = {
-    "test_identification_general.py::": "identification_general",
-    "test_identification_prior.py::": "lab_log",
-    "test_identification_delay.py::": "lab_log",
-    "test_identification_end_to_end.py::": "identification_end_to_end",
-    "test_gazebo.py::": "gazebo",
-    "test_codegen.py::": "codegen",
-    "test_cad_model.py::": "cad_model",
-    "test_derivation.py::": "derivation",
-    "test_ros2.py::test_the_node_": "ros2",
-    "test_drivers_ros2.py::test_the_stylus_floats": "ros2",
-    "test_drivers_ros2.py::test_without_the_node": "ros2",
+    "identification/test_general_structure.py::": "identification_general",
+    "identification/test_prior.py::": "lab_log",
+    "identification/test_timing.py::": "lab_log",
+    "identification/test_end_to_end.py::": "identification_end_to_end",
+    "integration/test_gazebo.py::": "gazebo",
+    "codegen/test_generate.py::": "codegen",
+    "config/test_cad_model.py::": "cad_model",
+    "report/test_derivation.py::": "derivation",
+    "tests/test_ros2.py::test_the_node_": "ros2",
+    "integration/test_drivers_ros2.py::test_the_stylus_floats": "ros2",
+    "integration/test_drivers_ros2.py::test_without_the_node": "ros2",
 }
 
 #: Tests that start a meshcat server (a share of the lock below), and those that check that a
 #: server's URL is dead once it stopped (the whole lock): meshcat takes the first free port
 #: from 7000, so a server another worker started meanwhile would answer there.
-MESHCAT_SERVERS = ("test_viewer.py::", "test_meshcat_server.py::", "test_cli.py::test_show_html_",
-                   "test_gimbal.py::test_the_viewer_", "test_touch.py::test_the_command_line_serves_the_touch",
-                   "test_examples.py::test_visualize_", "test_examples.py::test_existing_output_is_kept_without_force")
-MESHCAT_URL_CHECKS = ("test_cli.py::test_show_serves_", "test_cli.py::test_show_stops_")
+MESHCAT_SERVERS = ("viewer/test_viewer.py::", "viewer/test_server.py::", "cli/test_cli.py::test_show_html_",
+                   "description/test_gimbal.py::test_the_viewer_",
+                   "config/test_touch_model.py::test_the_command_line_serves_the_touch",
+                   "integration/test_examples.py::test_visualize_",
+                   "integration/test_examples.py::test_existing_output_is_kept_without_force")
+MESHCAT_URL_CHECKS = ("cli/test_cli.py::test_show_serves_", "cli/test_cli.py::test_show_stops_")
 
 
 @pytest.hookimpl(wrapper=True)

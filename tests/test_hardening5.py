@@ -73,8 +73,8 @@ def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_
     of the log alone (no prior at all): at MAX_SPREAD the prior no longer moves the estimate
     (relative difference below 1e-9 on a noiseless 10 s log of the model's own torques)."""
     from phantom_pin.identification import estimation, io, prior
-    from test_identification_prior import CONFIG as PREMIUM
-    from test_identification_prior import PRIOR, sum_of_sines
+    from test_prior import CONFIG as PREMIUM
+    from test_prior import PRIOR, sum_of_sines
 
     t, theta, dtheta, ddtheta = sum_of_sines(10, 0.2, 1)
     tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + PREMIUM.actuation.friction.torque(dtheta)
@@ -166,7 +166,7 @@ def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_
 
 def test_the_cli_page_says_what_ctrl_c_does_to_show_and_ros2():
     """M7: the README (now docs/cli.md) promised one line and 130 on Ctrl-C for every command, while `show`'s live
-    viewer and `ros2` exit 0 on it, their normal stop (tests/test_cli.py's
+    viewer and `ros2` exit 0 on it, their normal stop (tests/cli/test_cli.py's
     test_show_serves_on_loopback_until_interrupted runs show and sends SIGINT: exit 0)."""
     readme = " ".join((Path(__file__).parents[1] / "docs" / "cli.md").read_text().split())
     start = readme.index("Ctrl-C prints one line and exits with 130")

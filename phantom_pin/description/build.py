@@ -198,7 +198,7 @@ def driver_urdf(source: str | Path, *, prefix: str = "",
 @functools.cache
 def shipped(name: str = configuration.DEFAULT) -> Description:
     """A named model with its committed URDF, SRDF and MJCF files (which
-    tests/test_description.py shows equal to describe(name)), read once per process."""
+    tests/description/test_description.py shows equal to describe(name)), read once per process."""
     if name not in configuration.MODELS:
         raise InvalidInputError(f"{name!r} is not a model ({', '.join(configuration.MODELS)})", argument="model")
     model = configuration.MODELS[name]

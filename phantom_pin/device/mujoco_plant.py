@@ -1,7 +1,7 @@
 """The device in MuJoCo, driven like phantom_pin.simulate: the Description's MJCF (its motors and
 their ctrlrange, frictionloss, armature, joint and tendon limits, the mimic equalities), a
 controller sampled at a fixed rate with a zero-order hold, and simulate()'s SimulationResult,
-so that one controller runs unchanged against both plants (tests/test_plants.py compares
+so that one controller runs unchanged against both plants (tests/device/test_mujoco_plant.py compares
 them). Needs MuJoCo (``pip install phantom_pin[interop]``).
 """
 

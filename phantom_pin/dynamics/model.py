@@ -136,7 +136,7 @@ class Phantom:
     @classmethod
     def from_model(cls, name: str) -> Phantom:
         """The named model ``name`` (phantom_pin.models()), from its committed URDF and SRDF
-        (equal to describe(name)'s, tests/test_description.py). InvalidInputError naming
+        (equal to describe(name)'s, tests/description/test_description.py). InvalidInputError naming
         ``name`` for anything else."""
         if not (isinstance(name, str) and name in MODELS):
             raise InvalidInputError(f"expected one of {', '.join(MODELS)}, got {name!r}"
@@ -433,7 +433,7 @@ class Phantom:
                     and BOOL is not q.dtype and BOOL is not dtheta.dtype  # type: ignore[attr-defined]
                     and BOOL is not ddtheta.dtype):  # type: ignore[attr-defined]
                 tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
-                # NaN/inf in any input, or an overflow, reaches tau (tests/test_fast_paths.py);
+                # NaN/inf in any input, or an overflow, reaches tau (tests/dynamics/test_fast_paths.py);
                 # only then are the inputs inspected, to name the bad one.
                 t0, t1, t2 = tau.tolist()
                 if isfinite(t0 + t1 + t2):

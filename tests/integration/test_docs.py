@@ -10,7 +10,7 @@ from phantom_pin.config import MODELS
 
 CONFIG_DIR, URDF_PATH = MODELS["premium_1_5"].config, MODELS["premium_1_5"].urdf
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_readme_quick_start_says_how_to_get_chromium_for_the_tests():

@@ -14,7 +14,7 @@ from phantom_pin.identification.base import base_parameters
 from phantom_pin.identification.regressor import Regressor
 from phantom_pin.identification.structures import Report, Structured
 from phantom_pin.report import closed_form
-from test_identification_regressor import states as _states
+from test_regressor import states as _states
 
 REGRESSOR = Regressor(Phantom())
 DESCRIPTION = REGRESSOR.phantom.description
@@ -100,10 +100,10 @@ def test_sample_stays_inside_the_regressors_own_limits():
 
 
 def test_a_smooth_excitation_shows_all_26_base_parameters():
-    """On a three-frequency trajectory (tests/test_identification_estimation.py's, sampled at
+    """On a three-frequency trajectory (tests/identification/test_estimation.py's, sampled at
     50 Hz) the weakest of the 26 base parameters pivots at about 1e-5 of the strongest: the
     rank keeps it (a tolerance of 1e-4 would give 25)."""
-    from test_identification_estimation import log
+    from test_estimation import log
 
     data = log()
     rates = np.gradient(data.theta, data.t, axis=0)

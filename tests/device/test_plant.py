@@ -23,7 +23,7 @@ UPPER_1, COUPLED_MAX = 90 * DEG, 65 * DEG        # joint 1's upper stop, theta2 
 RATIOS = np.array([13.3, 11.6, 11.6])            # the report (docs/errata.md E15)
 TAU_NOMINAL, TAU_STALL = 28.6e-3, 129e-3         # N m, maxon RE 25 data sheet
 ENCODER_CPR, QUADRATURE = 1024, 4                # HEDM-5500, decoded X4
-DEVICE_DIR = Path(__file__).resolve().parents[1] / "phantom_pin" / "device"
+DEVICE_DIR = Path(__file__).resolve().parents[2] / "phantom_pin" / "device"
 
 
 @pytest.fixture(scope="module")

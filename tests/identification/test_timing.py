@@ -16,8 +16,8 @@ from phantom_pin.cli import main
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import estimation, filtering, io, result, simulation
-from test_identification_end_to_end import COULOMB, VISCOUS, truth_overrides
-from test_identification_prior import PRIOR, error, sum_of_sines, truth_log
+from test_end_to_end import COULOMB, VISCOUS, truth_overrides
+from test_prior import PRIOR, error, sum_of_sines, truth_log
 
 TRUE_FRICTION = np.array([VISCOUS] * 3 + [COULOMB] * 3)
 

@@ -289,7 +289,7 @@ def _floats_and_lifts(name: str, watcher: Watcher, drift: float) -> None:
 
 
 #: The documents that print the one-file relay for the omni_msgs driver (`ros2 --relay`).
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 #: The documents that print the relay: README.md and the documentation pages with an OmniFeedback block.
 RELAY = re.compile(r"```python(?:-norun)?\n[^`]*OmniFeedback")
 DOCUMENTS = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md")]
@@ -300,7 +300,7 @@ STAND_IN = "from geometry_msgs.msg import Wrench as OmniFeedback\n"
 
 def relay_block(document: str) -> str:
     """The one python block of ``document`` that uses omni_msgs' OmniFeedback, as printed."""
-    text = (Path(__file__).resolve().parents[1] / document).read_text()
+    text = (Path(__file__).resolve().parents[2] / document).read_text()
     blocks = [b for b in re.findall(r"```python(?:-norun)?\n(.*?)```", text, re.DOTALL) if "OmniFeedback" in b]
     assert len(blocks) == 1, f"{document}: {len(blocks)} relay blocks"
     return blocks[0]

@@ -12,7 +12,7 @@ from test_examples import figure, number, run
 #: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
 pytestmark = pytest.mark.slow
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_identify_simulated_example(tmp_path, machine_environment):

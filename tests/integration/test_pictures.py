@@ -14,7 +14,7 @@ from PIL import Image
 from phantom_pin import InvalidInputError, models
 from phantom_pin.viewer.screenshot import screenshot
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "docs" / "pictures.py"
 NAMES = [*models(), "frames"]
 

@@ -11,8 +11,8 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-ROOT = Path(__file__).resolve().parent.parent
-SCHEMA = json.loads((Path(__file__).parent / "data" / "cff-1.2.0-schema.json").read_text(encoding="utf-8"))
+ROOT = Path(__file__).resolve().parents[2]
+SCHEMA = json.loads((Path(__file__).parents[1] / "data" / "cff-1.2.0-schema.json").read_text(encoding="utf-8"))
 
 
 def _citation() -> dict:

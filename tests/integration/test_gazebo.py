@@ -15,7 +15,7 @@ import yaml
 from phantom_pin.config import MODELS, models
 
 pytestmark = pytest.mark.sdformat
-PROBE = Path(__file__).with_name("sdformat_probe.cpp")
+PROBE = Path(__file__).parents[1] / "sdformat_probe.cpp"
 #: sdformat's joint type enumeration (sdf::JointType): 6 is REVOLUTE.
 REVOLUTE = 6
 

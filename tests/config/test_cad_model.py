@@ -12,7 +12,7 @@ import yaml
 
 from cad_reference import gravity, mass_matrix
 
-FOLDER = Path(__file__).resolve().parent.parent / "robots/phantom_description/config/premium_1_5_cad"
+FOLDER = Path(__file__).resolve().parents[2] / "robots/phantom_description/config/premium_1_5_cad"
 JOINTS = ("joint1", "joint2", "joint3")
 N, SEED, TOLERANCE = 200, 20261123, 1e-9
 

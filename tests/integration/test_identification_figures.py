@@ -1,7 +1,7 @@
 """benchmarks/identification_figures.py --quick on its clean row: the CAD-built Premium 1.5,
 identified on the shipped model from excite's trajectory (20 s, instantaneous torques, no
 noise), judged against bounds from elsewhere: the prior's error recomputed here, and the
-accuracy tests/test_identification_general.py documents for a NOISY log of a device of the
+accuracy tests/identification/test_general_structure.py documents for a NOISY log of a device of the
 same kind (0.068 % on 500 states, friction within 1.3 %): a clean log must do at least as well."""
 
 import os
@@ -18,7 +18,7 @@ from phantom_pin.config.sampling import random_states
 #: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
 pytestmark = pytest.mark.slow
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "benchmarks" / "identification_figures.py"
 CLEAN = "clean, instantaneous torques, --torque-timing sampled"
 

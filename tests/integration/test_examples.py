@@ -20,7 +20,7 @@ from phantom_pin import closed_form as cf
 #: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
 pytestmark = pytest.mark.slow
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def run(script: str, out: Path, *argv: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:

@@ -18,7 +18,7 @@ from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import random_states
 from phantom_pin.identification import estimation, excitation, io, least_squares, prediction, simulation
 from phantom_pin.identification.structures import General
-from test_identification_end_to_end import COULOMB, VISCOUS, truth_overrides
+from test_end_to_end import COULOMB, VISCOUS, truth_overrides
 
 RATE = 1000.0
 #: The working posture the lab's motion is centred on (rad): inside every stop.

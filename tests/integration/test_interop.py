@@ -1,6 +1,6 @@
 """The committed URDF and MJCF in other tools: MuJoCo, Drake and urdfdom's check_urdf, for
 every model written in the report's terms (premium_1_5 and touch: the closed form applies;
-premium_1_5_cad has its own SymPy reference, tests/test_cad_model.py).
+premium_1_5_cad has its own SymPy reference, tests/config/test_cad_model.py).
 
 Each tool's dynamics are compared with the report's closed form (phantom_pin.report.closed_form),
 projected to theta1..theta3 through the coupling matrix G read from the URDF's mimic tags
@@ -329,7 +329,7 @@ def test_drake_warns_only_what_it_ignores_and_the_docs_line_silences_it(case):
     line of docs/tools.md ("In other tools") drops exactly those."""
     import logging
 
-    readme = (Path(__file__).resolve().parents[1] / "docs" / "tools.md").read_text()
+    readme = (Path(__file__).resolve().parents[2] / "docs" / "tools.md").read_text()
     assert SILENCE_DRAKE in readme
 
     class Records(logging.Handler):
@@ -372,7 +372,7 @@ def test_the_docs_drake_snippet_fixes_the_base_and_gives_the_closed_forms_gravit
     base: the arm fell as a free body)."""
     import re
 
-    readme = (Path(__file__).resolve().parents[1] / "docs" / "tools.md").read_text()
+    readme = (Path(__file__).resolve().parents[2] / "docs" / "tools.md").read_text()
     block = next(b for b in re.findall(r"```python\n(.*?)```", readme, re.DOTALL) if "WeldFrames" in b)
     scope: dict = {}
     exec(block, scope)
