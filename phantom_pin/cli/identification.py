@@ -111,6 +111,14 @@ def _held_stylus(gimbal: np.ndarray) -> dict[str, float]:
     return {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(middle)}
 
 
+def _reference(path: Path | None) -> tuple[np.ndarray, np.ndarray] | None:
+    """--reference's trajectory (excite's CSV): its times (s) and angles (rad), or None."""
+    if path is None:
+        return None
+    t, theta = io.read_trajectory(path)[:2]
+    return t, theta
+
+
 def _delay(text: str | None) -> float | None:
     """--delay's seconds (None: estimate it), checked by timing.delay_argument."""
     if text is None:
@@ -162,6 +170,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                "(near rest a joint sticks; default: chosen from the log of "
                                + ", ".join(f"{v:g}" for v in selection.MIN_SPEEDS) + " rad/s on held-out quarters "
                                "of it, docs/identification.md, step 4)")
+    identify.add_argument("--reference", type=Path, default=None, metavar="TRAJ.csv",
+                          help="the trajectory the servo loop tracked (excite's CSV, the report's convention, read "
+                               "from the log's start): the log is a closed loop on it, identified with instrumental "
+                               "variables against the noise the loop feeds back into the motion")
     identify.add_argument("--fixed-gains", action="store_true",
                           help="take the log's torques as they are (default: estimate each joint's torque gain "
                                "relative to joint 1, correct the model for it and report it)")
@@ -311,7 +323,8 @@ def identify_command(args: argparse.Namespace) -> int:
         result = identify(log, phantom, cutoff=args.cutoff, structure=args.structure, timing=args.torque_timing,
                           prior_spread=args.prior_spread, delay=delay, gains=not args.fixed_gains,
                           min_speed=args.min_speed, accept=args.accept, given=given, source=args.log.name,
-                          progress=bar.update)
+                          progress=bar.update,
+                          reference=_reference(args.reference))
     except RefusedError as error:
         raise PhantomPinError(f"{refusal(error.problems)}; nothing written (--accept writes it anyway)") from None
     finally:
