@@ -76,6 +76,7 @@ def test_instrumental_variables_find_the_simulation(fits):
     assert viscous < 0.2 and coulomb < 0.02
     assert held_out_error(iv) < 0.02                         # the log's predicted uncertainty: 1.9 % (joint 1)
     assert (iv.gains == 1).all()                             # no gain corrected: the device's are 1
+    assert not np.any(iv.gains_estimated[1])                 # nor estimated: instrumented, they are biased
 
 
 def test_a_reference_the_log_does_not_follow_is_refused():
@@ -92,3 +93,32 @@ def test_bad_references_are_refused(reference):
     with pytest.raises(InvalidInputError) as error:
         estimate(log, PRIOR, reference=reference)
     assert isinstance(error.value, (ValueError, PhantomPinError)) and error.value.argument == "reference"
+
+
+def test_identify_reference_on_the_command_line(tmp_path, capsys):
+    """`identify LOG --reference TRAJ.csv`: the closed loop said in the printed report, the torque
+    gains kept at 1 (said in that line); a reference the log does not follow or no
+    trajectory file refused in one line naming --reference, exit 2, nothing written."""
+    from phantom_pin.cli import main
+    from phantom_pin.identification import io
+
+    log, (t, theta) = closed_loop()
+    t_, theta_, dtheta, ddtheta = sum_of_sines(DURATION, AMPLITUDE, SEED)
+    io.write_log(tmp_path / "log.csv", log.t, log.theta, log.tau)
+    table = np.column_stack([t_, theta_, dtheta, ddtheta, np.zeros_like(theta_)])
+    io.write_csv(tmp_path / "traj.csv", io.TRAJECTORY_COLUMNS, table)
+    lengths = [f"--set=kinematics.{k}={v!r}" for k, v in dataclasses.asdict(TRUTH.config.kinematics).items()]
+    common = ["-q", *lengths, "identify", str(tmp_path / "log.csv")]
+    code = main([*common, "--reference", str(tmp_path / "traj.csv"), "-o", str(tmp_path / "id.yaml")])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "closed loop: the log follows the reference given" in out and (tmp_path / "id.yaml").is_file()
+    assert "the torque gains not estimated" in out
+    # the reference played backwards: a trajectory file of its own, which the log does not follow
+    reversed_ = np.column_stack([t_, theta_[::-1], -dtheta[::-1], ddtheta[::-1], np.zeros_like(theta_)])
+    io.write_csv(tmp_path / "backwards.csv", io.TRAJECTORY_COLUMNS, reversed_)
+    for reference in ("backwards.csv", "missing.csv"):
+        code = main([*common, "--reference", str(tmp_path / reference), "-o", str(tmp_path / "no.yaml")])
+        err = capsys.readouterr().err
+        assert code == 2 and err.count("\n") == 1 and "--reference" in err, err
+        assert not (tmp_path / "no.yaml").exists()

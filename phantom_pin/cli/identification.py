@@ -58,7 +58,7 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
 TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
                    ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", "held"),
                    ("min_speed", "--min-speed", None), ("cutoff", "--cutoff", 20.0),
-                   ("accept", "--accept", False), ("report", "--report", None))
+                   ("accept", "--accept", False), ("report", "--report", None), ("reference", "--reference", None))
 
 
 def _static_command(args: argparse.Namespace, phantom: Phantom, recording: bags.Recording | None,
@@ -111,11 +111,16 @@ def _held_stylus(gimbal: np.ndarray) -> dict[str, float]:
     return {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(middle)}
 
 
-def _reference(path: Path | None) -> tuple[np.ndarray, np.ndarray] | None:
-    """--reference's trajectory (excite's CSV): its times (s) and angles (rad), or None."""
+def _reference(path: Path | None, model: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """--reference's trajectory (excite's CSV in the report's convention, for ``model``): its times
+    (s) and angles (rad), or None; a file that is not one is refused naming --reference."""
     if path is None:
         return None
-    t, theta = io.read_trajectory(path)[:2]
+    check_record(path, model, "report", "--reference")
+    try:
+        t, theta = io.read_trajectory(path)[:2]
+    except PhantomPinError as error:
+        raise PhantomPinError(str(error), argument="--reference") from None
     return t, theta
 
 
@@ -153,7 +158,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                                "into a --params overlay (YAML)")
     identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
                                                          "prior_spread": "--prior-spread", "delay": "--delay",
-                                                         "min_speed": "--min-speed"})
+                                                         "min_speed": "--min-speed", "reference": "--reference"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3, or a "
                                                  "driver's rosbag2 recording (a folder, or its .mcap/.db3 file)")
     identify.add_argument("--driver", choices=profiles.names(), default=None,
@@ -324,7 +329,7 @@ def identify_command(args: argparse.Namespace) -> int:
                           prior_spread=args.prior_spread, delay=delay, gains=not args.fixed_gains,
                           min_speed=args.min_speed, accept=args.accept, given=given, source=args.log.name,
                           progress=bar.update,
-                          reference=_reference(args.reference))
+                          reference=_reference(args.reference, phantom.config.name))
     except RefusedError as error:
         raise PhantomPinError(f"{refusal(error.problems)}; nothing written (--accept writes it anyway)") from None
     finally:

@@ -82,7 +82,8 @@ class Instruments:
         """The printed line: the closed loop and its tracking."""
         tracking = ", ".join(f"{1e3 * e:.3g}" for e in self.tracking)
         return (f"closed loop: the log follows the reference given within {tracking} mrad RMS per joint; "
-                "instrumental variables (the regressor at the reference's motion), delay and gains with them")
+                "instrumental variables (the regressor at the reference's motion), the delay with them; "
+                "the torque gains not estimated (instrumented, unmodelled friction biases them)")
 
 
 def reference_angles(log: Log, reference: object) -> np.ndarray:
