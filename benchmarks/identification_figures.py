@@ -5,7 +5,8 @@ prior, the estimated delay), judged on the WRITTEN model against the device.
     python benchmarks/identification_figures.py [--quick] [-o FILE [--force]]
 
 Measured on the shared 2-core machine (x86_64, Python 3.11): the full table (81 rows) in 12 min 48 s
-of wall time (11 min 15 s of CPU); --quick (5 rows) in 13-24 s. Not run in CI: its --quick clean
+of wall time (11 min 15 s of CPU), before the two instrumental-variable conditions (12 rows more, not
+timed; the CAD's lab pair: 17 s); --quick (5 rows) in 13-24 s. Not run in CI: its --quick clean
 row is checked by tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
@@ -43,7 +44,9 @@ rigid body and rotors, viscous + Coulomb friction with stiction, stops, saturati
   actuation.yaml's per-joint keys) with a Stribeck peak (STRIBECK, a torque added to the
   plant's input), and all at once (identified with identify's defaults: held timing, delay
   estimated), also at 120 s, without the torque constant's error, and the friction and all at
-  once with ``--min-speed 0.05`` (the equations near rest left out: a Stribeck peak).
+  once with ``--min-speed 0.05`` (the equations near rest left out: a Stribeck peak); the current
+  noise and all at once with the reference the loop tracked given to identify (``estimate(reference=)``:
+  instrumental variables against the noise the loop feeds back, instruments.py).
 
 Columns: held-out error of the written model's rigid-body torques (``Phantom(describe(folder,
 overrides=overlay(fit)))``, rotors included, friction not) against the device's own inverse
@@ -85,7 +88,7 @@ from phantom_pin.identification.result import gain_warning, timing_warning
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
 #: The report-structured devices: each report parameter (parameterization.SYMBOLS) times its
-#: factor (the first moments take their mass's and length's): tests/test_identification_end_to_end's
+#: factor (the first moments take their mass's and length's): tests/identification/test_end_to_end's
 #: device; the Touch's as tests/test_touch's (Idfxx 1.1: every link of the Touch stays physical).
 MOVED = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85, "Iczz": 0.85,
          "mbe": 1.25, "mbe*l5": 1.25 * 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3, "mdf": 1.3, "mdf*l6": 1.3 * 0.9,
@@ -169,7 +172,8 @@ class Condition:
     """How the device is run and identified: the device's ``quantization``, ``noise`` (10 mA),
     ``gain`` (joint 2's torque constant 2 % high), ``friction`` (per joint, Stribeck); the log's
     ``duration`` (s), ``sampled`` (instantaneous torques, else the held commands), ``delay``
-    (samples late); identify's ``timing`` and ``min_speed`` (rad/s, --min-speed)."""
+    (samples late); identify's ``timing`` and ``min_speed`` (rad/s, --min-speed); ``reference``:
+    identify is given the motion the loop tracked (instrumental variables, instruments.py)."""
 
     name: str
     quantization: bool = False
@@ -181,6 +185,7 @@ class Condition:
     delay: int = 0
     timing: str = "sampled"
     min_speed: float = MIN_SPEED
+    reference: bool = False
 
     @property
     def device_key(self) -> tuple[bool, bool, bool, bool]:
@@ -206,6 +211,9 @@ CONDITIONS = {
     "all_slow": Condition("all at once, --min-speed 0.05", min_speed=0.05, **EVERYTHING),
     "all_long": Condition(f"all at once, {LONG:g} s", duration=LONG, **EVERYTHING),
     "all_but_gain": Condition("all at once but the torque constant", **{**EVERYTHING, "gain": False}),
+    "noise_iv": Condition("10 mA current noise, the reference given (instrumental variables)", noise=True,
+                          reference=True),
+    "all_iv": Condition("all at once, the reference given (instrumental variables)", reference=True, **EVERYTHING),
 }
 QUICK = ("clean", "gain", "delay", "all")
 
@@ -450,8 +458,9 @@ def rows_of(figures: Figures, kinds: tuple[str, ...], conditions: dict[str, Cond
             if setup.openhaptics:           # written and read back in OpenHaptics' convention
                 log = io.read_log(through_openhaptics(log, folder), "openhaptics")
             started = time.perf_counter()
+            reference = figures.trajectory(kind, condition.duration)[:2] if condition.reference else None
             fit = estimate(log, setup.prior, structure=setup.structure, timing=condition.timing, delay=None,
-                           min_speed=condition.min_speed)
+                           min_speed=condition.min_speed, reference=reference)
             judge(figures, fit, row, condition)
             progress(f"{setup.name}, {kind}, {condition.name}: {row.verdict}, held-out "
                      f"{100 * row.trajectory_error:.3f} / {100 * row.states_error:.3f} % "

@@ -58,7 +58,7 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
 TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
                    ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", "held"),
                    ("min_speed", "--min-speed", None), ("cutoff", "--cutoff", 20.0),
-                   ("accept", "--accept", False), ("report", "--report", None))
+                   ("accept", "--accept", False), ("report", "--report", None), ("reference", "--reference", None))
 
 
 def _static_command(args: argparse.Namespace, phantom: Phantom, recording: bags.Recording | None,
@@ -111,6 +111,19 @@ def _held_stylus(gimbal: np.ndarray) -> dict[str, float]:
     return {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(middle)}
 
 
+def _reference(path: Path | None, model: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """--reference's trajectory (excite's CSV in the report's convention, for ``model``): its times
+    (s) and angles (rad), or None; a file that is not one is refused naming --reference."""
+    if path is None:
+        return None
+    check_record(path, model, "report", "--reference")
+    try:
+        t, theta = io.read_trajectory(path)[:2]
+    except PhantomPinError as error:
+        raise PhantomPinError(str(error), argument="--reference") from None
+    return t, theta
+
+
 def _delay(text: str | None) -> float | None:
     """--delay's seconds (None: estimate it), checked by timing.delay_argument."""
     if text is None:
@@ -145,7 +158,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                                "into a --params overlay (YAML)")
     identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
                                                          "prior_spread": "--prior-spread", "delay": "--delay",
-                                                         "min_speed": "--min-speed"})
+                                                         "min_speed": "--min-speed", "reference": "--reference"})
     identify.add_argument("log", type=Path, help="CSV with the header t,theta1,theta2,theta3,tau1,tau2,tau3, or a "
                                                  "driver's rosbag2 recording (a folder, or its .mcap/.db3 file)")
     identify.add_argument("--driver", choices=profiles.names(), default=None,
@@ -162,6 +175,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                "(near rest a joint sticks; default: chosen from the log of "
                                + ", ".join(f"{v:g}" for v in selection.MIN_SPEEDS) + " rad/s on held-out quarters "
                                "of it, docs/identification.md, step 4)")
+    identify.add_argument("--reference", type=Path, default=None, metavar="TRAJ.csv",
+                          help="the trajectory the servo loop tracked (excite's CSV, the report's convention, read "
+                               "from the log's start): the log is a closed loop on it, identified with instrumental "
+                               "variables against the noise the loop feeds back into the motion")
     identify.add_argument("--fixed-gains", action="store_true",
                           help="take the log's torques as they are (default: estimate each joint's torque gain "
                                "relative to joint 1, correct the model for it and report it)")
@@ -311,7 +328,8 @@ def identify_command(args: argparse.Namespace) -> int:
         result = identify(log, phantom, cutoff=args.cutoff, structure=args.structure, timing=args.torque_timing,
                           prior_spread=args.prior_spread, delay=delay, gains=not args.fixed_gains,
                           min_speed=args.min_speed, accept=args.accept, given=given, source=args.log.name,
-                          progress=bar.update)
+                          progress=bar.update,
+                          reference=_reference(args.reference, phantom.config.name))
     except RefusedError as error:
         raise PhantomPinError(f"{refusal(error.problems)}; nothing written (--accept writes it anyway)") from None
     finally:

@@ -56,7 +56,8 @@ class Fit:
     the log better. ``curves``: the samples fitted, measured and predicted (Curves).
     ``min_speed`` (rad/s): the friction speed threshold fitted with; ``min_speed_scores``: each
     threshold's held-out weighted residual where it was chosen from the log (selection.py), else
-    empty."""
+    empty. ``closed_loop``: where the log was identified as a closed loop on a reference given,
+    the line that says so (instrumental variables, instruments.py), else empty."""
 
     structure: str
     names: tuple[str, ...]
@@ -88,6 +89,7 @@ class Fit:
     curves: Curves | None = None
     min_speed: float = 0.01          # filtering.MIN_SPEED (not imported: fit.py stays below filtering)
     min_speed_scores: dict[float, float] = dataclasses.field(default_factory=dict)
+    closed_loop: str = ""
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:

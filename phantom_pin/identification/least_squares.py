@@ -41,27 +41,31 @@ def condition_number(phi: np.ndarray) -> float:
 
 
 def fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
-        prior: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, ...]:
+        prior: tuple[np.ndarray, np.ndarray] | None = None,
+        measured: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
     """Weighted least squares of y (N, 3; N m) on phi (N, 3, P) over the equations ``moving``
     (N, 3; all by default): (beta, covariance, residual (N, 3; 0 where not fitted), joint
     weights (3,), the log's information Phi_w^T Phi_w / s^2, the log alone's beta), each joint
     weighted by 1 / its residual standard deviation. With ``prior`` (beta_0, P), the
     Gauss-Markov estimate with that prior (module doc), solved in the base parameters scaled by
     the prior's standard deviations (a singular value decomposition: the log alone may leave
-    directions unconstrained)."""
+    directions unconstrained). ``measured`` (N, 3, P): the regressor the residuals (and so the
+    weights and the noise's variance) are measured with, where ``phi`` is its projection on
+    instruments (instruments.py: two-stage least squares); ``phi`` by default."""
     import scipy.linalg  # here: 0.17 s that every command line start paid
 
     p = phi.shape[-1]
     moving = np.ones(y.shape, bool) if moving is None else moving
     phi, y = phi * moving[..., None], y * moving
+    measured = phi if measured is None else measured * moving[..., None]
     stacked = phi.reshape(-1, p)
     beta = np.linalg.lstsq(stacked, y.reshape(-1), rcond=None)[0]
-    residual = y - phi @ beta
+    residual = y - measured @ beta
     joint_sigma = np.sqrt((residual**2).sum(axis=0) / np.maximum(moving.sum(axis=0) - p / 3, 1))
     weight = 1.0 / np.maximum(joint_sigma, 1e-300)
     weighted, yw = (phi * weight[:, None]).reshape(-1, p), (y * weight).reshape(-1)
     beta = log_beta = np.linalg.lstsq(weighted, yw, rcond=None)[0]
-    rw = yw - weighted @ beta
+    rw = yw - (measured * weight[:, None]).reshape(-1, p) @ beta
     variance = rw @ rw / (moving.sum() - p)
     information = weighted.T @ weighted / variance
     if prior is None:
@@ -76,7 +80,7 @@ def fit(phi: np.ndarray, y: np.ndarray, moving: np.ndarray | None = None,
         u, sizes, vt = np.linalg.svd(stacked, full_matrices=False)
         beta = d * (vt.T @ ((u.T @ rhs) / sizes))
         covariance = (vt.T / sizes**2) @ vt * np.outer(d, d)
-    return beta, covariance, y - phi @ beta, weight, information, log_beta
+    return beta, covariance, y - measured @ beta, weight, information, log_beta
 
 
 def inverse_information(information: np.ndarray) -> np.ndarray:
@@ -110,7 +114,8 @@ def marginal(information: np.ndarray, p: int) -> np.ndarray:
 
 
 def solve_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.ndarray,
-                prior: tuple[np.ndarray, np.ndarray] | None, free: tuple[int, ...]) -> tuple:
+                prior: tuple[np.ndarray, np.ndarray] | None, free: tuple[int, ...],
+                measured: np.ndarray | None = None) -> tuple:
     """The estimate of beta with the torque gains of the joints ``free`` (of 1, 2; the others
     1): tau_j = (Phi_j beta + tau0_j) / g_j (module doc) solved by Gauss-Newton in beta and the
     inverse gains, linear about the last estimate, the inverse gains' columns being the model's
@@ -118,12 +123,15 @@ def solve_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.n
     shrink the residual, biasing the gains). ``phi`` (N, 3, P) and ``tau``, ``tau0`` (N, 3; N m)
     the regressor, the logged and the known torques, ``prior`` (beta_0, P) or None. Returns
     (beta, covariance, information (of beta and the free inverse gains), the log alone's beta
-    and residual RMS per joint in joint 1's scale (N m), (gains (3,), standard deviations (3,)))."""
+    and residual RMS per joint in joint 1's scale (N m), (gains (3,), standard deviations (3,))).
+    ``measured``: the regressor the residuals are measured with where ``phi`` is its projection
+    on instruments (``fit``); the gains' columns are then the instruments' torques."""
     import scipy.linalg
 
     p, scale = phi.shape[-1], np.ones(3)
+    measured = phi if measured is None else measured
     # where to start: the gains at 1 (with none free, the loop's one pass is that fit: not done twice)
-    beta = fit(phi, (tau - tau0) * moving, moving, prior)[0] if free else np.zeros(p)
+    beta = fit(phi, (tau - tau0) * moving, moving, prior, measured)[0] if free else np.zeros(p)
     if prior is not None:
         prior = (np.concatenate([prior[0], np.zeros(len(free))]),
                  scipy.linalg.block_diag(prior[1], GAIN_SPREAD**2 * np.eye(len(free))))
@@ -133,15 +141,16 @@ def solve_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.n
         for k, j in enumerate(free):
             columns[:, j, k] = predicted[:, j]
         system = np.concatenate([phi * scale[:, None], columns], axis=-1)
+        residual_system = np.concatenate([measured * scale[:, None], columns], axis=-1)
         rhs = (tau - scale * tau0) * moving
         if prior is not None:         # the inverse gains' prior mean is 1: their change's, 1 - scale
             prior = (np.concatenate([prior[0][:p], 1.0 - scale[list(free)]]), prior[1])
-        solution, covariance, _, _, information, log_beta = fit(system, rhs, moving, prior)
+        solution, covariance, _, _, information, log_beta = fit(system, rhs, moving, prior, residual_system)
         beta, change = solution[:p], solution[p:]
         scale[list(free)] += change
         if not free or np.abs(change).max() <= GAIN_TOLERANCE:
             break
-    log_rms = rms(rhs - system @ log_beta, moving) / scale
+    log_rms = rms(rhs - residual_system @ log_beta, moving) / scale
     sigma = np.zeros(3)
     sigma[list(free)] = np.sqrt(np.diag(covariance)[p:]) / scale[list(free)] ** 2
     return beta, covariance, information, log_beta, log_rms, (1.0 / scale, sigma)

@@ -45,6 +45,7 @@ class Identification:
         lines = [f"{self.rows} samples at {self.rate:.6g} Hz, {fit.samples} used (filtered at {self.cutoff:g} Hz); "
                  f"{fit.structure} structure, {len(fit.beta)} base parameters; condition number {fit.condition:.3g} "
                  "(a diagnostic: the fit is judged by its predicted torques)"]
+        lines += [fit.closed_loop] if fit.closed_loop else []
         lines += timing_lines(fit) + [speed_line(fit)] + gain_lines(fit) + fit.prediction.lines()
         lines.append("residual RMS per joint [N m]: " + ", ".join(
             f"{r:.3g} ({100 * r / s:.2f} % of {s:.3g})" for r, s in zip(fit.rms, fit.torque_rms))
@@ -121,15 +122,17 @@ def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str
              timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
              gains: bool = True, min_speed: float | None = None, accept: bool = False,
              given: dict[str, object] | None = None, source: str = "a log",
-             progress: Callable[[float], None] | None = None) -> Identification:
+             progress: Callable[[float], None] | None = None,
+             reference: tuple[np.ndarray, np.ndarray] | None = None) -> Identification:
     """Identify the device of ``log`` (read_log: theta rad, tau N m in the report's convention)
     on ``phantom`` (its parameters the prior): estimation.estimate with these arguments (its
     docstring has their units), then the overlay's keys (overlays.overlay, with the overrides
     ``given`` the model was made with). Without ``accept``, a log with problems raises
     RefusedError: those found before any fit (the torques' unit, a joint's sign) before any
-    costly stage, the others after the fit. ``source``: the log's name in the overlay."""
+    costly stage, the others after the fit. ``source``: the log's name in the overlay.
+    ``reference``: (t s, theta rad) the motion a closed loop tracked (estimate's: instrumental variables)."""
     fit = estimate(log, phantom, cutoff, structure, progress=progress, timing=timing, prior_spread=prior_spread,
-                   delay=delay, gains=gains, min_speed=min_speed, refuse=not accept)
+                   delay=delay, gains=gains, min_speed=min_speed, refuse=not accept, reference=reference)
     if fit.problems and not accept:
         raise RefusedError(fit.problems)
     keys, notes = overlay(fit, given, phantom.config)  # checked: a physical model, or nothing written
