@@ -13,9 +13,8 @@ import pytest
 # OpenBLAS: the identification's SVDs and least squares on tall (3N, P) matrices took 3 to 5
 # times the CPU with OpenBLAS's threads on a 2-core machine (an `identify` of a 20 s log: 5.8 s
 # of CPU against 1.1 s), and with the xdist workers filling the cores a script's threads could
-# take minutes (`check -n 2e7` took 64 s to answer Ctrl-C). The setting the suite found ("" for
-# none) is kept beside it for machine_environment; the xdist workers inherit both.
-os.environ.setdefault("PHANTOM_PIN_TESTS_OPENBLAS_NUM_THREADS", os.environ.get("OPENBLAS_NUM_THREADS", ""))
+# take minutes (`check -n 2e7` took 64 s to answer Ctrl-C). The xdist workers inherit it; the
+# docs quote examples/identify_simulated.py's figures as printed with it.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # after the setting above
@@ -34,18 +33,6 @@ def phantom() -> Phantom:
 def limits() -> tuple[np.ndarray, np.ndarray]:
     p = CONFIG.limits
     return np.array(p.lower), np.array(p.upper)
-
-
-@pytest.fixture(scope="session")
-def machine_environment() -> dict[str, str]:
-    """The environment with OpenBLAS's threads as the suite found them (the machine's default
-    unless OPENBLAS_NUM_THREADS was set): for a script whose printed figures the docs quote (the
-    fit of examples/identify_simulated.py differs in its last digits with OpenBLAS's threads)."""
-    environment = {k: v for k, v in os.environ.items() if k != "PHANTOM_PIN_TESTS_OPENBLAS_NUM_THREADS"}
-    environment["OPENBLAS_NUM_THREADS"] = os.environ["PHANTOM_PIN_TESTS_OPENBLAS_NUM_THREADS"]
-    if not environment["OPENBLAS_NUM_THREADS"]:
-        del environment["OPENBLAS_NUM_THREADS"]
-    return environment
 
 
 @pytest.fixture()

@@ -156,8 +156,13 @@ class _Problem:
         constraints stay differentiable for SLSQP), ``exact`` with the friction law itself."""
         at = self.t if at is None else at
         key = free.tobytes() + (b"exact" if exact else b"") + (b"" if at is self.t else b"checked")
-        if key not in self._memo:
-            self._memo.clear()
+        if key in self._memo:
+            self._memo[key] = self._memo.pop(key)            # the newest: kept longest
+        else:
+            # SLSQP's finite differences of the cost and then of the constraints step to the same
+            # points: keep one gradient's worth of evaluations (the oldest dropped first)
+            while len(self._memo) > 2 * len(free) + 4:
+                del self._memo[next(iter(self._memo))]
             states = Fourier.from_free(free, self.harmonics, self.period)(at)
             rates = states[1]
             smooth = None if exact else friction_block(np.concatenate([rates, np.tanh(rates / SMOOTH_SPEED)], axis=-1))

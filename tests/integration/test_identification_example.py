@@ -15,8 +15,8 @@ pytestmark = pytest.mark.slow
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def test_identify_simulated_example(tmp_path, machine_environment):
-    result = run("identify_simulated.py", tmp_path, env=machine_environment)   # as the docs' figures were made
+def test_identify_simulated_example(tmp_path):
+    result = run("identify_simulated.py", tmp_path)   # one BLAS thread (conftest), as the docs' figures were made
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "identify_simulated.png")
     general = number(r"identified \(general\) (\S+) %", result.stdout)
