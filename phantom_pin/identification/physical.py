@@ -24,10 +24,23 @@ from phantom_pin.identification import parameterization
 from phantom_pin.inertial import problem
 from phantom_pin.report.parameters import links
 
-#: The barrier method's end: the duality gap (in units of the whitened cost, a chi-square).
-GAP = 1e-7
+#: The barrier method's end: the duality gap (in units of the whitened cost, a chi-square). The
+#: cost sees a direction the data cannot see only through the prior (prior_weight^2 = 1e-6 of
+#: its typical size squared), so there the barrier's point at a finite weight lies off the
+#: optimum by up to sqrt(gap) / prior_weight of the typical size, at a place the metric's
+#: rounding moves (the covariance's conditioning leaves its stiff directions 1e-7 apart for logs
+#: a rounding apart). Issue 42, L14, measured: with a gap of 1e-7 the written link numbers were
+#: up to 7 % of their typical size off the optimum, and one log identified in two conventions
+#: up to 0.3 % (OpenHaptics' CSV) and 16 % (a bag, read back within 1e-9 s) of its link's size
+#: apart; with 1e-15, 7e-10 and 6e-8 (tests/test_identification_bags.py), for 1.2 times the CPU.
+GAP = 1e-15
 #: Newton steps per barrier weight, and the weight's growth.
 NEWTON_STEPS, GROWTH = 60, 10.0
+#: The Newton decrement below which a full step is taken (the quadratic phase: the function,
+#: weight x cost + the log-det barrier, is self-concordant, so the full step stays inside the
+#: domain and the decrement falls quadratically); the phase ends where it no longer falls
+#: (rounding), not in a line search that rounding defeats at large weights.
+QUADRATIC = 0.1
 
 
 def consistent(x: np.ndarray, config: Config) -> bool:
@@ -135,6 +148,22 @@ class _Barrier:
         self.rows = to_z[[list(free).index(i) for i in positive if i in free]]      # z_i = rows @ y > 0
         self.size = 4 * len(self.blocks) + len(self.rows)
 
+    def value(self, y: np.ndarray) -> float | None:
+        """The barrier at ``y`` alone (a line search's); None outside the domain."""
+        value = 0.0
+        for basis, constant in self.blocks:
+            try:
+                root = np.linalg.cholesky(constant + np.tensordot(y, basis, axes=1))
+            except np.linalg.LinAlgError:
+                return None
+            value -= 2 * np.log(np.diag(root)).sum()
+        if len(self.rows):
+            values = self.rows @ y
+            if (values <= 0).any():
+                return None
+            value -= np.log(values).sum()
+        return value if np.isfinite(value) else None
+
     def __call__(self, y: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
         """(the barrier, its gradient, its Hessian) at ``y``; None outside the domain."""
         value, gradient, curvature = 0.0, np.zeros(len(y)), np.zeros((len(y), len(y)))
@@ -179,11 +208,14 @@ def _barrier_method(barrier: _Barrier, whitened: _Whitened) -> np.ndarray:
 
 def _newton(barrier: _Barrier, cost: Callable[[np.ndarray], float], optimum: np.ndarray, y: np.ndarray,
             weight: float) -> np.ndarray:
-    """At most NEWTON_STEPS damped Newton steps on weight x cost + barrier from ``y``, each by a
-    backtracking line search that keeps y inside the domain."""
+    """At most NEWTON_STEPS Newton steps on weight x cost + barrier from ``y``: damped by a
+    backtracking line search that keeps y inside the domain while the decrement is at least
+    QUADRATIC, full (halved only to stay inside) below it, until the decrement is below 1e-12
+    or stops falling."""
+    previous = np.inf
     for _ in range(NEWTON_STEPS):
         evaluated = barrier(y)
-        if evaluated is None:  # the line search keeps y inside; rounding alone could leave
+        if evaluated is None:  # the steps keep y inside; rounding alone could leave
             break
         value, gradient, curvature = evaluated
         g = weight * (y - optimum) + gradient
@@ -195,14 +227,20 @@ def _newton(barrier: _Barrier, cost: Callable[[np.ndarray], float], optimum: np.
         if not np.isfinite(step).all():
             break
         decrement = -g @ step
-        if decrement < 1e-12:
+        if decrement < 1e-12 or decrement >= previous:
             break
-        here, alpha = weight * cost(y) + value, 1.0
-        while alpha > 1e-12:
-            trial = barrier(y + alpha * step)
-            if trial is not None and weight * cost(y + alpha * step) + trial[0] <= here - 0.25 * alpha * decrement:
-                break
-            alpha *= 0.5
+        alpha = 1.0
+        if decrement < QUADRATIC:
+            previous = decrement
+            while alpha > 1e-12 and barrier.value(y + alpha * step) is None:
+                alpha *= 0.5
+        else:
+            here = weight * cost(y) + value
+            while alpha > 1e-12:
+                trial = barrier.value(y + alpha * step)
+                if trial is not None and weight * cost(y + alpha * step) + trial <= here - 0.25 * alpha * decrement:
+                    break
+                alpha *= 0.5
         if alpha <= 1e-12:
             break
         y = y + alpha * step
