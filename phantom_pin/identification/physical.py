@@ -9,7 +9,9 @@ form a convex set, and the nearest of them to an estimate in any quadratic metri
 problem: ``nearest`` solves it by a log-det barrier (interior point) method whose Newton steps
 do not mind the metric's conditioning (the torques fix some combinations to 1e-8 and leave
 others to a prior). The decision stays with the one physical check of a link
-(phantom_pin.inertial.problem), which asks a margin of TRIANGLE_SLACK inside the boundary.
+(phantom_pin.inertial.problem), which asks a margin of TRIANGLE_SLACK inside the boundary; the
+barrier keeps a margin of its own that implies it (``margined``), so that its optimum passes the
+check by construction.
 """
 
 from __future__ import annotations
@@ -21,13 +23,29 @@ import numpy as np
 from phantom_pin.config import Config
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import parameterization
-from phantom_pin.inertial import problem
+from phantom_pin.inertial import TRIANGLE_SLACK, problem
 from phantom_pin.report.parameters import links
 
-#: The barrier method's end: the duality gap (in units of the whitened cost, a chi-square).
-GAP = 1e-7
+#: The barrier method's end: the duality gap (in units of the whitened cost, a chi-square). The
+#: cost sees a direction the data cannot see only through the prior (prior_weight^2 = 1e-6 of
+#: its typical size squared), so there the barrier's point at a finite weight lies off the
+#: optimum by up to sqrt(gap) / prior_weight of the typical size, at a place the metric's
+#: rounding moves (the covariance's conditioning leaves its stiff directions 1e-7 apart for logs
+#: a rounding apart). Issue 42, L14, measured: with a gap of 1e-7 the written link numbers were
+#: up to 7 % of their typical size off the optimum, and one log identified in two conventions
+#: up to 0.3 % (OpenHaptics' CSV) and 16 % (a bag, read back within 1e-9 s) of its link's size
+#: apart; with 1e-15, 7e-10 and 6e-8 (tests/test_identification_bags.py), for 1.2 times the CPU.
+GAP = 1e-15
 #: Newton steps per barrier weight, and the weight's growth.
 NEWTON_STEPS, GROWTH = 60, 10.0
+#: The Newton decrement below which a full step is taken (the quadratic phase: the function,
+#: weight x cost + the log-det barrier, is self-concordant, so the full step stays inside the
+#: domain and the decrement falls quadratically); the phase ends where it no longer falls
+#: (rounding), not in a line search that rounding defeats at large weights.
+QUADRATIC = 0.1
+#: The barrier's margin (``margined``): J - MARGIN tr(Sigma) diag(1, 1, 1, 0) positive definite
+#: gives a triangle slack above 2 MARGIN, twice the check's.
+MARGIN = TRIANGLE_SLACK
 
 
 def consistent(x: np.ndarray, config: Config) -> bool:
@@ -57,6 +75,22 @@ def pseudo_inertia(pi: np.ndarray) -> np.ndarray:
     return out
 
 
+def margined(j: np.ndarray) -> np.ndarray:
+    """The pseudo-inertia ``j`` less MARGIN tr(Sigma) on Sigma's diagonal: linear in j, so the
+    bodies whose margined J is positive definite are still a convex set. It is positive definite
+    exactly when m > 0 and the second moments at the centre of mass Sigma_c = Sigma - h h^T / m
+    exceed MARGIN tr(Sigma) >= MARGIN tr(Sigma_c) >= MARGIN c (c the largest principal moment,
+    tr(Sigma_c) less the smallest second moment); the triangle slack (a + b - c) / c is twice the
+    smallest second moment over c, so above 2 MARGIN = 2 TRIANGLE_SLACK, and the margin in units
+    of tr(Sigma) (m |c|^2 with the rest) also covers the rounding of the check's parallel-axis
+    step. Measured (issue 42, L14; the identification tests' 60 projections): with no margin 9
+    barrier ends at GAP = 1e-15 lay within rounding of the boundary (J's smallest eigenvalue
+    1e-16 of its largest) and failed the check, with it none."""
+    out = np.array(j, float)
+    out[:3, :3] -= MARGIN * np.trace(out[:3, :3]) * np.eye(3)
+    return out
+
+
 def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: np.ndarray,
             scale: np.ndarray, bodies: Sequence[tuple[np.ndarray, np.ndarray]], positive: Sequence[int],
             consistent: Callable[[np.ndarray], bool], fixed: Sequence[int] = (),
@@ -81,7 +115,7 @@ def nearest(target: np.ndarray, weights: np.ndarray, matrix: np.ndarray, prior: 
     x = whitened.full(_barrier_method(barrier, whitened))
     if consistent(x):
         return x
-    low, high = 0.0, 1.0          # the barrier's end lies within rounding of the boundary: step back
+    low, high = 0.0, 1.0          # not met (``margined`` and the bodies keep it off): step back
     for _ in range(60):
         middle = (low + high) / 2
         if consistent(prior + middle * (x - prior)):
@@ -121,35 +155,65 @@ class _Whitened:
 
 
 class _Barrier:
-    """-log det of every body's pseudo-inertia J - log z_i of the positive entries, over y
-    (_Whitened); each J as C + sum_j y_j B_j. ``size``: the number of barrier terms (4 a body)."""
+    """-log det of every body's margined pseudo-inertia J (``margined``) - log z_i of the positive
+    entries, over y (_Whitened); each J as C + sum_j y_j B_j, all bodies at once (``bases``
+    (bodies, len(y), 4, 4), ``constants`` (bodies, 4, 4)). ``size``: the number of barrier terms
+    (4 a body)."""
 
     def __init__(self, whitened: _Whitened, bodies: Sequence[tuple[np.ndarray, np.ndarray]],
                  positive: Sequence[int]) -> None:
         free, scale, to_z = whitened.free, whitened.scale, whitened.to_z
-        self.blocks = []
+        bases, constants = [], []
         for a, b in bodies:
             a = np.asarray(a, float)[:, free] * scale[free] @ to_z
             if np.abs(a).max() > 0:
-                self.blocks.append((np.array([pseudo_inertia(column) for column in a.T]), pseudo_inertia(b)))
+                bases.append([margined(pseudo_inertia(column)) for column in a.T])
+                constants.append(margined(pseudo_inertia(b)))
+        self.bases = np.array(bases).reshape(len(bases), len(to_z.T), 4, 4)
+        self.constants = np.array(constants).reshape(len(constants), 4, 4)
         self.rows = to_z[[list(free).index(i) for i in positive if i in free]]      # z_i = rows @ y > 0
-        self.size = 4 * len(self.blocks) + len(self.rows)
+        self.size = 4 * len(self.bases) + len(self.rows)
+
+    def _roots(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """(every J, its Cholesky factor) at ``y``; None outside the domain (a J not positive
+        definite, to rounding)."""
+        j = self.constants + np.einsum("j,bjkl->bkl", y, self.bases)
+        try:
+            return j, np.linalg.cholesky(j)
+        except np.linalg.LinAlgError:
+            return None
+
+    def value(self, y: np.ndarray) -> float | None:
+        """The barrier at ``y`` alone (a line search's); None outside the domain."""
+        roots = self._roots(y)
+        if roots is None:
+            return None
+        value = -2 * np.log(np.diagonal(roots[1], axis1=1, axis2=2)).sum()
+        if len(self.rows):
+            values = self.rows @ y
+            if (values <= 0).any():
+                return None
+            value -= np.log(values).sum()
+        return float(value) if np.isfinite(value) else None
 
     def __call__(self, y: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
         """(the barrier, its gradient, its Hessian) at ``y``; None outside the domain."""
-        value, gradient, curvature = 0.0, np.zeros(len(y)), np.zeros((len(y), len(y)))
-        for basis, constant in self.blocks:
-            j = constant + np.tensordot(y, basis, axes=1)
-            try:                       # outside the domain (J not positive definite, to rounding)
-                root = np.linalg.cholesky(j)
-                inverse_basis = np.linalg.solve(j, basis)                  # J^-1 B_j, stacked
-            except np.linalg.LinAlgError:
-                return None
-            if not np.isfinite(inverse_basis).all():
-                return None
-            value -= 2 * np.log(np.diag(root)).sum()
-            gradient -= np.trace(inverse_basis, axis1=1, axis2=2)
-            curvature += np.einsum("iab,jba->ij", inverse_basis, inverse_basis)
+        roots = self._roots(y)
+        if roots is None:
+            return None
+        j, root = roots
+        try:
+            inverse_basis = np.linalg.inv(j)[:, None] @ self.bases           # J^-1 B_j, (bodies, y, 4, 4)
+        except np.linalg.LinAlgError:
+            return None
+        if not np.isfinite(inverse_basis).all():
+            return None
+        value = -2 * np.log(np.diagonal(root, axis1=1, axis2=2)).sum()
+        gradient = -np.trace(inverse_basis, axis1=2, axis2=3).sum(axis=0)
+        # tr(M_i M_j) = <M_i, M_j^T>, summed over the bodies: one product
+        flat = inverse_basis.transpose(1, 0, 2, 3).reshape(len(y), -1)
+        flat_t = inverse_basis.transpose(1, 0, 3, 2).reshape(len(y), -1)
+        curvature = flat @ flat_t.T
         if len(self.rows):
             values = self.rows @ y
             if (values <= 0).any():
@@ -157,7 +221,7 @@ class _Barrier:
             value -= np.log(values).sum()
             gradient -= self.rows.T @ (1 / values)
             curvature += (self.rows.T / values**2) @ self.rows
-        return value, gradient, curvature
+        return float(value), gradient, curvature
 
 
 def _barrier_method(barrier: _Barrier, whitened: _Whitened) -> np.ndarray:
@@ -179,11 +243,14 @@ def _barrier_method(barrier: _Barrier, whitened: _Whitened) -> np.ndarray:
 
 def _newton(barrier: _Barrier, cost: Callable[[np.ndarray], float], optimum: np.ndarray, y: np.ndarray,
             weight: float) -> np.ndarray:
-    """At most NEWTON_STEPS damped Newton steps on weight x cost + barrier from ``y``, each by a
-    backtracking line search that keeps y inside the domain."""
+    """At most NEWTON_STEPS Newton steps on weight x cost + barrier from ``y``: damped by a
+    backtracking line search that keeps y inside the domain while the decrement is at least
+    QUADRATIC, full (halved only to stay inside) below it, until the decrement is below 1e-12
+    or stops falling."""
+    previous = np.inf
     for _ in range(NEWTON_STEPS):
         evaluated = barrier(y)
-        if evaluated is None:  # the line search keeps y inside; rounding alone could leave
+        if evaluated is None:  # the steps keep y inside; rounding alone could leave
             break
         value, gradient, curvature = evaluated
         g = weight * (y - optimum) + gradient
@@ -195,14 +262,20 @@ def _newton(barrier: _Barrier, cost: Callable[[np.ndarray], float], optimum: np.
         if not np.isfinite(step).all():
             break
         decrement = -g @ step
-        if decrement < 1e-12:
+        if decrement < 1e-12 or decrement >= previous:
             break
-        here, alpha = weight * cost(y) + value, 1.0
-        while alpha > 1e-12:
-            trial = barrier(y + alpha * step)
-            if trial is not None and weight * cost(y + alpha * step) + trial[0] <= here - 0.25 * alpha * decrement:
-                break
-            alpha *= 0.5
+        alpha = 1.0
+        if decrement < QUADRATIC:
+            previous = decrement
+            while alpha > 1e-12 and barrier.value(y + alpha * step) is None:
+                alpha *= 0.5
+        else:
+            here = weight * cost(y) + value
+            while alpha > 1e-12:
+                trial = barrier.value(y + alpha * step)
+                if trial is not None and weight * cost(y + alpha * step) + trial <= here - 0.25 * alpha * decrement:
+                    break
+                alpha *= 0.5
         if alpha <= 1e-12:
             break
         y = y + alpha * step

@@ -111,7 +111,7 @@ class Structure:
         links = self.constant.copy()
         links[self.regressor.inertial] -= self.regressor.carried
         bodies = [(self.affine[rows], links[rows]) for rows in
-                  (slice(10 * k, 10 * k + 10) for k in range(len(self.regressor.bodies)))]
+                  (slice(10 * k, 10 * k + 10) for k in range(len(self.regressor.bodies)))] + self.checked()
         rotor = [self.rotor] if self.rotor is not None else []
         positive = (rotor if self.motor else []) + list(range(n - 6, n))
         fixed = [] if self.motor or self.rotor is None else rotor
@@ -119,6 +119,12 @@ class Structure:
         start[n - 6:] = np.maximum(start[n - 6:], 1e-3 * self.friction_scale)
         return physical.nearest(target - self.offset, weights, self.matrix, start, self.scale, bodies,
                                 positive, self.consistent, fixed, prior_weight)
+
+    def checked(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The bodies ``consistent`` checks besides the tree's links, each as (A, b) with its
+        standard parameters A x + b: nearest's barrier must hold them too, or its optimum (on
+        the links' boundary) can leave one of them outside (issue 42, L14)."""
+        return []
 
     def friction_ok(self, x: np.ndarray) -> bool:
         return bool((np.asarray(x)[-6:] >= 0).all())
@@ -201,6 +207,18 @@ class General(Structure):
         if (x[0:50:10] <= 0).any():
             return None
         return {name: Inertial.from_dynamic_parameters(x[10 * i:10 * i + 10]) for i, name in enumerate(BODIES)}
+
+    def checked(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The five bodies the overlay writes, x itself: a body is its tree link(s) plus the
+        pins' shares, which for turret_link is a moment about z alone (carve), so a turret link
+        on the triangle's edge leaves its body outside."""
+        n = len(self.names)
+        out = []
+        for i in range(len(BODIES)):
+            a = np.zeros((10, n))
+            a[:, 10 * i:10 * i + 10] = np.eye(10)
+            out.append((a, np.zeros(10)))
+        return out
 
     def consistent(self, x: np.ndarray) -> bool:
         """Every body the overlay writes and every link carved from them passes the one physical
