@@ -34,7 +34,8 @@ from phantom_pin.report.parameters import links
 #: a rounding apart). Issue 42, L14, measured: with a gap of 1e-7 the written link numbers were
 #: up to 7 % of their typical size off the optimum, and one log identified in two conventions
 #: up to 0.3 % (OpenHaptics' CSV) and 16 % (a bag, read back within 1e-9 s) of its link's size
-#: apart; with 1e-15, 7e-10 and 6e-8 (tests/test_identification_bags.py), for 1.2 times the CPU.
+#: apart; with 1e-15, 7e-10 and 6e-8 (tests/identification/test_bags.py), the bodies and the check's
+#: margin in the barrier (margined), for 0.65 times the CPU (the blocks evaluated at once).
 GAP = 1e-15
 #: Newton steps per barrier weight, and the weight's growth.
 NEWTON_STEPS, GROWTH = 60, 10.0

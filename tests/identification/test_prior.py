@@ -1,7 +1,7 @@
 """Identification with the prior (identification.prior: the Gauss-Markov estimate with the
 configuration's base parameters as its mean) and the predicted torque uncertainty
 (identification.prediction), on a device that is NOT the prior: the report's device with its
-parameters moved by 10-30 % (test_identification_end_to_end.FACTORS), logged as a lab would,
+parameters moved by 10-30 % (test_end_to_end.FACTORS), logged as a lab would,
 a sum of five sines per joint around a working posture, tracked by the repo's own simulated
 plant (identification.simulation.track: friction, 1 % torque noise, encoder quantization), and
 identified on the shipped model (the prior). Judged on held-out motion against the device's own
@@ -52,7 +52,7 @@ def lab_log(device, duration, amplitude, seed):
 @functools.cache
 def truth_log(duration, amplitude, seed):
     """lab_log of the device of truth_overrides(), simulated once per arguments (the wide log is
-    test_identification_delay's too; conftest.GROUPS keeps both modules on one worker)."""
+    test_timing's too; conftest.GROUPS keeps both modules on one worker)."""
     return lab_log(Device(Phantom(describe(overrides=truth_overrides()))), duration, amplitude, seed)
 
 

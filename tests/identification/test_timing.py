@@ -1,7 +1,7 @@
 """The delay between positions and torques, and the torque timing (issue 31, item 4), on a
 device that is not the prior: the report's device with its parameters moved by 10-30 %
-(test_identification_end_to_end.truth_overrides), tracking a lab's 60 s sum of sines
-(test_identification_prior.lab_log: the repo's own plant, 1 % torque noise, encoder
+(test_end_to_end.truth_overrides), tracking a lab's 60 s sum of sines
+(test_prior.lab_log: the repo's own plant, 1 % torque noise, encoder
 quantization, commands held for a sample). Delayed logs are that log with its torques written
 n samples late (1 kHz: n ms), so the true delay is known exactly; friction is judged against
 the device's own (VISCOUS, COULOMB), held-out torques against its own inverse dynamics on 500
