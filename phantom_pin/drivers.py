@@ -47,7 +47,7 @@ base_ref, which puts the shoulder at (0, 35, -157) mm). Ubitrack's calibration m
 (PhantomForwardKinematics.h above) puts OpenHaptics' origin at frame s's (its offsets zero);
 a real Touch's logged HD_CURRENT_TRANSFORM positions (iLUVE69/Limb-Impedance-measurement-
 using-GeoMagic-Touch-Haptic-Device) reach no posture inside the stops with that, and all of
-them with the estimate (tests/test_hardening5_ros.py). Check it on your device: the gimbal
+them with the estimate (tests/test_drivers.py). Check it on your device: the gimbal
 centre's HD_CURRENT_POSITION at a known posture gives it.
 
 Arrays: one vector (3,) or a batch (..., 3), as the rest of phantom_pin.

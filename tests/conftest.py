@@ -1,6 +1,7 @@
 """Shared fixtures (one Phantom, seeded random states inside the joint limits, the command line
-run in-process), the pytest markers of the Debian packages some tests need, and the groups the
-xdist workers keep together. What tests import lives in helpers.py."""
+run in-process, the Touch's six-joint model), the pytest markers of the Debian packages some
+tests need, and the groups the xdist workers keep together. What tests import lives in
+helpers.py."""
 
 import os
 import shutil
@@ -19,7 +20,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # after the setting above
 
-from helpers import CONFIG, N_STATES
+from helpers import CONFIG, N_STATES, Six
 from phantom_pin import Phantom
 from phantom_pin.config.sampling import random_states
 
@@ -52,6 +53,13 @@ def cli(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str, str
 def states():
     """N_STATES seeded (theta, dtheta, ddtheta) inside the joint limits (config.sampling.random_states)."""
     return random_states(CONFIG.limits, N_STATES, seed=20261121)
+
+
+@pytest.fixture(scope="module")
+def six() -> Six:
+    """The Touch's six-joint model built from its committed URDF by Pinocchio alone (helpers.Six):
+    the reference of the arm's dynamics with the gimbal held at given angles."""
+    return Six()
 
 
 def _sdformat() -> bool:

@@ -1,7 +1,8 @@
 """What the tests share besides fixtures: the default model's configuration and files, frame
-poses by Pinocchio, relative errors, and the browser helpers: render an HTML file in headless
-chromium, project a world point to its pixel with meshcat's camera (75 degrees vertical field of
-view, looking at the world origin, z up, from viewer.CAMERA_POSITION)."""
+poses by Pinocchio, relative errors, the Touch's six-joint model (Six), logs and trajectories
+with a known truth, and the browser helpers: render an HTML file in headless chromium, project
+a world point to its pixel with meshcat's camera (75 degrees vertical field of view, looking at
+the world origin, z up, from viewer.CAMERA_POSITION)."""
 
 import json
 import re
@@ -13,7 +14,7 @@ import numpy as np
 import pinocchio as pin
 from PIL import Image
 
-from phantom_pin import config
+from phantom_pin import Phantom, config
 from phantom_pin.viewer import CAMERA_POSITION
 from phantom_pin.viewer.screenshot import chromium_command
 
@@ -36,6 +37,91 @@ def frame_pose(model: pin.Model, theta: np.ndarray, name: str) -> pin.SE3:
 def relative_error(actual: np.ndarray, expected: np.ndarray) -> float:
     """max |actual - expected| / max |expected| over the whole array."""
     return float(np.abs(actual - expected).max() / np.abs(expected).max())
+
+
+# -- the stylus gimbal held at given angles (tests/dynamics, tests/device, tests/cli) -----------
+#: far from locked_at (0): the stylus's load differs by percents of the arm's torques
+HELD = np.array([1.0, -0.8, 1.2])
+
+
+class Six:
+    """The Touch's six-joint model built here from its committed URDF with Pinocchio alone (the
+    gimbal free, the configuration's g along base_link's -z): the arm's rows and columns of its
+    dynamics with the gimbal at rest are what the arm's methods with gimbal= compute (the
+    fixture ``six`` of conftest.py)."""
+
+    def __init__(self):
+        self.model = pin.buildModelFromXML(config.MODELS["touch"].urdf.read_text(), mimic=True)
+        self.model.gravity = pin.Motion(np.array([0.0, 0.0, -config.read("touch").gravity]), np.zeros(3))
+        self.data = self.model.createData()
+        names = [f"joint{j}" for j in range(1, 7)]
+        self.order = [self.model.joints[self.model.getJointId(n)].idx_q for n in names]
+        self.arm = self.order[:3]
+
+    def q(self, theta, gimbal=None):
+        """The six joints' vector of the arm's theta (rad), with the gimbal's angles or zero."""
+        q = np.zeros(6)
+        q[self.order] = np.concatenate([theta, np.zeros(3) if gimbal is None else gimbal])
+        return q
+
+    def mass(self, theta, gimbal):
+        return pin.crba(self.model, self.data, self.q(theta, gimbal))[np.ix_(self.arm, self.arm)]
+
+    def torques(self, theta, gimbal, dtheta, ddtheta):
+        return pin.rnea(self.model, self.data, self.q(theta, gimbal), self.q(dtheta), self.q(ddtheta))[self.arm]
+
+    def pose(self, theta, gimbal, frame):
+        """A frame's pose in frame s (report_s), (4, 4)."""
+        pin.framesForwardKinematics(self.model, self.data, self.q(theta, gimbal))
+        s = self.data.oMf[self.model.getFrameId("report_s")]
+        return (s.inverse() * self.data.oMf[self.model.getFrameId(frame)]).homogeneous
+
+    def energy(self, theta, gimbal, dtheta):
+        """T + V (J): 1/2 dtheta^T M dtheta, and the sum of -m g . c over the bodies (each centre
+        of mass c placed by the forward kinematics)."""
+        pin.forwardKinematics(self.model, self.data, self.q(theta, gimbal))
+        potential = -sum(inertia.mass * self.model.gravity.linear @ placement.act(inertia.lever)
+                         for inertia, placement in zip(self.model.inertias, self.data.oMi))
+        return 0.5 * dtheta @ self.mass(theta, gimbal) @ dtheta + potential
+
+
+# -- logs with a known truth (tests/identification, tests/cli) ----------------------------------
+#: 10 s at 1 kHz (s)
+T10 = np.arange(10001) / 1000.0
+
+
+def sines(t, amplitude=0.2, seed=1):
+    """Five sines per joint of seeded frequencies (0.1-1 Hz) and phases around (0, 0.3, 0.45) rad,
+    at any times ``t`` (s): theta, dtheta, ddtheta, exact."""
+    rng = np.random.default_rng(seed)
+    w, phase = 2 * np.pi * rng.uniform(0.1, 1.0, (3, 5)), rng.uniform(0, 2 * np.pi, (3, 5))
+    arg, a = w * t[:, None, None] + phase, amplitude / 5
+    return (np.array([0.0, 0.3, 0.45]) + a * np.sin(arg).sum(-1), a * (w * np.cos(arg)).sum(-1),
+            -a * (w**2 * np.sin(arg)).sum(-1))
+
+
+def model_torques(phantom, theta, dtheta, ddtheta, coulomb=None):
+    """The model's inverse dynamics plus the shipped friction law (its Coulomb torques replaced)."""
+    law = phantom.config.actuation.friction
+    coulomb = law.coulomb if coulomb is None else coulomb
+    return (phantom.inverse_dynamics(theta, dtheta, ddtheta) + np.array(law.viscous) * dtheta
+            + np.array(coulomb) * np.sign(dtheta))
+
+
+def recorded_trajectory(path, record=None, model="touch"):
+    """A 2.5 s trajectory at 1 kHz in the report's convention (sines about a posture inside the
+    stops, exact derivatives, the model's torques), written here with ``record`` as its second
+    line (None: none, as files before 0.5.0)."""
+    t = np.arange(2501) / 1000
+    w = 2 * np.pi * np.array([0.4, 0.6, 0.5])
+    theta = np.array([0.0, 0.3, 0.5]) + 0.1 * np.sin(np.outer(t, w))
+    dtheta, ddtheta = 0.1 * w * np.cos(np.outer(t, w)), -0.1 * w**2 * np.sin(np.outer(t, w))
+    tau = Phantom.from_model(model).inverse_dynamics(theta, dtheta, ddtheta)
+    lines = ["t,theta1,theta2,theta3,dtheta1,dtheta2,dtheta3,ddtheta1,ddtheta2,ddtheta3,tau1,tau2,tau3"]
+    lines += [] if record is None else [record]
+    lines += [",".join(map(repr, row)) for row in np.column_stack([t, theta, dtheta, ddtheta, tau]).tolist()]
+    path.write_text("\n".join(lines) + "\n")
+    return path
 
 
 WIDTH, HEIGHT, FOV = 800, 600, 75.0

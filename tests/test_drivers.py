@@ -6,13 +6,17 @@
 - the ROS joint_states of fsuarez6/phantom_omni (omni_state.cpp: waist = -a1, shoulder = a2,
   elbow = a3 - a2) and of jhu-saw/sawSensablePhantom (mtsSensableHD.cpp: q[0] = -q[0]; q[2] -= q[1]);
 - SensAble's CommandJointTorque sample: torque (mN m) = k (0 - angle) is a restoring spring;
-- and power: the same motion does the same work in either convention.
+- and power: the same motion does the same work in either convention;
+- HD_CURRENT_TRANSFORM: a finite rigid pose, column-major, and its origin in OpenHaptics'
+  coordinates (a real Touch's logged position ranges reached inside the stops from it).
 """
+
+import math
 
 import numpy as np
 import pytest
 
-from phantom_pin import Phantom, drivers
+from phantom_pin import Phantom, closed_form, drivers
 from phantom_pin.config import read
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.exceptions import InvalidInputError
@@ -129,3 +133,204 @@ def test_overflow_and_a_non_string_prefix_are_named_errors(call, argument):
     with pytest.raises(InvalidInputError) as error:
         call()
     assert error.value.argument == argument
+
+
+# -- HD_CURRENT_TRANSFORM: a finite rigid pose, column-major; the gimbal's joint states ---------
+
+
+def rodrigues(axis: np.ndarray, angle: float) -> np.ndarray:
+    """The rotation by ``angle`` (rad) about the unit ``axis``: I + sin K + (1 - cos) K^2."""
+    x, y, z = axis / np.linalg.norm(axis)
+    k = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k
+
+
+def transform(rotation: np.ndarray, translation_mm) -> np.ndarray:
+    """A 4x4 homogeneous transform (translation in mm)."""
+    out = np.eye(4)
+    out[:3, :3], out[:3, 3] = rotation, translation_mm
+    return out
+
+
+ROTATION = rodrigues(np.array([0.3, -0.5, 0.8]), 0.9)
+
+
+@pytest.mark.parametrize("pose", [
+    "abc",                                                          # a string
+    transform(1.1 * ROTATION, [10, 20, 30]) * [[1], [1], [1], [1]],  # scaled
+    transform(ROTATION, [1e308, 0, 0]) / 1000,                      # 1e305 m: its mm overflow
+    transform(ROTATION @ np.diag([-1.0, 1, 1]), [0, 0, 0]),         # a mirror (det -1)
+    [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]],                     # 3x4
+])
+def test_openhaptics_transform_from_pose_refuses_what_is_not_a_finite_rigid_pose(pose):
+    """openhaptics_transform_from_pose takes a finite rigid pose only: a string, a scaled or
+    mirrored rotation, a translation whose mm overflow and a 3x4 matrix are each refused with
+    InvalidInputError naming ``pose``."""
+    with pytest.raises(InvalidInputError) as error:
+        drivers.openhaptics_transform_from_pose(pose)
+    assert error.value.argument == "pose"
+
+
+def test_a_mirrored_hd_current_transform_is_refused():
+    """An HD_CURRENT_TRANSFORM whose rotation is mirrored (orthogonal of determinant -1, which
+    R R^T = I alone lets through) is refused naming ``transform``."""
+    for mirror in (np.diag([-1.0, 1, 1]), -np.eye(3)):
+        rotation = ROTATION @ mirror
+        assert np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12) and np.linalg.det(rotation) < 0
+        flat = transform(rotation, [12.0, -70.0, -50.0]).T.ravel()   # column-major
+        with pytest.raises(InvalidInputError) as error:
+            drivers.pose_from_openhaptics_transform(flat)
+        assert error.value.argument == "transform"
+
+
+def test_a_row_major_hd_current_transform_is_refused():
+    """An HD_CURRENT_TRANSFORM is read column-major, OpenHaptics' order (the translation at
+    12..14): a row-major one (its translation read as the last row, its rotation transposed,
+    still proper) is refused by its last row, naming ``transform``; column-major, the same numbers
+    give the pose in m."""
+    matrix = transform(ROTATION, [12.0, -70.0, -50.0])
+    with pytest.raises(InvalidInputError) as error:
+        drivers.pose_from_openhaptics_transform(matrix.ravel())        # row-major
+    assert error.value.argument == "transform"
+    flat = matrix.T.ravel()
+    assert np.array_equal(flat[12:15], [12.0, -70.0, -50.0])
+    assert np.abs(drivers.pose_from_openhaptics_transform(flat)[:3, :3] - ROTATION).max() < 1e-15
+
+
+def test_omni_firewire_gimbal_rates_convert_without_the_offsets():
+    """omni_firewire's gimbal rates convert without the angles' offsets. fsuarez6/phantom_omni
+    omni_state.cpp 188-193 publishes yaw = pi - g1, pitch = -g2 - 3 pi / 4, roll = -g3 - pi,
+    written out here: the rates of a motion g(t) are the finite difference of those positions
+    (the map is affine: exact up to rounding, 1e-6 rad/s)."""
+    rng = np.random.default_rng(42)
+    g0, rate, h = rng.uniform(-0.5, 0.5, 3), rng.uniform(-2, 2, 3), 1e-3
+
+    def published(g):
+        return np.array([math.pi - g[0], -g[1] - 3 * math.pi / 4, -g[2] - math.pi])
+
+    published_rate = (published(g0 + rate * h) - published(g0)) / h
+    names = ["roll", "yaw", "pitch"]
+    order = [2, 0, 1]
+    back = drivers.gimbal_from_joint_state(names, published_rate[order], convention="omni_firewire", rates=True)
+    assert np.abs(back - rate).max() < 1e-6
+    positions = drivers.gimbal_from_joint_state(names, published(g0)[order], convention="omni_firewire")
+    assert np.abs(positions - g0).max() < 1e-14
+
+
+def test_gimbal_joint_states_with_a_prefix_read_their_own_names():
+    """With a prefix, the gimbal's joint states are read under the prefixed names only (two
+    devices in one message, unprefixed and left_: each prefix reads its own three values; raw
+    convention: the values themselves), the names written carry it, and a message without them
+    is refused naming ``names``."""
+    names = ["left_roll", "yaw", "left_yaw", "pitch", "left_pitch", "roll"]
+    values = [0.3, -1.0, 0.1, -2.0, 0.2, -3.0]
+    assert np.array_equal(drivers.gimbal_from_joint_state(names, values, prefix="left_"), [0.1, 0.2, 0.3])
+    assert np.array_equal(drivers.gimbal_from_joint_state(names, values), [-1.0, -2.0, -3.0])
+    written, position = drivers.joint_state_from_gimbal([0.1, 0.2, 0.3], prefix="left_")
+    assert written == ["left_yaw", "left_pitch", "left_roll"] and np.array_equal(position, [0.1, 0.2, 0.3])
+    with pytest.raises(InvalidInputError) as error:
+        drivers.gimbal_from_joint_state(["yaw", "pitch", "roll"], [0, 0, 0], prefix="left_")
+    assert error.value.argument == "names"
+
+
+# -- OpenHaptics' origin: frame s's origin in OpenHaptics' coordinates ------------------------------
+
+#: The ranges of a real Touch's logged HD_CURRENT_TRANSFORM positions (mm, OpenHaptics'
+#: coordinates; iLUVE69/Limb-Impedance-measurement-using-GeoMagic-Touch-Haptic-Device,
+#: NoDrift_Batch1/2_data.csv, the stylus slid in a horizontal plane): facts about the file,
+#: which has no licence and is not copied.
+LOGGED = {"x": (-75.0, 57.0), "y": (-83.0, -62.0), "z": (-66.0, -39.0)}
+
+
+def touch_stops_yaml() -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The Touch's stops as joint_limits.yaml states them (PyYAML): per joint, and coupled."""
+    import yaml
+
+    from helpers import CONFIG_DIR
+
+    stops = yaml.safe_load((CONFIG_DIR.parent / "touch" / "joint_limits.yaml").read_text())["stops"]
+    joints = ("joint1", "joint2", "joint3")
+    return (np.array([stops[j]["lower"] for j in joints]), np.array([stops[j]["upper"] for j in joints]),
+            stops["theta2_minus_theta3_max"], stops["theta3_minus_theta2_max"])
+
+
+def reachable_inside_the_stops(position: np.ndarray, report) -> bool:
+    """Whether the report's closed-form inverse kinematics (eqs 11-20, either elbow branch) puts
+    the gimbal centre at ``position`` (m, frame s) with theta inside the Touch's stops (its YAML)."""
+    from phantom_pin.exceptions import UnreachableTargetError
+
+    lower, upper, below, above = touch_stops_yaml()
+    for branch in ("report", "other"):
+        try:
+            theta = closed_form.inverse_kinematics(position, report, branch=branch)
+        except UnreachableTargetError:
+            return False
+        assert np.abs(closed_form.forward_kinematics(theta, report)[:3, 3] - position).max() < 1e-12
+        if (np.all(lower <= theta) and np.all(theta <= upper) and theta[1] - theta[2] <= below
+                and theta[2] - theta[1] <= above):
+            return True
+    return False
+
+
+def logged_box(n: int = 3) -> np.ndarray:
+    """An n x n x n grid over the logged ranges (mm), its corners included."""
+    axes = [np.linspace(*LOGGED[axis], n) for axis in "xyz"]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def test_the_logged_positions_of_a_real_touch_are_reached_inside_its_stops_from_the_estimated_origin():
+    """HD_CURRENT_TRANSFORM's translation is taken from OpenHaptics' origin, frame s's origin in
+    its coordinates from gimbal.yaml's openhaptics_shoulder (Carrot404's base_ref, an estimate),
+    not as frame s's: with it every point of a real Touch's logged box (a 3x3x3 grid, its corners
+    included; the translation of an HD_CURRENT_TRANSFORM is the gimbal centre, the stylus frame's
+    origin) maps to a gimbal-centre position that the report's inverse kinematics reaches inside
+    the stops; with the origins equal none does (it needs theta2 < 0; the Touch's stop is 0)."""
+    report = read("touch").report
+    for point in logged_box():
+        flat = np.eye(4)
+        flat[:3, 3] = point
+        flat = flat.T.ravel()                                 # column-major, mm
+        estimated = drivers.pose_from_openhaptics_transform(flat)[:3, 3]
+        assert reachable_inside_the_stops(estimated, report), point
+        equal = drivers.pose_from_openhaptics_transform(flat, origin=np.zeros(3))[:3, 3]
+        assert not reachable_inside_the_stops(equal, report), point
+
+
+def test_the_origin_is_gimbal_yamls_shoulder_less_the_shoulder_in_frame_s():
+    """openhaptics_origin: gimbal.yaml's openhaptics_shoulder less the shoulder's position in
+    frame s, which the report's forward kinematics places at (0, l2, -l1) (the zero posture's
+    upper arm l1 along +z, forearm l2 along -y, from the shoulder to frame s's origin): read
+    through the configuration, an override moves it, a value in mm and a model without a
+    gimbal are refused naming the key and the argument."""
+    import yaml
+
+    from helpers import CONFIG_DIR
+    from phantom_pin import describe
+    from phantom_pin.exceptions import ParameterFileError
+
+    stated = yaml.safe_load((CONFIG_DIR.parent / "touch" / "gimbal.yaml").read_text())["openhaptics_shoulder"]
+    report = read("touch").report
+    # the shoulder: the point every posture's elbow stays l1 from, on the joint-1 axis
+    shoulder = np.array([0.0, report.l2, -report.l1])
+    for theta in np.random.default_rng(15).uniform(-1, 1, (10, 3)):
+        tip = closed_form.forward_kinematics(theta, report)[:3, 3]
+        assert abs(np.linalg.norm(tip - shoulder) ** 2 - (report.l1**2 + report.l2**2
+                                                          + 2 * report.l1 * report.l2 * math.sin(theta[2] - theta[1]))
+                   ) < 1e-12
+    assert np.abs(drivers.openhaptics_origin() - (np.array(stated) - shoulder)).max() < 1e-15
+    assert np.array_equal(drivers.openhaptics_origin(Phantom.from_model("touch")), drivers.openhaptics_origin())
+    moved = describe("touch", overrides={"openhaptics_shoulder.2": -0.2})
+    assert np.abs(drivers.openhaptics_origin(moved) - drivers.openhaptics_origin() - [0, 0, -0.2 - stated[2]]
+                  ).max() < 1e-15
+    back = drivers.pose_from_openhaptics_transform(drivers.openhaptics_transform_from_pose(
+        transform(ROTATION, [0.01, 0.02, 0.03]) / [[1], [1], [1], [1]], origin=drivers.openhaptics_origin(moved)),
+        origin=drivers.openhaptics_origin(moved))
+    assert np.abs(back[:3, 3] - [0.01, 0.02, 0.03]).max() < 1e-15
+    with pytest.raises(ParameterFileError, match="openhaptics_shoulder"):
+        describe("touch", overrides={"openhaptics_shoulder.2": -157})
+    with pytest.raises(InvalidInputError) as error:
+        drivers.openhaptics_origin(Phantom.from_model("premium_1_5"))
+    assert error.value.argument == "phantom"
+    with pytest.raises(InvalidInputError) as error:
+        drivers.pose_from_openhaptics_transform(np.eye(4).ravel(), origin=[[0, 0, 0]])
+    assert error.value.argument == "origin"

@@ -18,7 +18,8 @@ import yaml
 
 from gimbal_reference import gimbal_gravity, openhaptics, ubitrack
 from helpers import CONFIG_DIR
-from phantom_pin import InvalidInputError, Phantom, closed_form
+from phantom_pin import InvalidInputError, Phantom, closed_form, drivers, ros2
+from phantom_pin.config import read
 from phantom_pin.ros2 import Bridge
 
 TOUCH = CONFIG_DIR.parent / "touch"
@@ -276,3 +277,126 @@ def test_the_node_stops_cleanly_on_sigint_and_refuses_bad_arguments_in_one_line(
                             env=_environment(), capture_output=True, text=True, timeout=60)
     assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
     assert "--topic" in result.stderr
+
+
+# -- Bridge: names given twice, the gimbal's names, the velocity, a model without a gimbal -------
+
+
+@pytest.mark.parametrize("names", [
+    ["waist", "waist", "shoulder", "elbow"],
+    ["waist", "shoulder", "elbow", "yaw", "pitch", "roll", "pitch"],
+    ["joint1", "joint2", "joint3", "joint3"],
+    ["joint1", "joint2", "joint3", "joint4", "joint5", "joint6", "joint4"],
+])
+def test_a_name_given_twice_is_refused_as_the_drivers_conversions_refuse_it(touch, names):
+    """The node drops a message giving a joint name twice, InvalidInputError naming ``name``, as
+    drivers.theta_from_joint_state and gimbal_from_joint_state refuse it, naming ``names``."""
+    position = [0.1] * len(names)
+    with pytest.raises(InvalidInputError) as error:
+        ros2.Bridge(touch)(names, position)
+    assert error.value.argument == "name"
+    if names[0] == "waist":
+        convert = drivers.theta_from_joint_state if len(names) == 4 else drivers.gimbal_from_joint_state
+        with pytest.raises(InvalidInputError) as error:
+            convert(names, position)
+        assert error.value.argument == "names"
+
+
+@pytest.mark.parametrize("gimbal_names", [("joint4", "joint5", "joint6"), ("yaw", "pitch", "roll")])
+@pytest.mark.parametrize("arm_names", ["driver", "model"])
+def test_the_gimbal_is_read_under_either_names_with_either_arm(touch, arm_names, gimbal_names):
+    """The node reads the gimbal under the drivers' names (yaw, pitch, roll) or the model's
+    (joint4..joint6), beside either the drivers' arm names or the model's: each pairing gives the
+    closed form's gravity with the gimbal's reference load and Ubitrack's stylus pose (1e-12)."""
+    bridge = ros2.Bridge(touch)
+    for position in driver_states(5, seed=11):
+        reference = expected(touch.config.report, position)
+        waist, shoulder, elbow, *g = position
+        arm = ((["waist", "shoulder", "elbow"], [waist, shoulder, elbow]) if arm_names == "driver"
+               else (["joint1", "joint2", "joint3"], [waist, shoulder, shoulder + elbow]))
+        out = bridge([*gimbal_names, *arm[0]], [*g, *arm[1]])
+        e = reference["effort"]     # conjugate to (waist, shoulder, elbow); the model's names get tau itself
+        effort = e if arm_names == "driver" else np.array([e[0], e[1] - e[2], e[2]])
+        assert np.abs(out.effort - effort).max() < 1e-12
+        assert out.stylus is not None and np.abs(out.stylus - reference["stylus"]).max() < 1e-12
+
+
+@pytest.mark.parametrize("names", [["waist", "shoulder", "elbow", "yaw"], ["waist", "shoulder", "elbow", "joint5"],
+                                   ["joint1", "joint2", "joint3", "yaw", "pitch"],
+                                   ["waist", "shoulder", "elbow", "yaw", "pitch", "roll", "joint4", "joint5",
+                                    "joint6"]])
+def test_some_of_the_gimbals_names_are_refused_naming_name(touch, names):
+    """A message with some but not all of the gimbal's names, or the gimbal under both sets of
+    names, is refused with InvalidInputError naming ``name`` (never an exception the node does
+    not catch)."""
+    with pytest.raises(InvalidInputError) as error:
+        ros2.Bridge(touch)(names, [0.1] * len(names))
+    assert error.value.argument == "name"
+
+
+def test_a_velocity_of_the_wrong_length_is_refused(touch):
+    """A velocity field has one value per name, or none (the drivers that publish no velocity);
+    another length is refused naming ``velocity``."""
+    names, position = list(DRIVER), list(driver_states(1, seed=12)[0])
+    bridge = ros2.Bridge(touch)
+    for velocity in ([0.0, 0.1], [0.0] * 7):
+        with pytest.raises(InvalidInputError) as error:
+            bridge(names, position, velocity)
+        assert error.value.argument == "velocity"
+    assert np.array_equal(bridge(names, position, [0.5] * 6).effort, bridge(names, position).effort)
+
+
+def test_the_bridge_of_a_model_without_a_gimbal_answers_from_the_closed_form():
+    """The Bridge of a model without a gimbal (premium_1_5) answers from the closed form: against
+    the report's closed form (eqs 10, 93-94) and the URDF's mimic tags written out here, under the
+    drivers' names (their yaw, pitch, roll ignored, there being no gimbal) and the model's, 1e-12
+    (N m, m)."""
+    config = read("premium_1_5")
+    bridge = ros2.Bridge(Phantom.from_model("premium_1_5"))
+    l1, l2 = config.kinematics.l1, config.kinematics.l2
+    base_from_s = np.eye(4)                      # the macro's report_s: at (l1, 0, -l2), axes (y, z, x)
+    base_from_s[:3, :3] = [[0, 0, 1], [1, 0, 0], [0, 1, 0]]
+    base_from_s[:3, 3] = l1, 0, -l2
+    rng = np.random.default_rng(13)
+    lower, upper = np.array(config.limits.stops.lower), np.array(config.limits.stops.upper)
+    for theta in rng.uniform(lower, upper, (20, 3)):
+        tau = closed_form.gravity(theta, config.report)
+        out = bridge(["yaw", "elbow", "shoulder", "pitch", "waist", "roll"],
+                     [9.0, theta[2] - theta[1], theta[1], 9.0, theta[0], 9.0])
+        assert out.stylus is None and out.names == ("waist", "shoulder", "elbow")
+        assert np.abs(out.effort - [tau[0], tau[1] + tau[2], tau[2]]).max() < 1e-12
+        assert np.abs(out.tip - base_from_s @ closed_form.forward_kinematics(theta, config.report)).max() < 1e-12
+        assert np.abs(out.openhaptics - 1000 * tau * [-1, 1, 1]).max() < 1e-9
+        model = {"joint1": theta[0], "joint2": theta[1], "joint3": theta[2], "crank_pin_a": -theta[2],
+                 "crank_pin_b": theta[1], "forearm_pin_a": -theta[1], "forearm_pin_b": theta[2]}
+        assert dict(zip(out.model_names, out.model_positions)) == pytest.approx(model, abs=1e-15)
+        mine = bridge(["joint1", "joint2", "joint3"], list(theta))
+        assert mine.stylus is None and np.abs(mine.effort - tau).max() < 1e-12
+
+
+class _Publisher:
+    def __init__(self) -> None:
+        self.messages: list = []
+
+    def publish(self, message) -> None:
+        self.messages.append(message)
+
+
+def test_the_openhaptics_topic_names_its_torques_turret_thigh_shin(touch):
+    """The OpenHaptics topic names its torques turret, thigh, shin (after the prefix), each
+    carrying its own joint's torque. OpenHaptics' reference guide names its joints "Turet Left +,
+    Thigh Up +, Shin Up +", in the order of HD_CURRENT_JOINT_ANGLES; its torque on each is 1000
+    (-tau1, tau2, tau3) mN m (SensAble's CommandJointTorque sample), tau the closed form's."""
+    position = driver_states(1, seed=14)[0]
+    out = ros2.Bridge(touch)(list(DRIVER), list(position))
+    outputs = {role: _Publisher() for role in ("gravity_torque", "gravity_torque_openhaptics", "tip_pose",
+                                               "stylus_pose", "model_joint_states")}
+    from builtin_interfaces.msg import Time
+
+    ros2._publish_outputs(outputs, out, Time(sec=1, nanosec=2), "", "left_")
+    message = outputs["gravity_torque_openhaptics"].messages[0]
+    torques = dict(zip(message.name, message.effort))
+    reference = expected(touch.config.report, position)["openhaptics"]
+    assert list(torques) == ["left_turret", "left_thigh", "left_shin"]
+    assert [torques["left_turret"], torques["left_thigh"], torques["left_shin"]] == pytest.approx(
+        reference, abs=1e-9)

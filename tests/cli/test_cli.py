@@ -6,6 +6,7 @@ import json
 import os
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -16,10 +17,10 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from helpers import CONFIG, RAISED, REPORT, dark, frame_pose, patch, render
+from helpers import CONFIG, HELD, RAISED, REPORT, dark, frame_pose, patch, render
 from phantom_pin import closed_form as cf
 from phantom_pin import describe
-from phantom_pin.config import MODELS
+from phantom_pin.config import MODELS, read
 from phantom_pin.config.sampling import random_states
 
 CONFIG_DIR, URDF_PATH = MODELS["premium_1_5"].config, MODELS["premium_1_5"].urdf
@@ -426,3 +427,166 @@ def test_info_says_when_overrides_apply(tmp_path, capsys):
     assert data["overrides"] == 3 and data["device"]["friction"]["coulomb"] == [0.02] * 3
     assert main(["info", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["overrides"] == 0
+
+
+# -- show on the Touch, pipes, errors naming their option, outputs staged, --prefix, --gimbal -----
+TOUCH = read("touch")
+
+
+def bounds(lower, upper):
+    """The warning's "[a b c]..[d e f]" of limits (rad), as warn_limits prints them."""
+    return "[" + " ".join(f"{v:.6g}" for v in lower) + "]..[" + " ".join(f"{v:.6g}" for v in upper) + "]"
+
+
+def test_show_on_the_touch_checks_the_arm_and_the_gimbal_against_their_own_ranges(tmp_path, cli):
+    """`show` on the Touch (six joints) checks the arm's angles against the arm's stops and
+    the gimbal's against the gimbal's range: inside both, no warning; beyond either, one warning
+    line naming it and its bounds. The ranges are the configuration's."""
+    arm, gimbal = TOUCH.limits, TOUCH.gimbal
+    inside = (np.array(arm.lower) + np.array(arm.upper)) / 2
+    code, out, err = cli("--model", "touch", "show", "--theta", *map(str, inside),
+                         "--gimbal", "0.1", "0.2", "0.3", "--html", str(tmp_path / "in.html"))
+    assert code == 0 and err == "" and out.startswith("wrote") and (tmp_path / "in.html").is_file(), err
+    beyond = [0.0, 0.0, gimbal.upper[2] + 0.01]  # joint6 just past its stop
+    code, out, err = cli("--model", "touch", "show", "--theta", *map(str, inside),
+                         "--gimbal", *map(str, beyond), "--html", str(tmp_path / "gimbal.html"))
+    assert code == 0 and err.count("\n") == 1, err
+    assert "warning: gimbal" in err and bounds(gimbal.lower, gimbal.upper) in err, err
+    above = [0.0, 0.0, arm.upper[2] + 0.01]
+    code, out, err = cli("--model", "touch", "show", "--theta", *map(str, above),
+                         "--html", str(tmp_path / "arm.html"))
+    assert code == 0 and err.count("\n") == 1, err
+    assert "warning: theta" in err and bounds(arm.lower, arm.upper) in err, err
+
+
+@pytest.mark.parametrize("unbuffered", ["1", None])
+def test_simulate_into_a_pipe_closed_part_way_exits_141(unbuffered):
+    """Output into a pipe that its reader closes part way exits 141, without a word, buffered or
+    with PYTHONUNBUFFERED=1 (as Docker images set it: unbuffered, Python writes the 219 kB at once
+    and the reader's exit leaves a short write, not an error); docs/cli.md says 141. Read in full,
+    the output is a whole JSON document of duration x rate + 1 samples."""
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"} | (
+        {"PYTHONUNBUFFERED": unbuffered} if unbuffered else {})
+    argv = [sys.executable, "-m", "phantom_pin.cli", "simulate", "--theta0", "0", "0.3", "0.4", "--duration", "1"]
+    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    assert len(process.stdout.read(10)) == 10
+    process.stdout.close()
+    assert process.wait(120) == 141 and process.stderr.read() == b""
+    process.stderr.close()
+    whole = subprocess.run(argv, capture_output=True, env=env, check=True, timeout=120)
+    assert len(whole.stdout) > 2**16 and len(json.loads(whole.stdout)["t"]) == 1001
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["ik", "1e308", "0", "0"], "position: [1.e+308 0.e+000 0.e+000] m is 1e+308 m from the shoulder, outside the "
+                                "reachable shell [0.0450, 0.3850] m"),                       # 4 digits, not 309
+    (["--set", "=0.2", "fk", "0", "0", "0"], "--set: expected KEY=NUMBER, got '=0.2' (no key)"),       # no key
+    (["urdf", "-o", "/dev/full", "-f"], "--output: cannot write /dev/full (No space left on device)"),  # a failed write
+    (["--config", "{tmp}", "info"], "{tmp}: not a configuration folder (it has none of kinematics.yaml, "),  # empty
+    (["excite", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),  # one wording
+    (["urdf", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),
+])
+def test_an_error_names_the_option_at_fault_in_one_readable_line(tmp_path, cli, argv, message):
+    """An error names the option at fault in one readable line (exit 2, nothing overwritten): ik's
+    distance to the shoulder in four significant digits (not 309 digits at 1e308), --set without
+    a key as such, a write that fails by --output, a folder with none of the parameter files as
+    not a configuration folder, an existing output with "use --force" in every command."""
+    (tmp_path / "old.csv").write_text("kept\n")
+    code, out, err = cli(*[a.replace("{tmp}", str(tmp_path)) for a in argv])
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert err.startswith("phantom-pin: error: " + message.replace("{tmp}", str(tmp_path))), err
+    assert (tmp_path / "old.csv").read_text() == "kept\n"
+
+
+@pytest.mark.parametrize("argv, option", [(["identify", "{missing}", "-o", "{tmp}/id.yaml"], "LOG"),
+                                          (["simulate", "--trajectory", "{missing}"], "--trajectory")])
+def test_a_missing_log_or_trajectory_is_named_by_its_option(tmp_path, cli, argv, option):
+    """A log or trajectory that cannot be read is named by its option (LOG, --trajectory) with the
+    system's reason, in one line (not Python's errno text)."""
+    missing = tmp_path / "missing.csv"
+    code, out, err = cli(*[a.replace("{missing}", str(missing)).replace("{tmp}", str(tmp_path)) for a in argv])
+    assert (code, out) == (2, "") and err == f"phantom-pin: error: {option}: {missing}: cannot read (No such file or " \
+                                             "directory)\n"
+
+
+@pytest.mark.parametrize("prefix, valid", [('a"b', False), ("a b", False), ("9lives", False), ("arm/", True),
+                                           ("left_", True), ("", True)])
+def test_urdf_refuses_a_prefix_that_is_no_ros_name(tmp_path, cli, prefix, valid):
+    """urdf/srdf --prefix takes only what a ROS name can start with (ROS 2's rule for names:
+    tokens of letters, digits and _, not starting with a digit, separated by /; codegen's --prefix
+    checks its own): anything else (a space, a quote, a leading digit) is refused in one line
+    naming --prefix, nothing written."""
+    code, out, err = cli("srdf", "-o", str(tmp_path / "p.srdf"), "--prefix", prefix)
+    assert code == (0 if valid else 2) and (tmp_path / "p.srdf").exists() == valid
+    if not valid:
+        assert err == ("phantom-pin: error: --prefix: expected a ROS name's start (letters, digits, _ and /, not "
+                       f"starting with a digit), got {prefix!r}\n")
+
+
+@pytest.mark.parametrize("output, scene", [("model.xml", "/dev/full"), ("/dev/full", "scene.xml")])
+def test_mjcf_writes_neither_file_when_one_cannot_be_written(tmp_path, cli, output, scene):
+    """mjcf writes both of its files or neither: with either unwritable (a full device), the
+    folder stays empty and one line names the option whose file failed."""
+    paths = [p if p.startswith("/dev") else str(tmp_path / p) for p in (output, scene)]
+    code, out, err = cli("mjcf", "-o", paths[0], "--scene", paths[1], "--force")
+    option = "--scene" if scene.startswith("/dev") else "--output"
+    assert (code, out, err) == (2, "", f"phantom-pin: error: {option}: cannot write /dev/full (No space left on "
+                                       "device)\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_written_files_take_the_umask_and_an_overwritten_file_keeps_its_mode(tmp_path, cli):
+    """The command line's files are staged beside their targets and renamed into place: a new
+    file gets the mode open() would give it (0666 less the umask), an overwritten one keeps its
+    own, a symbolic link is written through (as open() would), and no temporary file is left
+    behind."""
+    mask = os.umask(0o027)
+    try:
+        assert cli("mjcf", "-o", tmp_path / "m.xml", "--scene", tmp_path / "s.xml")[0] == 0
+        os.chmod(tmp_path / "s.xml", 0o600)
+        (tmp_path / "s.xml").write_text("old\n")
+        assert cli("mjcf", "-o", tmp_path / "m.xml", "--scene", tmp_path / "s.xml", "--force")[0] == 0
+    finally:
+        os.umask(mask)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.xml", "s.xml"]
+    assert stat.S_IMODE((tmp_path / "m.xml").stat().st_mode) == 0o640
+    assert stat.S_IMODE((tmp_path / "s.xml").stat().st_mode) == 0o600
+    assert "m.xml" in (tmp_path / "s.xml").read_text()
+    (tmp_path / "link.xml").symlink_to(tmp_path / "m.xml")  # written through, as open() would
+    (tmp_path / "m.xml").write_text("old\n")
+    assert cli("mjcf", "-o", tmp_path / "link.xml", "--force")[0] == 0
+    assert (tmp_path / "link.xml").is_symlink() and "<mujoco" in (tmp_path / "m.xml").read_text()
+
+
+def test_fk_and_dynamics_take_gimbal_angles(cli, six):
+    """fk --gimbal prints the stylus frame's and its tip's poses and dynamics --gimbal holds the
+    gimbal there: against the six-joint model built here (1e-12)."""
+    theta, dtheta, ddtheta = [0.1, 0.3, 0.5], [0.4, -1.0, 2.0], [3.0, -2.0, 1.0]
+    code, out, err = cli("--model", "touch", "fk", *theta, "--gimbal", *HELD, "--json")
+    assert (code, err) == (0, "")
+    poses = json.loads(out)
+    for key, frame in (("stylus", "stylus"), ("stylus_tip", "stylus_tip"), ("g_st", "tip")):
+        np.testing.assert_allclose(poses[key], six.pose(theta, HELD, frame), rtol=0, atol=1e-12)
+    code, out, err = cli("--model", "touch", "dynamics", "--theta", *theta, "--dtheta", *dtheta, "--ddtheta",
+                         *ddtheta, "--gimbal", *HELD, "--json")
+    assert (code, err) == (0, "")
+    results = json.loads(out)
+    torques = six.torques(np.array(theta), HELD, np.array(dtheta), np.array(ddtheta))
+    np.testing.assert_allclose(results["tau"], torques, rtol=0, atol=1e-12 * np.abs(torques).max())
+    np.testing.assert_allclose(results["M"], six.mass(theta, HELD), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(results["N"], six.torques(np.array(theta), HELD, np.zeros(3), np.zeros(3)), rtol=0,
+                               atol=1e-14)
+
+
+@pytest.mark.parametrize("command", [["fk", "0", "0", "0"], ["dynamics", "--theta", "0", "0", "0"],
+                                     ["simulate", "--theta0", "0", "0.3", "0.4", "--duration", "0.01"]])
+def test_gimbal_angles_for_a_model_without_a_gimbal_are_refused_naming_the_option(cli, command):
+    """fk, dynamics and simulate refuse --gimbal for a model without a stylus gimbal, in one
+    line naming the option and the model."""
+    code, out, err = cli(*command, "--gimbal", "0.1", "0.2", "0.3")
+    assert (code, out) == (2, "") and err.startswith("phantom-pin: error: --gimbal: the model 'premium_1_5' has no "
+                                                     "stylus gimbal"), err

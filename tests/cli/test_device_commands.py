@@ -6,9 +6,10 @@ import json
 
 import numpy as np
 import pytest
+import yaml
 
-from helpers import REPORT
-from phantom_pin import closed_form, simulate
+from helpers import HELD, REPORT, recorded_trajectory
+from phantom_pin import closed_form, config, simulate
 from phantom_pin.cli import main
 
 START = ["0.3", "0.8", "0.4"]
@@ -167,3 +168,104 @@ def test_simulate_blames_what_is_at_fault_in_one_line(tmp_path, cli, argv, messa
     code, out, err = cli("simulate", "--theta0", "0.1", "0.3", "0.4", *argv, "-o", str(tmp_path / "r.csv"))
     assert code == 2 and out == "" and err.count("\n") == 1 and message in err, err
     assert not (tmp_path / "r.csv").exists()
+
+
+# -- info's sources, simulate --gimbal, the model and convention recorded in the files ------------
+
+
+def test_info_says_which_numbers_of_a_sourced_section_the_overrides_changed(tmp_path, cli):
+    """info gives each sourced section's source as its file states it (read here with PyYAML),
+    and for a section whose numbers an override changed, says which ones are not from it
+    (OVERRIDDEN here, then the rest's source); the others are unchanged, in --json and the text."""
+    folder = config.MODELS["touch"].config
+    stated = {**yaml.safe_load((folder / "actuation.yaml").read_text())["sources"],
+              **yaml.safe_load((folder / "joint_limits.yaml").read_text())["sources"],
+              **yaml.safe_load((folder / "gimbal.yaml").read_text())["sources"]}
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text("actuation:\n  friction:\n    viscous:\n      joint2: 0.01\ntip_offset: 0.04\n")
+    code, out, err = cli("--model", "touch", "info", "--json", "--params", str(overlay),
+                         "--set", "joint_torque_limit.joint1=0.5")
+    assert code == 0 and err == ""
+    data = json.loads(out)["device"]
+    expected = {"friction": "friction.viscous.joint2", "motor": "joint_torque_limit.joint1"}
+    for section in ("stops", "friction", "motor", "encoder", "transmission_ratio"):
+        changed = expected.get(section)
+        assert data[section]["source"] == (stated[section] if changed is None else
+                                           f"OVERRIDDEN here: {changed} (not from the source); the rest: "
+                                           f"{stated[section]}")
+    code, out, _ = cli("--model", "touch", "info", "--params", str(overlay))
+    assert f"  source: OVERRIDDEN here: tip_offset (not from the source); the rest: {stated['gimbal']}\n" in out
+    assert f"  source: {stated['friction']}\n" not in out
+
+
+def test_simulate_with_the_gimbal_held_and_its_gravity_compensated_stays_at_rest(cli):
+    """simulate --gimbal holds the gimbal there in the plant as in the controller: the arm under
+    `--controller gravity` (gravity(theta, gimbal), the six-joint model's rows) stays at rest when
+    the plant holds the gimbal there too (the arm locked at those angles, a second computation):
+    within 1e-12 rad over 0.5 s, without friction or stops. Held at locked_at instead, the
+    stylus's load at HELD is missing and the arm moves."""
+    theta0 = [0.2, 0.3, 0.5]
+    common = ("--model", "touch", "simulate", "--theta0", *theta0, "--duration", "0.5", "--controller", "gravity",
+              "--no-friction", "--no-hard-stops")
+    code, out, err = cli(*common, "--gimbal", *HELD)
+    assert (code, err) == (0, "")
+    result = json.loads(out)
+    assert result["settings"]["gimbal"] == HELD.tolist()
+    assert np.abs(np.array(result["theta"]) - theta0).max() < 1e-12
+    with pytest.MonkeyPatch.context() as patch:  # the plant at locked_at, the controller at HELD
+        patch.setattr("phantom_pin.device.simulation.held", lambda description, gimbal: description)
+        moved = json.loads(cli(*common, "--gimbal", *HELD)[1])
+    assert np.abs(np.array(moved["theta"]) - theta0).max() > 1e-3
+
+
+def test_excite_and_simulate_record_the_model_and_the_convention(tmp_path, cli):
+    """excite's trajectory and simulate's log name the model and the convention of their columns
+    on their second line (a # comment, which the readers and numpy.loadtxt skip); simulate's log
+    is in the report's convention whatever its input's."""
+    code, _, err = cli("--model", "touch", "excite", "-o", tmp_path / "t.csv", "--duration", "5", "--iterations", "1",
+                       "--restarts", "1", "--convention", "openhaptics", "-q")
+    assert (code, err) == (0, "")
+    lines = (tmp_path / "t.csv").read_text().splitlines()
+    assert lines[0].startswith("t,theta1,") and lines[1] == "# phantom-pin: model touch, convention openhaptics"
+    assert np.loadtxt(tmp_path / "t.csv", delimiter=",", skiprows=1).shape == (5001, 13)
+    code, _, err = cli("--model", "touch", "simulate", "--trajectory", tmp_path / "t.csv", "--convention",
+                       "openhaptics", "-o", tmp_path / "log.csv", "-q")
+    assert (code, err) == (0, "")
+    assert (tmp_path / "log.csv").read_text().splitlines()[1] == "# phantom-pin: model touch, convention report"
+
+
+@pytest.mark.parametrize("given, written", [(("--model", "touch"), ("premium_1_5", "report")),
+                                            (("--model", "touch", "--convention", "openhaptics"), ("touch", "report")),
+                                            ((), ("touch", "report"))])
+def test_a_trajectory_for_another_model_or_convention_is_refused_naming_both(tmp_path, cli, given, written):
+    """simulate refuses a trajectory recorded for another model or convention than the ones
+    given, before the run, in one line naming both, nothing written."""
+    path = recorded_trajectory(tmp_path / "t.csv", f"# phantom-pin: model {written[0]}, convention {written[1]}")
+    code, out, err = cli("simulate", "--trajectory", path, "-o", tmp_path / "log.csv", *given)
+    model = "touch" if "touch" in given else "premium_1_5"
+    convention = "openhaptics" if "openhaptics" in given else "report"
+    assert (code, out) == (2, "") and err == (
+        f"phantom-pin: error: --trajectory: {path} was written for the model {written[0]} in the {written[1]} "
+        f"convention, read here for the model {model} in the {convention} convention (give --model and "
+        "--convention as written, or delete its '# phantom-pin' line)\n")
+    assert not (tmp_path / "log.csv").exists()
+
+
+@pytest.mark.parametrize("record", [None, "# phantom-pin: model touch, convention report", "# a comment of one's own"])
+def test_a_trajectory_without_the_record_or_with_the_right_one_is_read(tmp_path, cli, record):
+    """A trajectory without the record (files before 0.5.0, other tools) is read as before, and
+    so is one with the matching record: the run tracks the trajectory (its start is the file's
+    first state)."""
+    path = recorded_trajectory(tmp_path / "t.csv", record)
+    code, out, err = cli("--model", "touch", "simulate", "--trajectory", path, "--format", "json", "-q")
+    assert (code, err) == (0, "")
+    np.testing.assert_allclose(json.loads(out)["theta"][0], [0.0, 0.3, 0.5], rtol=0, atol=1e-15)
+
+
+def test_a_malformed_record_is_refused(tmp_path, cli):
+    """A '# phantom-pin' line of another form than 'model NAME, convention NAME' is refused in
+    one line quoting it."""
+    path = recorded_trajectory(tmp_path / "t.csv", "# phantom-pin: touch, report")
+    code, _, err = cli("--model", "touch", "simulate", "--trajectory", path)
+    assert code == 2 and err == (f"phantom-pin: error: --trajectory: {path}: its line '# phantom-pin: touch, report' "
+                                 "is not '# phantom-pin: model NAME, convention NAME'\n")

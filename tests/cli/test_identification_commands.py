@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 import yaml
 
-from helpers import CONFIG, CONFIG_DIR, REPORT
+from helpers import CONFIG, CONFIG_DIR, REPORT, T10, model_torques, recorded_trajectory, sines
 from phantom_pin import Phantom, closed_form, describe
+from phantom_pin.cli import main
 from phantom_pin.identification import io
 from phantom_pin.identification.excitation import continuous_effort
 
@@ -260,3 +261,131 @@ def test_a_folder_one_cannot_write_in_is_refused_before_any_work(tmp_path, cli, 
     code, out, err = cli(*args, "-o", str(tmp_path / "out.yaml" if "identify" in args else tmp_path / "out.csv"))
     assert code == 2 and f"--output: cannot write in {tmp_path}" in err and out == "", err
     assert list(tmp_path.iterdir()) == []
+
+
+# -- outputs, warnings, and logs refused before any fit ---------------------------------------------
+
+
+@pytest.mark.parametrize("command, name, kind", [
+    (["excite"], "t.json", "CSV; name a .csv file"),
+    (["identify", "LOG"], "id.json", "a YAML overlay; name a .yaml or .yml file"),
+])
+def test_excite_and_identify_refuse_an_output_of_another_format(tmp_path, cli, command, name, kind):
+    """excite writes CSV and identify a YAML overlay: an --output named for another format is
+    refused in one line naming the format to give, nothing written."""
+    (tmp_path / "log.csv").write_text("t,theta1,theta2,theta3,tau1,tau2,tau3\n")
+    target = tmp_path / name
+    argv = [a.replace("LOG", str(tmp_path / "log.csv")) for a in command]
+    code, out, err = cli(*argv, "-o", str(target))
+    assert (code, out) == (2, "") and err == f"phantom-pin: error: --output: {target}: this command writes {kind}\n"
+    assert not target.exists()
+
+
+def test_excite_says_when_it_rounds_the_duration_up_to_whole_periods(tmp_path, cli):
+    """excite writes whole periods: a --duration that is none is rounded up with one warning line
+    stating the length written, which the file's own time column is; a whole number of periods
+    is written as given, without a word."""
+    path = tmp_path / "t.csv"
+    code, out, err = cli("excite", "-o", str(path), "--duration", "3", "--rate", "100",
+                         "--iterations", "2", "--restarts", "1")
+    assert code == 0 and err == ("phantom-pin: warning: --duration 3 s rounded up to 1 whole period(s) of 5 s: 5 s "
+                                 "(the excitation is periodic; --period sets its length)\n")
+    assert np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(5.0, abs=1e-12)
+    code, out, err = cli("excite", "-o", str(path), "--duration", "10", "--rate", "100", "--force",
+                         "--iterations", "2", "--restarts", "1")
+    assert code == 0 and err == "" and np.loadtxt(path, delimiter=",", skiprows=1)[-1, 0] == pytest.approx(10.0)
+
+
+@pytest.mark.parametrize("second", ["tau1", "TAU1 [mN m]"])
+def test_a_log_naming_one_column_twice_is_refused(tmp_path, cli, second):
+    """A log whose header names one column twice (in any case, with a unit or not) is refused in
+    one line naming the column and how often, nothing written: either could be the one meant
+    (another unit, a filtered copy)."""
+    t = np.arange(3001) / 1000.0
+    theta = 0.2 * np.sin(np.outer(t, [1.0, 1.3, 1.7]))
+    table = np.column_stack([t, theta, 0.01 * theta, 10 * theta[:, 0]])
+    log = tmp_path / "log.csv"
+    np.savetxt(log, table, delimiter=",", header=f"t,theta1,theta2,theta3,tau1,tau2,tau3,{second}", comments="")
+    code, out, err = cli("identify", str(log), "-o", str(tmp_path / "id.yaml"))
+    assert (code, out) == (2, "") and err == (f"phantom-pin: error: {log}: the header names tau1 2 times; name each "
+                                              "column once\n"), err
+    assert not (tmp_path / "id.yaml").exists()
+
+
+def _log(path, units):
+    t = np.arange(3001) / 1000.0
+    theta = 0.2 * np.sin(np.outer(t, [1.0, 1.3, 1.7]))
+    header = "t [s]," + ",".join(f"theta{j} [rad]" for j in (1, 2, 3)) + "," + ",".join(
+        f"tau{j} [{units}]" for j in (1, 2, 3))
+    np.savetxt(path, np.column_stack([t, theta, 10 * theta]), delimiter=",", header=header, comments="")
+
+
+def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(tmp_path, cli):
+    """A log whose header gives the torques in another unit than the convention's is refused at
+    once (under 1 s, before any fit) in one line naming the column, the unit and --convention,
+    nothing written; the units each convention takes are read (the report's N m in any spelling,
+    OpenHaptics' mN m)."""
+    import time
+
+    from phantom_pin.identification import io
+
+    for units, convention in (("N m", "report"), ("Nm", "report"), ("N*m", "report"), ("mN m", "openhaptics")):
+        _log(tmp_path / "ok.csv", units)
+        assert io.read_log(tmp_path / "ok.csv", convention).tau.shape == (3001, 3)
+    _log(tmp_path / "log.csv", "mN m")
+    start = time.monotonic()
+    code, out, err = cli("identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"))
+    assert time.monotonic() - start < 1.0
+    assert (code, out) == (2, "") and err == (
+        f"phantom-pin: error: {tmp_path / 'log.csv'}: tau1 is in mN m (its header), the report convention's torques "
+        "in N m: give the convention of the log (--convention; OpenHaptics': mN m) or convert it\n")
+    assert not (tmp_path / "id.yaml").exists()
+    _log(tmp_path / "log.csv", "N m")
+    with pytest.raises(io.LogError, match="tau1 is in N m .its header., the openhaptics convention's torques in mN m"):
+        io.read_log(tmp_path / "log.csv", "openhaptics")
+
+
+def test_identify_passes_min_speed_to_the_fit(tmp_path, monkeypatch):
+    """identify hands --min-speed to the fit (a spy in place of estimate)."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import io, result
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = sines(T10)
+    io.write_log(tmp_path / "log.csv", T10, theta, model_torques(phantom, theta, dtheta, ddtheta))
+    seen = {}
+
+    def spy(*args, **kwargs):
+        seen.update(kwargs)
+        raise io.LogError("stopped by the test")
+
+    monkeypatch.setattr(result, "estimate", spy)
+    assert main(["identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"), "--min-speed", "0.05"]) == 2
+    assert seen["min_speed"] == 0.05
+
+
+def test_identify_accept_warns_on_stderr(tmp_path, cli):
+    """identify --accept prints its warnings on stderr, as every command does, the results alone
+    on stdout. The model's own torques with tau3 2.5 times too small: a gain outside 0.5-2 (a
+    problem --accept writes anyway)."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = sines(T10)
+    io.write_log(tmp_path / "log.csv", T10, theta, model_torques(phantom, theta, dtheta, ddtheta) / [1, 1, 2.5])
+    code, out, err = cli("identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"), "--accept",
+                         "--torque-timing", "sampled")
+    assert code == 0 and out.startswith("10001 samples") and "warning" not in out
+    assert "phantom-pin: warning: (written with --accept) tau3 is 0.4 times joint 1's torque scale (gain 2.5" in err
+
+
+def test_a_log_for_another_model_is_refused_by_identify_before_any_fit(tmp_path, cli):
+    """identify refuses a log recorded for another model than the one given, before any fit, in
+    one line naming both, nothing written."""
+    path = recorded_trajectory(tmp_path / "log.csv", "# phantom-pin: model touch, convention report")
+    code, out, err = cli("identify", path, "-o", tmp_path / "id.yaml")
+    assert (code, out) == (2, "") and err.startswith(
+        f"phantom-pin: error: LOG: {path} was written for the model touch in the report convention, read here for "
+        "the model premium_1_5 in the report convention")
+    assert not (tmp_path / "id.yaml").exists()

@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 import pytest
+import yaml
 
 from helpers import REPORT
 from phantom_pin import closed_form as cf
@@ -100,3 +101,38 @@ def test_show_refuses_an_empty_html_name_instead_of_serving(cli):
     """Before: `show --html ''` started the live viewer and blocked."""
     code, out, err = cli("show", "--html", "")
     assert code == 2 and out == "" and err == "phantom-pin: error: --html: empty; give a file name\n"
+
+
+@pytest.mark.parametrize("text, message", [
+    ("l1: 0.2\nl1: 0.3\n", "not valid YAML at line 2, column 1: the key 'l1' is given twice"),
+    ("segment_a:\n  mass: 0.03\n  mass: 0.04\n", "not valid YAML at line 3, column 3: the key 'mass' is given twice"),
+    ("segment_a:\n  mass: 0.03\nsegment_a.mass: 0.04\n", "segment_a.mass is given twice (nested and dotted)"),
+])
+def test_an_overlay_that_gives_one_number_twice_is_refused(tmp_path, cli, text, message):
+    """An overlay that gives one number twice (a key twice in one mapping, or one number both
+    nested and dotted) is refused in one line naming --params and the file, not the last taken.
+    PyYAML itself reads such a file without a word (the premise)."""
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text(text)
+    yaml.safe_load(text)  # no error from PyYAML: it keeps the last
+    code, out, err = cli("--params", str(overlay), "fk", "0", "0", "0")
+    assert (code, out) == (2, "") and err == f"phantom-pin: error: --params: {overlay}: {message}\n", err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["urdf", "-o", "{tmp}/a.urdf", "--output", "{tmp}/b.urdf"], "--output: given twice; give it once"),
+    (["simulate", "--theta0", "0", "0.3", "0.4", "--duration", "0.1", "-o", "{tmp}/a.json", "-o", "{tmp}/b.json"],
+     "-o: given twice; give it once"),
+    (["excite", "-o", "{tmp}/a.csv", "-o", "{tmp}/b.csv"], "-o: given twice; give it once"),
+    (["--set", "l1=0.2", "fk", "0", "0", "0", "--set", "l1=0.3"], "--set: l1 given twice; give it once"),
+])
+def test_an_option_given_twice_is_refused_not_silently_the_last(tmp_path, cli, argv, message):
+    """-o/--output, or one --set key, given twice is refused in one line with nothing written
+    (as a second --model is), not silently the last. --params then --set of one key stays an
+    override (the documented order)."""
+    code, out, err = cli(*[a.replace("{tmp}", str(tmp_path)) for a in argv])
+    assert (code, out, err) == (2, "", f"phantom-pin: error: {message}\n")
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "p.yaml").write_text("l1: 0.25\n")
+    code, out, _ = cli("--params", str(tmp_path / "p.yaml"), "--set", "l1=0.3", "fk", "0", "0", "0", "--json")
+    assert code == 0 and json.loads(out) == json.loads(cli("--set", "l1=0.3", "fk", "0", "0", "0", "--json")[1])

@@ -2,9 +2,12 @@
 timestep, and a motor's data sheet consistent with itself (torque = torque constant x current,
 continuous below stall). Against the maxon RE 25 data sheet's own arithmetic and MuJoCo."""
 
+import re
+
 import mujoco
 import numpy as np
 import pytest
+import yaml
 
 from phantom_pin import ParameterFileError, config, describe
 from phantom_pin.cli import main
@@ -56,3 +59,31 @@ def test_the_largest_accepted_scale_still_steps_in_mujoco():
         for _ in range(100):
             mujoco.mj_step(model, data)
         assert np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()
+
+
+@pytest.mark.parametrize("source, key, value, message", [
+    ("touch", "segment_df.com", -1e7, "segment_df.com must be at most 1e+06 in magnitude (SI units), got -10000000.0"),
+    ("premium_1_5", "housing.com.2", -1e300, "housing.com must be a list of 3 finite numbers of magnitude at most "
+                                             "1e+06, got [0, 0, -1e+300]"),
+    ("premium_1_5_cad", "links.forearm_link.com.0", 1e300, "links.forearm_link.com must be a list of 3 finite "
+                                                           "numbers of magnitude at most 1e+06, got [1e+300, "),
+])
+def test_the_magnitude_bound_holds_for_negative_numbers_and_list_items(source, key, value, message):
+    """The 1e6 bound on a number's magnitude holds for negative numbers and for each item of a
+    list (com.0 = 1e300 would give NaN gravity), refused naming the key."""
+    with pytest.raises(ParameterFileError, match=re.escape(message)):
+        config.read(source, {key: value})
+
+
+def test_a_continuous_torque_equal_to_the_stall_torque_is_refused():
+    """A motor's continuous torque must be strictly below its stall torque (a winding cannot run
+    at stall): equal to the data sheet's 129 mN m (read with PyYAML) it is refused; just below it
+    is a motor."""
+    stated = yaml.safe_load((config.MODELS["premium_1_5"].config / "actuation.yaml").read_text())["motor"]
+    key = "actuation.motor.max_continuous_torque"
+    current = {"actuation.motor.max_continuous_current": 0.998 * stated["stall_current"]}  # Kt I = the torque
+    with pytest.raises(ParameterFileError, match=f"max_continuous_torque {stated['stall_torque']:g} N m must be "
+                                                 f"below stall_torque {stated['stall_torque']:g} N m"):
+        config.read("premium_1_5", {key: stated["stall_torque"], **current})
+    below = config.read("premium_1_5", {key: stated["stall_torque"] * (1 - 1e-9), **current})
+    assert below.actuation.motor.max_continuous_torque < stated["stall_torque"]

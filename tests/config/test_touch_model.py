@@ -310,3 +310,24 @@ def test_a_touch_trajectory_in_openhaptics_terms_is_tracked_and_identified(tmp_p
     assert main(["--model", "touch", "simulate", "--theta0", "0", "0.3", "0.4", "--duration", "1",
                  "--convention", "openhaptics"]) == 2
     assert "--convention: it reads --trajectory" in capsys.readouterr().err
+
+
+def test_a_copy_of_the_touchs_folder_is_the_touch(tmp_path, cli):
+    """A copy of the Touch's configuration folder given with --config is the Touch: its URDF and
+    MJCF equal the named model's committed files, MuJoCo loads the scene written with the same
+    joints, and fk answers as --model touch does."""
+    mujoco = pytest.importorskip("mujoco")
+    copy = tmp_path / "my_touch"
+    shutil.copytree(config.MODELS["touch"].config, copy)
+    urdf, mjcf, scene = tmp_path / "t.urdf", tmp_path / "t.xml", tmp_path / "scene.xml"
+    assert cli("--config", str(copy), "urdf", "-o", str(urdf))[0] == 0
+    assert urdf.read_text() == config.MODELS["touch"].urdf.read_text()
+    assert cli("--config", str(copy), "mjcf", "-o", str(mjcf), "--scene", str(scene))[0] == 0
+    assert mjcf.read_text() == config.MODELS["touch"].mjcf.read_text()
+    assert mujoco.MjModel.from_xml_path(str(scene)).nq == \
+        mujoco.MjModel.from_xml_path(str(config.MODELS["touch"].scene)).nq
+    theta = ["0.1", "0.3", "0.4"]
+    code, out, err = cli("--config", str(copy), "fk", *theta, "--json")
+    assert code == 0 and err == "", err
+    _, named, _ = cli("--model", "touch", "fk", *theta, "--json")
+    assert json.loads(out) == json.loads(named)

@@ -4,12 +4,14 @@ describe() and Phantom.from_folder(folder)), and physical.check_urdf of a URDF g
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
 from helpers import CONFIG_DIR, SRDF_PATH, URDF_PATH
 from phantom_pin import ParameterFileError, Phantom
 from phantom_pin.cli import main
+from phantom_pin.config import MODELS
 from phantom_pin.config.files import FILES, apply_overrides, read_documents
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics.loader import PhantomLoader, load_files
@@ -117,3 +119,28 @@ def test_check_urdf_reads_each_product_of_inertia_into_its_place():
     swapped = link.replace('ixz="0.6"', 'ixz="0"').replace('iyz="0"', 'iyz="0.6"')
     with pytest.raises(ParameterFileError, match="triangle inequality"):
         check_urdf(f'<robot name="r">{swapped}</robot>', "test")
+
+
+def test_a_length_that_leaves_the_lower_bar_unphysical_is_named(cli):
+    """A length that leaves a link the hinge pin is carved out of non-physical is named with the
+    link's keys, in one line: `--set l1=...` on the Touch names the lower bar, its principal
+    moments and l1 (the pin's distance). The hinge pin (mass mp) is carved out of the lower bar
+    (mass mc, transverse inertia I about its centre, l1 long) at its end, l1 / 2 from the centre:
+    by the parallel-axis theorem what is left has I - mp mc (l1 / 2)^2 / (mc - mp) about its own
+    centre, and the same axial moment Izz (the pin sits on the axis): a body while twice the
+    first is at least Izz (the triangle inequality), up to the l1 below."""
+    physical = yaml.safe_load((MODELS["touch"].config / "physical_parameters.yaml").read_text())
+    mc, inertia, axial, mp = (physical["segment_c"]["mass"], physical["segment_c"]["inertia"]["xx"],
+                              physical["segment_c"]["inertia"]["zz"], physical["hinge_pin"]["mass"])
+    longest = 2 * np.sqrt((inertia - axial / 2) * (mc - mp) / (mp * mc))      # 0.1661 m
+    code, _, err = cli("--model", "touch", "--set", f"l1={longest * 0.999}", "fk", "0", "0", "0")
+    assert code == 0 and err == "", err
+    l1 = 0.2
+    code, out, err = cli("--model", "touch", "--set", f"l1={l1}", "fk", "0", "0", "0")
+    left = inertia - mp * mc * (l1 / 2) ** 2 / (mc - mp)
+    assert (code, out) == (2, "") and err.count("\n") == 1 and "link lower_bar_link" in err
+    assert f"principal moments {left:.6g}, {left:.6g}, {axial:.6g} kg m^2)" in err
+    assert err.endswith("(from segment_c.mass, segment_c.inertia, hinge_pin.mass, l1 (the hinge pin's distance; "
+                        "the inertias do not follow it))\n"), err
+    code, _, _ = cli("--model", "touch", "--set", f"l1={longest * 1.001}", "fk", "0", "0", "0")
+    assert code == 2

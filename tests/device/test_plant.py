@@ -10,9 +10,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from helpers import REPORT
-from phantom_pin import Device, InvalidInputError, MissingDataError, closed_form, simulate
+from phantom_pin import Device, InvalidInputError, MissingDataError, closed_form, config, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.device.plant import Plant
 
@@ -203,3 +204,105 @@ def test_the_device_modules_keep_to_their_own_private_names_and_import_at_the_to
                     if any(name.split(".")[0] == "phantom_pin" for name in names):
                         found.append(f"{path.name}:{inner.lineno} imports inside {node.name}")
     assert found == []
+
+
+# -- stiction: which joint breaks away, where and when; the substeps; divergence ----------------
+
+
+def _plant(overrides=None, **options):
+    from phantom_pin import Device, Phantom, describe
+    from phantom_pin.device.plant import Plant
+
+    device = Device(Phantom(describe(overrides=overrides or {})))
+    settings = {"friction": True, "hard_stops": False, "saturation": False, "contact_step": 1e-3} | options
+    return device, Plant(device, **settings)
+
+
+def test_of_the_joints_stuck_at_rest_the_most_overloaded_breaks_away_first():
+    """Of the joints stuck at rest, the most overloaded (holding torque less its Coulomb torque)
+    breaks away first, not the most loaded. The rule written here on Phantom's M and gravity
+    (the holding torques of the stuck joints, M_SL a_L - rhs_S with the sliding ones' Coulomb
+    friction), at 300 seeded postures and loads at rest with Coulomb torques (0.1, 0.45, 0.1) N m:
+    the plant's stuck joints (zero acceleration) and sliding directions are the rule's; the most
+    loaded first would differ at a share of them."""
+    coulomb = (0.1, 0.45, 0.1)
+    device, plant = _plant({f"actuation.friction.coulomb.joint{j + 1}": c for j, c in enumerate(coulomb)})
+    phantom = device.phantom
+
+    def modes(q, tau, overload):
+        mass, gravity, mode = phantom.mass_matrix(np.array(q)), phantom.gravity(np.array(q)), [0, 0, 0]
+        while 0 in mode:
+            free, stuck = [i for i in range(3) if mode[i]], [i for i in range(3) if not mode[i]]
+            rhs = np.array(tau) - gravity - np.array(coulomb) * mode
+            a = np.zeros(3)
+            if free:
+                a[free] = np.linalg.solve(mass[np.ix_(free, free)], rhs[free])
+            holding = mass[stuck] @ a - rhs[stuck]
+            k = max(range(len(stuck)), key=lambda k: abs(holding[k]) - (coulomb[stuck[k]] if overload else 0))
+            if abs(holding[k]) < coulomb[stuck[k]]:
+                break
+            mode[stuck[k]] = -1 if holding[k] > 0 else 1
+        return mode
+
+    rng, differ = np.random.default_rng(5), 0
+    for _ in range(300):
+        q = [0.0, rng.uniform(0.1, 1.0), rng.uniform(0.2, 1.5)]
+        tau = (phantom.gravity(np.array(q)) - [0.0, *rng.uniform(-0.6, 0.6, 2)]).tolist()
+        got = [int(np.sign(a)) for a in plant.acceleration(q, [0.0] * 3, tau)]
+        assert got == modes(q, tau, True), (q, tau)
+        differ += modes(q, tau, False) != got
+    assert differ > 30
+
+
+def test_a_joint_that_breaks_away_within_a_step_is_released_there():
+    """A joint that breaks away within a step is released there (the stick-to-slip event), not at
+    the step's end. Joint 2 at rest held 0.0022 N m past gravity (below its 0.01 N m Coulomb
+    torque at the start), joint 3 driven: as joint 3 sweeps, the torque holding joint 2 crosses
+    the Coulomb torque within the 20 ms step. One step of 20 ms equals 2000 steps of 10 us (whose
+    own lateness is 10 us) within 1e-5 rad/s; a step that ignored the breakaway ends with joint 2
+    still at rest."""
+    device, plant = _plant()
+    q = [0.0, 0.5, 0.9]
+    tau = (device.phantom.gravity(np.array(q)) + [0.0, -0.0022, 0.05]).tolist()
+    assert plant.acceleration(q, [0.0] * 3, tau)[1] == 0.0        # stuck at the start
+    coarse, fine = plant.hold(q, [0.0] * 3, tau, 0.02, 1), plant.hold(q, [0.0] * 3, tau, 0.02, 2000)
+    assert fine[1][1] < -3e-4                                         # broken away by the end
+    np.testing.assert_allclose(coarse[1], fine[1], rtol=0, atol=1e-5)
+    np.testing.assert_allclose(coarse[0], fine[0], rtol=0, atol=1e-7)
+
+
+@pytest.mark.parametrize("share, slides", [(1.05, True), (0.95, False)])
+def test_a_joint_at_rest_breaks_away_at_its_coulomb_torque(share, slides):
+    """A joint at rest breaks away at its Coulomb torque: joint 1 (no gravity) at rest under
+    gravity compensation plus share x its Coulomb torque (0.01 N m, as actuation.yaml states it)
+    slides beyond it, sticks below."""
+    stated = yaml.safe_load((config.MODELS["premium_1_5"].config / "actuation.yaml").read_text())["friction"]
+    device, plant = _plant()
+    q = [0.2, 0.5, 0.7]
+    tau = (device.phantom.gravity(np.array(q)) + [share * stated["coulomb"], 0.0, 0.0]).tolist()
+    assert (plant.acceleration(q, [0.0] * 3, tau)[0] > 0) == slides
+
+
+def test_the_contact_substeps_follow_the_largest_viscous_coefficient():
+    """The contact substeps follow the largest of the joints' viscous coefficients:
+    contact_substeps' documented rule, period x (3 B + max viscous) / m / 0.7 rounded up, m half
+    the smallest eigenvalue of M(theta0), with joint 3's viscous 5 N m s/rad (joint 1's the
+    shipped 5e-4) and without stops, where the damping alone sets it."""
+    from phantom_pin.device.plant import DAMPING_SCALE, contact_substeps
+
+    device, _ = _plant({"actuation.friction.viscous.joint3": 5.0})
+    theta0 = np.array([0.0, 0.5, 0.9])
+    m = 0.5 * np.linalg.eigvalsh(device.phantom.mass_matrix(theta0)).min()
+    expected = int(np.ceil(1e-3 * 5.0 / m / DAMPING_SCALE))
+    assert expected > 5
+    assert contact_substeps(device, theta0, 1e-3, friction=True, hard_stops=False) == expected
+
+
+def test_hold_raises_diverged_when_the_state_leaves_the_finite_numbers():
+    """hold() raises Diverged when the state leaves the finite numbers (with friction, a 1e300 N m
+    command), never NaN angles."""
+    from phantom_pin.device.plant import Diverged
+
+    _, plant = _plant()
+    with pytest.raises(Diverged):
+        plant.hold([0.0, 0.5, 0.9], [0.0] * 3, [1e300, 0.0, 0.0], 1e-3, 1)

@@ -1,4 +1,5 @@
-"""Phantom (Pinocchio) against closed_form, finite differences and energy conservation."""
+"""Phantom (Pinocchio) against closed_form, finite differences and energy conservation; with the
+stylus gimbal held at given angles, against the Touch's six-joint model (helpers.Six)."""
 
 import shutil
 import warnings
@@ -10,6 +11,8 @@ import pytest
 from helpers import CONFIG_DIR, REPORT, relative_error
 from phantom_pin import InvalidInputError, Phantom, UnreachableTargetError
 from phantom_pin import closed_form as cf
+from phantom_pin.config import read
+from phantom_pin.config.sampling import random_states
 
 TOLERANCE = 1e-9  # relative, both sides exact
 
@@ -297,3 +300,115 @@ def test_a_prefixed_description_gives_the_same_phantom():
     gimbal = np.array([0.3, -0.2, 0.5])
     np.testing.assert_allclose(left.stylus_tip_pose(theta, gimbal), touch.stylus_tip_pose(theta, gimbal),
                                rtol=0, atol=1e-15)
+
+
+# -- the stylus gimbal held at given angles, against the six-joint model (conftest.py's six) -----
+TOUCH = read("touch")
+
+
+@pytest.fixture(scope="module")
+def touch():
+    return Phantom.from_model("touch")
+
+
+def _held_states(n, seed):
+    """``n`` seeded (theta, dtheta, ddtheta, gimbal): theta inside the Touch's stops, gimbal
+    angles uniform inside the gimbal's range."""
+    theta, dtheta, ddtheta = random_states(TOUCH.limits, n, seed=seed)
+    gimbal = np.random.default_rng(seed).uniform(TOUCH.gimbal.lower, TOUCH.gimbal.upper, (n, 3))
+    return theta, dtheta, ddtheta, gimbal
+
+
+def _christoffel(six, theta, gimbal, dtheta, step=1e-6):
+    """C(theta, dtheta) of the Christoffel symbols of M's central differences (step rad):
+    C_ij = sum_k 1/2 (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) dtheta_k."""
+    dm = np.array([(six.mass(theta + step * e, gimbal) - six.mass(theta - step * e, gimbal)) / (2 * step)
+                   for e in np.eye(3)])  # dm[k] = dM/dq_k
+    return 0.5 * (np.einsum("kij,k->ij", dm, dtheta) + np.einsum("jik,k->ij", dm, dtheta)
+                  - np.einsum("ijk,k->ij", dm, dtheta))
+
+
+def test_the_arms_dynamics_with_the_gimbal_held_are_the_six_joint_models(touch, six):
+    """mass_matrix, coriolis_matrix, inverse_dynamics, forward_dynamics and gravity with gimbal=
+    are the six-joint model's arm block with the gimbal at rest at those angles. Against the
+    six-joint model built here from the URDF, at 40 seeded states inside the stops with gimbal
+    angles across their range: M's arm block, rnea's and gravity's arm rows (1e-12 relative), the
+    accelerations of M's solve (1e-9), and C against the Christoffel symbols of M's central
+    differences (1e-6 of C's largest entry; C dtheta also against rnea's bias, 1e-12). At
+    locked_at they would differ by percents."""
+    scale = 1e-12
+    for theta, dtheta, ddtheta, gimbal in zip(*_held_states(40, seed=4201)):
+        mass, torques = six.mass(theta, gimbal), six.torques(theta, gimbal, dtheta, ddtheta)
+        gravity = six.torques(theta, gimbal, 0 * dtheta, 0 * ddtheta)
+        bias = six.torques(theta, gimbal, dtheta, 0 * ddtheta)
+        np.testing.assert_allclose(touch.mass_matrix(theta, gimbal), mass, rtol=0, atol=scale * np.abs(mass).max())
+        np.testing.assert_allclose(touch.gravity(theta, gimbal), gravity, rtol=0, atol=scale * np.abs(gravity).max())
+        np.testing.assert_allclose(touch.inverse_dynamics(theta, dtheta, ddtheta, gimbal), torques, rtol=0,
+                                   atol=scale * np.abs(torques).max())
+        np.testing.assert_allclose(touch.forward_dynamics(theta, dtheta, torques, gimbal),
+                                   np.linalg.solve(mass, torques - bias), rtol=1e-9, atol=1e-9 * np.abs(ddtheta).max())
+        c = touch.coriolis_matrix(theta, dtheta, gimbal)
+        np.testing.assert_allclose(c, _christoffel(six, theta, gimbal, dtheta), rtol=0, atol=1e-6 * np.abs(c).max())
+        np.testing.assert_allclose(c @ dtheta, bias - gravity, rtol=0, atol=scale * np.abs(bias - gravity).max())
+    locked = touch.inverse_dynamics(theta, dtheta, ddtheta)
+    assert np.abs(locked - torques).max() > 1e-3 * np.abs(torques).max()  # the gimbal's angles show
+
+
+def test_the_coriolis_matrix_with_the_gimbal_held_keeps_the_energy_balance(touch):
+    """With the gimbal held, dM/dt - 2 C is skew-symmetric (the power balance of a mechanical
+    system): dM/dt by central differences of mass_matrix(theta + t dtheta, gimbal), at 20 seeded
+    states; 1e-6 of C's largest entry (the differences' error)."""
+    step = 1e-6
+    for theta, dtheta, _, gimbal in zip(*_held_states(20, seed=4202)):
+        dm = (touch.mass_matrix(theta + step * dtheta, gimbal) - touch.mass_matrix(theta - step * dtheta, gimbal)) / (
+            2 * step)
+        skew = dm - 2 * touch.coriolis_matrix(theta, dtheta, gimbal)
+        np.testing.assert_allclose(skew, -skew.T, rtol=0, atol=1e-6 * np.abs(dm).max())
+
+
+@pytest.mark.parametrize("method, count", [("gravity", 1), ("mass_matrix", 1), ("coriolis_matrix", 2),
+                                           ("inverse_dynamics", 3), ("forward_dynamics", 3), ("stylus_pose", 1),
+                                           ("stylus_tip_pose", 1)])
+def test_one_gimbal_broadcasts_over_a_batch_of_states(touch, six, method, count):
+    """The gimbal broadcasts against theta: theta's batch (2, 5, 3) with one gimbal (3,), and
+    with one gimbal per row of the last axis (5, 3): each state's result equals its single call's;
+    the poses against the six-joint model's frames (1e-12 m)."""
+    theta, dtheta, ddtheta, gimbal = _held_states(10, seed=4203)
+    values = [v.reshape(2, 5, 3) for v in (theta, dtheta, ddtheta)[:count]]
+    function = getattr(touch, method)
+    for g in (gimbal[0], gimbal[:5]):
+        batch = function(*values, gimbal=g)
+        assert batch.shape[:2] == (2, 5)
+        for i, j in np.ndindex(2, 5):
+            row = g if g.ndim == 1 else g[j]
+            one = function(*(v[i, j] for v in values), gimbal=row)
+            np.testing.assert_allclose(batch[i, j], one, rtol=1e-13, atol=1e-15)
+            if method.startswith("stylus"):
+                frame = "stylus" if method == "stylus_pose" else "stylus_tip"
+                np.testing.assert_allclose(one, six.pose(values[0][i, j], row, frame), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("gimbal, message", [
+    ([0.1, 0.2], r"gimbal: expected shape \(3,\) or \(\.\.\., 3\)"),
+    ([0.1, np.nan, 0.2], "gimbal: contains NaN or inf"),
+    ([True, False, True], "gimbal: expected real numbers, got booleans"),
+    (np.zeros((4, 3)), r"gimbal: shape \(4, 3\) does not broadcast against theta's \(5, 3\)"),
+])
+@pytest.mark.parametrize("method", ["mass_matrix", "coriolis_matrix", "inverse_dynamics", "forward_dynamics",
+                                    "gravity", "stylus_pose"])
+def test_a_bad_gimbal_is_refused_by_name(touch, method, gimbal, message):
+    """A gimbal of the wrong shape, with NaN, of booleans or that does not broadcast against theta
+    is refused by every method, InvalidInputError naming gimbal."""
+    count = {"coriolis_matrix": 2, "inverse_dynamics": 3, "forward_dynamics": 3}.get(method, 1)
+    shape = (5, 3) if np.ndim(gimbal) == 2 else (3,)
+    with pytest.raises(InvalidInputError, match=f"^{message}"):
+        getattr(touch, method)(*[np.full(shape, 0.2)] * count, gimbal=gimbal)
+
+
+@pytest.mark.parametrize("method, count", [("mass_matrix", 1), ("coriolis_matrix", 2), ("inverse_dynamics", 3),
+                                           ("forward_dynamics", 3), ("gravity", 1)])
+def test_a_model_without_a_gimbal_refuses_gimbal_angles_by_name(method, count):
+    """A model without a stylus gimbal refuses gimbal angles in every method, InvalidInputError
+    naming gimbal and the model."""
+    with pytest.raises(InvalidInputError, match="^gimbal: the model 'premium_1_5' has no stylus gimbal"):
+        getattr(Phantom(), method)(*[np.full(3, 0.2)] * count, gimbal=[0.1, 0.2, 0.3])

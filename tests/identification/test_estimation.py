@@ -1,13 +1,15 @@
 """estimate() on logs made here from the closed form: a three-frequency trajectory (exact
 rates and accelerations), torques from the report's inverse dynamics plus the friction law,
-so that the true beta is known (constants.nominal)."""
+so that the true beta is known (constants.nominal); and each of the fit's thresholds (the
+torque guard, too little motion, the gains, negative friction) on logs of the model's own
+torques (helpers.sines, helpers.model_torques)."""
 
 import re
 
 import numpy as np
 import pytest
 
-from helpers import CONFIG, REPORT
+from helpers import CONFIG, REPORT, T10, model_torques, sines
 from phantom_pin import Device, Phantom, closed_form
 from phantom_pin.cli import main
 from phantom_pin.identification import constants, estimation, io
@@ -280,3 +282,93 @@ def test_the_excitation_and_the_log_check_their_arguments(call, argument):
 def excitation_optimise(**kwargs):
     from phantom_pin.identification import excitation
     return excitation.optimise(PHANTOM, **kwargs)
+
+
+# -- each threshold against a log built here with a known truth (helpers.sines) ----------------
+
+
+def test_a_log_with_torques_beyond_1000_n_m_is_refused_at_once(monkeypatch):
+    """A log whose torques reach beyond 1000 N m is refused at once, as its message says: the
+    model's torques with 2000 N m on joint 2's, refused before any fit (the filter, the first
+    costly stage, is never reached)."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    def unreachable(*args, **kwargs):
+        raise AssertionError("filtered before the refusal")
+
+    monkeypatch.setattr(estimation, "filtered", unreachable)
+    phantom = Phantom()
+    theta, dtheta, ddtheta = sines(T10)
+    tau = model_torques(phantom, theta, dtheta, ddtheta)
+    tau[100, 1] = 2000.0
+    with pytest.raises(io.LogError, match=r"tau2: the log's torques reach 2e\+03 N m, more than 1000 N m"):
+        estimation.estimate(io.Log(T10, theta, tau), phantom)
+
+
+def test_a_joint_moving_in_fewer_than_50_samples_is_too_little_motion():
+    """A joint moving in fewer than 50 samples is too little motion. Joint 3 swings 3.4 mrad at
+    0.5 Hz (peak 10.7 mrad/s): at --min-speed 10.5 mrad/s the filtered log has between 5 and 50
+    of its samples moving (counted by filtering.filtered), which is too little motion."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, filtering, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = sines(T10)
+    w, amplitude = np.pi, 0.0034
+    theta[:, 2], dtheta[:, 2], ddtheta[:, 2] = (0.45 + amplitude * np.sin(w * T10), amplitude * w * np.cos(w * T10),
+                                                -amplitude * w * w * np.sin(w * T10))
+    log = io.Log(T10, theta, model_torques(phantom, theta, dtheta, ddtheta))
+    moving = filtering.filtered(log, 20.0, phantom.config.actuation.friction, min_speed=0.0105).moving.sum(axis=0)
+    assert 5 < moving[2] < 50 and (moving[:2] >= 50).all(), moving
+    with pytest.raises(io.LogError, match="too little motion: joint.s. 3 move faster than 0.0105 rad/s in fewer "
+                                          "than 50 samples"):
+        estimation.estimate(log, phantom, min_speed=0.0105)
+
+
+@pytest.mark.parametrize("gain, corrected", [(1.005, False), (2.5, None)])
+def test_a_gain_is_corrected_only_beyond_1_percent_and_refused_beyond_2(gain, corrected):
+    """A torque gain is corrected only beyond 1 % AND 4 sigma from 1, and refused outside 0.5-2
+    as no drive's tolerance. The model's own torques with joint 2's (or 3's) logged 1 / gain
+    times too small: 0.5 % off (thousands of sigma on a noiseless log, but within 1 %) is
+    estimated and kept at 1; 2.5 is refused."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = sines(T10)
+    joint = 1 if corrected is not None else 2
+    tau = model_torques(phantom, theta, dtheta, ddtheta)
+    tau[:, joint] /= gain
+    fit = estimation.estimate(io.Log(T10, theta, tau), phantom, timing="sampled")
+    values, sigma = fit.gains_estimated
+    assert values[joint] == pytest.approx(gain, rel=1e-4) and abs(values[joint] - gain) < 10 * sigma[joint] + 1e-4
+    if corrected is False:
+        assert abs(values[joint] - 1) > 4 * sigma[joint] and fit.gains[joint] == 1.0
+    else:
+        assert any(f"tau3 is {1 / gain:.3g} times joint 1's torque scale (gain {gain:.3g}, outside 0.5-2" in p
+                   for p in fit.problems), fit.problems
+
+
+def test_friction_estimated_3_to_30_sigma_below_zero_is_refused():
+    """Friction estimated well below zero (here 10 sigma, between 3 and 30) is refused as
+    negative. Two logs with the same seeded torque noise (2 mN m): joint 1's Coulomb torque 0
+    gives its standard deviation s; -10 s as the truth is estimated about 10 s below zero and
+    refused as negative."""
+    from phantom_pin import Phantom
+    from phantom_pin.identification import estimation, io
+
+    phantom = Phantom()
+    theta, dtheta, ddtheta = sines(T10)
+    noise = np.random.default_rng(7).normal(0, 2e-3, (len(T10), 3))
+    law = phantom.config.actuation.friction
+
+    def fit(coulomb1):
+        tau = model_torques(phantom, theta, dtheta, ddtheta, (coulomb1, *law.coulomb[1:])) + noise
+        return estimation.estimate(io.Log(T10, theta, tau), phantom, timing="sampled")
+
+    s = fit(0.0).friction[1][3]
+    refused = fit(-10 * s)
+    value, sigma = refused.friction[0][3], refused.friction[1][3]
+    assert -15 < value / sigma < -5, value / sigma
+    assert any(p.startswith("negative friction (") for p in refused.problems), refused.problems

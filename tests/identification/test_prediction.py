@@ -2,6 +2,7 @@
 Monte Carlo of the parameters, and the poorly excited directions of a known information matrix."""
 
 import numpy as np
+import pytest
 
 from phantom_pin.identification import prediction
 
@@ -34,3 +35,28 @@ def test_the_poorly_excited_directions_are_named_by_their_parameters():
                                   prediction.poorly_excited(unseen, np.ones(3), names), 0.3).warnings()
     assert words == ["the log leaves poorly excited: 0.71 (a) + 0.71 (b): more than 1000 % uncertain; c: 50 % "
                      "uncertain (from the log alone, of their typical size; where above 30 %, the prior holds them)"]
+
+
+def test_a_poorly_excited_direction_spread_over_many_parameters_is_named_by_its_largest_three():
+    """A poorly excited direction is named by its three largest components, also when none has
+    more than 0.2 of its square (spread over many parameters). Unit vector by hand: the three
+    largest."""
+    from phantom_pin.identification import prediction
+
+    vector = np.array([3.0, -3.0, 2.9, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0])
+    vector /= np.linalg.norm(vector)                 # largest square 9 / 58.41 = 0.154
+    names = tuple(f"p{k}" for k in range(len(vector)))
+    a, c = 3 / np.sqrt(58.41), 2.9 / np.sqrt(58.41)
+    assert prediction._words(vector, names) == f"{a:.2f} (p0) - {a:.2f} (p1) + {c:.2f} (p2)"
+
+
+@pytest.mark.parametrize("ratio, refused", [(1.12, True), (1.08, False)])
+def test_a_model_worse_than_the_prior_by_more_than_10_percent_is_refused(ratio, refused):
+    """A fit worse than the prior by more than 10 % on a joint's log is refused, 8 % is not (the
+    module's 1.1, "markedly worse")."""
+    from phantom_pin.identification import prediction
+
+    shares = dict(log=np.zeros(3), states=np.zeros(3), prior_states=np.zeros(3), directions=(), spread=0.3)
+    prior_log = np.array([0.01, 0.02, 0.03])
+    fit_log = prior_log * [1.0, ratio, 1.0]
+    assert (prediction.Prediction(fit_log=fit_log, prior_log=prior_log, **shares).worse() is not None) == refused

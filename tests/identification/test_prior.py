@@ -9,6 +9,7 @@ inverse dynamics (Pinocchio on its description): a second sum-of-sines trajector
 seeded states inside the stops."""
 
 import functools
+import warnings
 
 import numpy as np
 import pytest
@@ -287,3 +288,29 @@ def test_a_prior_without_friction_lets_the_log_give_it(lab):
     np.testing.assert_allclose(values[3:], COULOMB, rtol=0.01)
     states = held["states"]
     assert np.abs(error(fit.written, truth, states) - error(fits["wide"].written, truth, states)).max() < 1e-3
+
+
+def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_path, cli):
+    """identify refuses a --prior-spread beyond MAX_SPREAD (1e6), where the prior no longer
+    counts, in one line naming the option (inf: no prior), nothing written. The bound's reason,
+    against the fit of the log alone (no prior at all): at MAX_SPREAD the prior no longer moves
+    the estimate (relative difference below 1e-9 on a noiseless 10 s log of the model's own
+    torques), and no warning is raised."""
+    from phantom_pin.identification import estimation, io, prior
+
+    t, theta, dtheta, ddtheta = sum_of_sines(10, 0.2, 1)
+    tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + CONFIG.actuation.friction.torque(dtheta)
+    io.write_log(tmp_path / "log.csv", t, theta, tau)
+    log = io.read_log(tmp_path / "log.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        alone = estimation.estimate(log, PRIOR, prior_spread=float("inf")).beta
+        widest = estimation.estimate(log, PRIOR, prior_spread=prior.MAX_SPREAD).beta
+        assert np.abs(widest - alone).max() < 1e-9 * np.abs(alone).max()
+        for spread in ("1e300", "1e7"):
+            code, out, err = cli("identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"),
+                                 "--prior-spread", spread)
+            assert code == 2 and out == "" and err == (
+                f"phantom-pin: error: --prior-spread: {float(spread)!r} is beyond 1e+06, where the prior no "
+                "longer counts; give inf for no prior\n")
+            assert not (tmp_path / "id.yaml").exists()

@@ -1,4 +1,5 @@
-"""Documentation that states facts: the README's quick start and the YAML's comments."""
+"""Documentation that states facts: the README's quick start, the YAML's comments, and docs/cli.md's
+Ctrl-C sentence and command table."""
 
 import re
 import xml.etree.ElementTree as ET
@@ -52,3 +53,28 @@ def test_simulation_doc_quotes_the_shipped_friction_and_stops():
     quoted = re.search(r"\(([0-9.e-]+) rad at joint 1\) unless σ0 < (\d+) N m/rad", text)
     assert abs(float(quoted[1]) / count - 1) < 5e-3                      # rounded to 3 digits
     assert int(quoted[2]) == round(friction.coulomb[0] / count)
+
+
+def test_the_cli_page_says_what_ctrl_c_does_to_show_and_ros2():
+    """docs/cli.md's Ctrl-C sentence (one line, exit 130) names its exceptions: `show`'s live
+    viewer and the `ros2` node exit 0 on it, their normal stop (tests/cli/test_cli.py's
+    test_show_serves_on_loopback_until_interrupted runs show and sends SIGINT: exit 0)."""
+    readme = " ".join((ROOT / "docs" / "cli.md").read_text().split())
+    start = readme.index("Ctrl-C prints one line and exits with 130")
+    sentence = readme[start:readme.index(". ", start)]
+    assert "`show`'s live viewer and the `ros2` node run until Ctrl-C or SIGTERM and then exit 0" in sentence
+
+
+def test_the_cli_pages_command_table_lists_every_command_and_the_newest_options():
+    """docs/cli.md's command table has a row for every subcommand of the parser, and shows
+    show --gimbal and urdf --convention driver."""
+    from phantom_pin.cli.app import parser
+
+    readme = (ROOT / "docs" / "cli.md").read_text()
+    table = readme.split("## The commands at a glance")[1].split("\n\n")[1]
+    rows = [line for line in table.splitlines() if line.startswith("| `phantom-pin")]
+    commands = next(a for a in parser()._actions if a.dest == "command").choices
+    for command in commands:
+        assert any(re.search(rf"[ `]{command}[ `]", row.split("` |")[0] + "`") for row in rows), command
+    assert any("show [" in row and "--gimbal" in row for row in rows)
+    assert any("urdf -o" in row and "--convention driver" in row for row in rows)
