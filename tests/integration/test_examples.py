@@ -124,7 +124,7 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
     which; test_viewer checks the timing of animations): at that posture the black tip ball is
     where the kinematics put the tip AND the light grey upper arm and forearm cover 9 points
     each along them (the black motors and the dark base, onto which some postures project
-    their tip, cannot fake those). The candidates are the sweep at 8 times its keyframe rate:
+    their tip, cannot fake those). The candidates are the sweep at 32 times its keyframe rate:
     the page may be caught between two keyframes (where it has loaded decides when the clip
     starts, later on a loaded machine), where meshcat shows the posture in between."""
     result = run("visualize.py", tmp_path)
@@ -135,7 +135,7 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
     _, postures = example("visualize").sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
                                              dataclasses.astuple(CONFIG.limits.stops.coupled))
     assert Device().within_limits(postures).all()
-    steps = np.linspace(0.0, 1.0, 8, endpoint=False)[:, None, None]
+    steps = np.linspace(0.0, 1.0, 32, endpoint=False)[:, None, None]
     postures = (postures[:-1] + steps * (postures[1:] - postures[:-1])).transpose(1, 0, 2).reshape(-1, 3)
     along = np.linspace(0.1, 0.9, 9)[:, None]
 
