@@ -56,7 +56,7 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
 
 #: The options of the trajectory fit, which rest postures do not take (dest, option, default).
 TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
-                   ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", "held"),
+                   ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", None),
                    ("min_speed", "--min-speed", None), ("cutoff", "--cutoff", 20.0),
                    ("accept", "--accept", False), ("report", "--report", None), ("reference", "--reference", None))
 
@@ -167,9 +167,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                           help="the bag's sensor_msgs/JointState topic (default: the driver's, or the bag's only one)")
     identify.add_argument("--output", "-o", required=True, type=Path, action=Once)
     identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
-    identify.add_argument("--torque-timing", choices=("held", "sampled"), default="held",
+    identify.add_argument("--torque-timing", choices=("held", "sampled"), default=None,
                           help="held: each logged torque is a command applied until the next sample (a servo "
-                               "loop's, default); sampled: the torque at that instant (a sensor, or a model)")
+                               "loop's); sampled: the torque at that instant (a sensor, or a model); default: "
+                               "chosen from the log on held-out quarters of it (held unless sampled fits them "
+                               "better; docs/identification.md, step 4)")
     identify.add_argument("--min-speed", type=float, default=None, metavar="RAD_PER_S",
                           help="fit a joint's torques only where its rate stays above this over the filter's span "
                                "(near rest a joint sticks; default: chosen from the log of "

@@ -1,13 +1,16 @@
 """The estimate of a device's parameters from its log, in named stages (docs/identification.md):
 
 1. the cheap refusals (checks.py): the arguments, a log no arithmetic should touch, the filtered
-   log's length and motion, the torques' size and sign against the prior's prediction;
+   log's length and motion, the torques' size and sign against the prior's prediction; the
+   friction speed threshold and the torque timing, where not given, chosen on held-out
+   quarters of the log (selection.py);
 2. timing (timing.py): the delay between positions and torques, estimated or given; for a
    closed-loop log with its reference, every stage from here uses instrumental variables
    (instruments.py: the torque noise the loop feeds back into the motion biases least squares);
 3. gains (least_squares.solve_gains): each joint's torque gain relative to joint 1, corrected
    where the log shows it differs from 1 (by more than GAIN_NOTED and GAIN_EVIDENCE standard
-   deviations), and the delay estimated again with the corrected ones;
+   deviations) and the correction predicts held-out quarters of the log better
+   (selection.validate_gains), and the delay estimated again with the corrected ones;
 4. the fit with the prior (least_squares.fit): the base parameters and their covariance;
 5. the physical projection (physical.nearest): the structure's parameters whose base
    parameters are nearest to beta in the covariance's metric, every link physical, friction >= 0;
@@ -41,7 +44,7 @@ from phantom_pin.identification.least_squares import (
 )
 from phantom_pin.identification.least_squares import fit as least_squares
 from phantom_pin.identification.prediction import judge
-from phantom_pin.identification.selection import choose_min_speed
+from phantom_pin.identification.selection import FOLDS, choose_min_speed, choose_timing, validate_gains
 from phantom_pin.identification.structures import STRUCTURES, Structure
 from phantom_pin.identification.timing import HOLD, TIMINGS, criterion, delay_argument, estimate_delay
 
@@ -54,6 +57,13 @@ from phantom_pin.identification.timing import HOLD, TIMINGS, criterion, delay_ar
 #: of current noise; correcting such a gain cost 0.3-0.9 % of held-out accuracy where the drives
 #: were right. A torque constant 2 % off or a ratio misread (3.5 %) is well beyond both.
 GAIN_NOTED, GAIN_EVIDENCE = 0.01, 4.0
+#: A gain that passes both is corrected only where that makes the held-out prediction better on
+#: every one of the log's FOLDS quarters (selection.validate_gains: estimated on three, judged on
+#: the fourth, against the fit with the gains at 1). Not a size: a real gain error's improvement
+#: is as small as the rest of the residual is large (a 2 % torque constant on a lab's sum of
+#: sines with 1 % torque noise: 0.3-1.0 % per quarter, every quarter), while a gain the closed
+#: loop's noise biased improves some quarters and worsens others (the CAD's lab log with 10 mA:
+#: -0.2 to +0.2 %, which corrected joint 3 to 0.935, and the held-out error with it).
 #: The report's structure needs the general model when it leaves more than this times the
 #: general model's residual on some joint.
 NEEDS_GENERAL = 1.2
@@ -64,7 +74,9 @@ class _Regression:
     """A log made ready for the fit: its filtered ``samples``, its ``structure``, the
     regressor ``phi`` (N, 3, P) zeroed outside the fitted equations ``moving`` (N, 3), the known
     torques ``tau0`` (N, 3; N m), the prior (beta_0, P) or None (prior_spread inf), the friction
-    speed threshold ``min_speed`` (rad/s) and, where it was chosen, each one's held-out residual."""
+    speed threshold ``min_speed`` (rad/s) and, where it was chosen, each one's held-out residual;
+    the torque ``timing`` the samples' torques are read at and, where it was chosen, each
+    timing's held-out residual (selection.choose_timing)."""
 
     samples: Samples
     structure: Structure
@@ -76,6 +88,8 @@ class _Regression:
     min_speed: float = MIN_SPEED
     min_speed_scores: dict[float, float] = dataclasses.field(default_factory=dict)
     instruments: Instruments | None = None
+    timing: str = "held"
+    timing_scores: dict[str, float] = dataclasses.field(default_factory=dict)
 
     @property
     def solved(self) -> np.ndarray:
@@ -90,7 +104,10 @@ class _Timed:
     """Stages 2-4's result: the ``samples`` with the torques at the ``delay`` (s), the estimate
     with the prior (``beta``, ``covariance``, ``information`` of beta and the free inverse gains,
     the log alone's ``log_beta`` and ``log_rms`` (N m)), the ``gains`` applied and those
-    ``estimated`` ((3,), (3,): least_squares.solve_gains), each timing's weighted ``residuals``."""
+    ``estimated`` ((3,), (3,): least_squares.solve_gains), each timing's weighted ``residuals``,
+    and where a gain passed the evidence rule, the held-out ``gain_scores`` of keeping the gains
+    at 1 and of correcting them and the quarters where correcting was better
+    (selection.validate_gains), else empty."""
 
     samples: Samples
     delay: float
@@ -102,11 +119,12 @@ class _Timed:
     gains: np.ndarray
     estimated: tuple[np.ndarray, np.ndarray]
     residuals: dict[str, float]
+    gain_scores: dict[str, float]
 
 
 def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
-             timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
+             timing: str | None = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
              gains: bool = True, min_speed: float | None = MIN_SPEED, refuse: bool = False,
              reference: tuple[np.ndarray, np.ndarray] | None = None) -> Fit:
     """Identify the device of ``log`` on the configuration of ``phantom`` (its parameters are
@@ -114,8 +132,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     ("general": the rigid body in full; "report": the report's structure, for a model in the
     report's form) and the nearest physically consistent parameters, in the stages of the
     module doc. ``cutoff`` (Hz): the filter's (filtering.py). ``timing``: how the torques
-    relate to the times (timing.TIMINGS: "held" commands, the default, or "sampled" values);
-    both timings are also fitted (``Fit.timing_residual``). ``prior_spread``: the prior's
+    relate to the times (timing.TIMINGS: "held" commands, the default, or "sampled" values), or
+    None: chosen from the log on held-out parts of it (selection.choose_timing;
+    ``Fit.timing_scores``); both timings are also fitted (``Fit.timing_residual``). ``prior_spread``: the prior's
     relative standard deviation of every physical parameter (prior.py; inf: the log alone).
     ``delay`` (s): how long after the positions they belong to the torques were logged, or
     None to estimate it (timing.py). ``gains``: estimate each joint's torque gain relative to
@@ -148,6 +167,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     checks.refuse_log(log, phantom)
     ready = _regression(log, phantom, cutoff, structure, timing, spread, 0.0 if delay is None else delay,
                         min_speed, refuse)
+    timing = ready.timing                   # given, or chosen from the log
     if angles is not None:
         ready = dataclasses.replace(ready, instruments=instruments(
             log, angles, ready.structure, cutoff, ready.samples, phantom.config.actuation.friction, timing))
@@ -173,8 +193,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
                                ready.beta0, information, priors.typical(chosen.matrix, chosen.scale),
                                chosen.base_names, spread),
               delay=timed.delay, delay_estimated=delay is None, timing=timing, timing_residual=timed.residuals,
+              timing_scores=ready.timing_scores,
               ratios=phantom.config.actuation.ratios, min_speed=ready.min_speed,
-              min_speed_scores=ready.min_speed_scores,
+              min_speed_scores=ready.min_speed_scores, gain_scores=timed.gain_scores,
               closed_loop="" if ready.instruments is None else ready.instruments.words(),
               curves=Curves(log.t[samples.index], samples.dtheta, samples.tau, phi @ written + ready.tau0,
                             samples.friction @ x[-6:], moving))
@@ -209,17 +230,20 @@ def _arguments(log: object, phantom: object, cutoff: object, structure: object, 
     if not isinstance(gains, bool):
         raise InvalidInputError(f"expected True (estimate the joints' relative torque gains) or False, got {gains!r}",
                                 argument="gains")
-    if timing not in TIMINGS:
-        raise InvalidInputError(f"expected one of {', '.join(TIMINGS)}, got {timing!r}", argument="timing")
+    if timing is not None and timing not in TIMINGS:
+        raise InvalidInputError(f"expected one of {', '.join(TIMINGS)}, or None to choose it from the log; got "
+                                f"{timing!r}", argument="timing")
     if structure not in STRUCTURES:
         raise InvalidInputError(f"expected one of {', '.join(STRUCTURES)}, got {structure!r}", argument="structure")
     return spread, checked
 
 
-def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timing: str, spread: float,
+def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timing: str | None, spread: float,
                 delay: float, min_speed: float | None, refuse: bool) -> _Regression:
     """Stage 1: the log filtered, the regressor, the prior, and the refusals that need no fit
-    (with ``refuse``, the torques' size and sign as well)."""
+    (with ``refuse``, the torques' size and sign as well); the timing chosen where None (after
+    the threshold, chosen with the held timing: the timings differ by half a sample only)."""
+    given_timing, timing = timing, timing or "held"
     model = STRUCTURES[structure](phantom)
     beta0, spread_covariance = priors.base_prior(model.matrix, model.offset, model.prior, model.scale,
                                                  spread if np.isfinite(spread) else 1.0)
@@ -233,11 +257,16 @@ def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timin
     phi, tau0 = model.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     moving = samples.moving                  # the equations fitted: joints clear of rest
     phi = phi * moving[..., None]
+    timing_scores: dict[str, float] = {}
+    if given_timing is None:
+        timing, timing_scores = choose_timing(samples, phi, tau0, delay, prior)
+        samples = samples.at(HOLD[timing] / samples.rate - delay)
     if refuse:
         found = checks.before_fit((samples.tau - tau0) * moving, phi @ (model.matrix @ model.prior + model.offset))
         if found:
             raise checks.RefusedError(found)
-    return _Regression(samples, model, phi, tau0, moving, beta0, prior, min_speed, scores)
+    return _Regression(samples, model, phi, tau0, moving, beta0, prior, min_speed, scores, timing=timing,
+                       timing_scores=timing_scores)
 
 
 def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gains: bool) -> _Timed:
@@ -264,22 +293,32 @@ def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gain
 
     solved = solve_gains(phi, used.tau, tau0, moving, prior, (1, 2) if gains else (), residuals_with)
     estimated = solved[-1]
+    scores: tuple[float, float, int] | None = None
     if gains:            # correct only the gains the log shows to differ from 1 (module doc, stage 3)
         values, sigma = estimated
         shown = tuple(j for j in (1, 2) if abs(values[j] - 1) > max(GAIN_NOTED, GAIN_EVIDENCE * sigma[j]))
+        kept = at, used, solved
         if delay is None and shown:          # the delay again with the gains corrected: a joint's scale moves it
             scale = np.ones(3)
             scale[list(shown)] = values[list(shown)]
             at, used = lag(scale)
             solved = solve_gains(phi, used.tau, tau0, moving, prior, (1, 2), residuals_with)
             estimated = solved[-1]
+        if shown:            # and only where the held-out prediction gets better (selection.py)
+            scores = validate_gains(phi, used.tau, tau0, moving, prior, shown)
+            if scores[2] < FOLDS:
+                shown = ()
+                at, used, solved = kept
+                estimated = solved[-1]
         if shown != (1, 2):
             solved = solve_gains(phi, used.tau, tau0, moving, prior, shown, residuals_with)
     beta, covariance, information, log_beta, log_rms, (gain, _) = solved
     given = 0.0 if delay is None else delay      # both timings at zero delay when it is estimated
     residuals = {name: weighted(samples.at(HOLD[name] / samples.rate - given, gain).tau - tau0)
                  for name in TIMINGS}     # in joint 1's scale, the gains applied
-    return _Timed(used, at, beta, covariance, information, log_beta, log_rms, gain, estimated, residuals)
+    return _Timed(used, at, beta, covariance, information, log_beta, log_rms, gain, estimated, residuals,
+                  {} if scores is None else {"kept at 1": scores[0], "corrected": scores[1],
+                                             "quarters better": float(scores[2])})
 
 
 def _projection(ready: _Regression, beta: np.ndarray, covariance: np.ndarray,

@@ -56,7 +56,10 @@ class Fit:
     the log better. ``curves``: the samples fitted, measured and predicted (Curves).
     ``min_speed`` (rad/s): the friction speed threshold fitted with; ``min_speed_scores``: each
     threshold's held-out weighted residual where it was chosen from the log (selection.py), else
-    empty. ``closed_loop``: where the log was identified as a closed loop on a reference given,
+    empty. ``gain_scores``: where a torque gain passed the evidence rule (estimation.GAIN_NOTED,
+    GAIN_EVIDENCE), the held-out weighted residual of the fit with the gains "kept at 1" and
+    "corrected" (selection.validate_gains; corrected only where better by estimation.GAIN_TIE),
+    else empty. ``closed_loop``: where the log was identified as a closed loop on a reference given,
     the line that says so (instrumental variables, instruments.py), else empty."""
 
     structure: str
@@ -90,6 +93,8 @@ class Fit:
     min_speed: float = 0.01          # filtering.MIN_SPEED (not imported: fit.py stays below filtering)
     min_speed_scores: dict[float, float] = dataclasses.field(default_factory=dict)
     closed_loop: str = ""
+    gain_scores: dict[str, float] = dataclasses.field(default_factory=dict)
+    timing_scores: dict[str, float] = dataclasses.field(default_factory=dict)
 
     @property
     def friction(self) -> tuple[np.ndarray, np.ndarray]:

@@ -21,6 +21,7 @@ from phantom_pin.identification.overlays import overlay
 
 __all__ = ["Identification", "RefusedError", "identify", "refusal"]
 from phantom_pin._validation import output_path
+from phantom_pin.identification.selection import FOLDS, TIE
 from phantom_pin.identification.timing import TIMING_MARGIN
 
 
@@ -119,7 +120,7 @@ def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], f
 
 
 def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str = "general",
-             timing: str = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
+             timing: str | None = None, prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
              gains: bool = True, min_speed: float | None = None, accept: bool = False,
              given: dict[str, object] | None = None, source: str = "a log",
              progress: Callable[[float], None] | None = None,
@@ -153,7 +154,14 @@ def timing_lines(fit: Fit) -> list[str]:
     how = "estimated from the log" if fit.delay_estimated else "given"
     lines = [f"delay between positions and torques: {1e3 * fit.delay:.3f} ms ({how}; the torques are read "
              f"that long after their positions, then the {fit.timing} timing's lag)"]
-    if len(fit.timing_residual) == 2:
+    if fit.timing_scores:
+        at = "no delay" if fit.delay_estimated else f"the given {1e3 * fit.delay:.3g} ms delay"
+        lines.append(f"torque timing: {fit.timing}, chosen on held-out quarters of the log with {at} (weighted "
+                     "residual: " + ", ".join(f"{name} {100 * np.sqrt(value / 3):.3g} %" for name, value in
+                                              fit.timing_scores.items())
+                     + f" of the torque RMS; held unless sampled is {100 * TIE:g} % better; --torque-timing "
+                     "gives it)")
+    elif len(fit.timing_residual) == 2:
         best = min(fit.timing_residual, key=lambda name: fit.timing_residual[name])
         at = "no delay" if fit.delay_estimated else f"the given {1e3 * fit.delay:.3g} ms delay"
         lines.append(f"torque timing: {best} fits the log better with {at} (weighted residual: "
@@ -168,7 +176,7 @@ def timing_lines(fit: Fit) -> list[str]:
 def timing_warning(fit: Fit) -> str | None:
     """One line when the timing given fits the log worse than the other by more than
     TIMING_MARGIN of its weighted residual, else None."""
-    if len(fit.timing_residual) != 2:
+    if len(fit.timing_residual) != 2 or fit.timing_scores:      # chosen from the log: nothing to warn
         return None
     other = next(name for name in fit.timing_residual if name != fit.timing)
     chosen, alternative = fit.timing_residual[fit.timing], fit.timing_residual[other]
@@ -187,11 +195,30 @@ def gain_lines(fit: Fit) -> list[str]:
     values, sigma = fit.gains_estimated
     if not sigma.any():
         return ["torque gains: not estimated (--fixed-gains / gains=False): the log's torques taken as they are"]
-    return ["torque gains relative to joint 1 (the log's torques times these are the model's): " + ", ".join(
+    rejected = rejected_gains(fit)
+    lines = ["torque gains relative to joint 1 (the log's torques times these are the model's): " + ", ".join(
         f"joint{j + 1} " + (f"{fit.gains[j]:.6g} +- {sigma[j]:.2g} (corrected in the written model)"
-                            if fit.gains[j] != 1 else f"{values[j]:.6g} +- {sigma[j]:.2g} (within "
-                            f"{GAIN_EVIDENCE:g} standard deviations or {100 * GAIN_NOTED:g} % of 1: kept at 1)")
+                            if fit.gains[j] != 1 else f"{values[j]:.6g} +- {sigma[j]:.2g} (kept at 1: correcting "
+                            "it did not improve the held-out prediction)" if j in rejected else
+                            f"{values[j]:.6g} +- {sigma[j]:.2g} (within {GAIN_EVIDENCE:g} standard deviations or "
+                            f"{100 * GAIN_NOTED:g} % of 1: kept at 1)")
         for j in (1, 2))]
+    if fit.gain_scores:
+        kept, corrected = fit.gain_scores["kept at 1"], fit.gain_scores["corrected"]
+        lines.append("torque gain correction checked on held-out quarters of the log (weighted residual: kept at 1 "
+                     f"{100 * np.sqrt(kept / 3):.3g} %, corrected {100 * np.sqrt(corrected / 3):.3g} % of the "
+                     f"torque RMS; corrected better on {fit.gain_scores['quarters better']:.0f} of {FOLDS} quarters): "
+                     f"{'kept at 1' if rejected else 'corrected'} (corrected only where better on every quarter)")
+    return lines
+
+
+def rejected_gains(fit: Fit) -> list[int]:
+    """The joints whose gain passed the evidence rule but was kept at 1: correcting them did not
+    improve the held-out prediction (Fit.gain_scores)."""
+    if not fit.gain_scores or (fit.gains != 1).any():
+        return []
+    values, sigma = fit.gains_estimated
+    return [j for j in (1, 2) if abs(values[j] - 1) > max(GAIN_NOTED, GAIN_EVIDENCE * sigma[j])]
 
 
 def gain_warning(fit: Fit) -> str | None:
@@ -199,7 +226,9 @@ def gain_warning(fit: Fit) -> str | None:
     that the estimate puts more than GAIN_NOTED from it (the log cannot tell), else None."""
     values, sigma = fit.gains_estimated
     off = [j for j in (1, 2) if fit.gains[j] != 1 and GAIN_BOUNDS[0] <= fit.gains[j] <= GAIN_BOUNDS[1]]
-    unsure = [j for j in (1, 2) if fit.gains[j] == 1 and sigma[j] > 0 and abs(values[j] - 1) > GAIN_NOTED]
+    rejected = rejected_gains(fit)
+    unsure = [j for j in (1, 2) if fit.gains[j] == 1 and sigma[j] > 0 and abs(values[j] - 1) > GAIN_NOTED
+              and j not in rejected]
     parts = []
     if off:
         hint = "" if fit.ratios is None else " (or were they converted with transmission ratio " + ", ".join(
@@ -213,6 +242,13 @@ def gain_warning(fit: Fit) -> str | None:
         parts.append(", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in unsure)
                      + f": kept at 1, the log cannot show it differs (needs {GAIN_EVIDENCE:g} standard "
                      "deviations); a log that moves joint 1 more (phantom-pin excite) would tell")
+    if rejected:
+        kept, corrected = (100 * np.sqrt(fit.gain_scores[name] / 3) for name in ("kept at 1", "corrected"))
+        parts.append(", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in rejected)
+                     + f": kept at 1 (the prior's), the log cannot tell: correcting it did not improve the held-out "
+                     f"prediction on every quarter of the log (better on {fit.gain_scores['quarters better']:.0f} of "
+                     f"{FOLDS}; {corrected:.3g} % of the torque RMS against {kept:.3g} % kept at 1); a log that "
+                     "moves joint 1 more (phantom-pin excite) would tell")
     return "; ".join(parts) or None
 
 

@@ -22,9 +22,11 @@ from phantom_pin.identification import checks
 from phantom_pin.identification.filtering import Samples, filtered
 from phantom_pin.identification.io import Log
 from phantom_pin.identification.least_squares import fit as least_squares
+from phantom_pin.identification.least_squares import solve_gains
 from phantom_pin.identification.structures import Structure
+from phantom_pin.identification.timing import HOLD, TIMINGS
 
-__all__ = ["choose_min_speed"]
+__all__ = ["choose_min_speed", "choose_timing", "validate_gains"]
 
 #: The thresholds tried (rad/s), and the parts of the log each is judged on.
 MIN_SPEEDS, FOLDS = (0.01, 0.02, 0.05, 0.1), 4
@@ -57,7 +59,7 @@ def choose_min_speed(log: Log, phantom: Phantom, structure: Structure, cutoff: f
     phi, tau0 = structure.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     y = samples.tau - tau0
     judged = moving[max(moving)]                                           # where every threshold fits
-    part = np.minimum((np.arange(len(y)) * FOLDS) // len(y), FOLDS - 1)
+    part = parts(len(y))
     scores = {speed: _held_out(phi, y, mask, judged, part, prior) for speed, mask in moving.items()}
     best = min(scores.values())
     chosen = min(speed for speed, score in scores.items() if score <= (1 + TIE) * best)
@@ -75,3 +77,48 @@ def _held_out(phi: np.ndarray, y: np.ndarray, mask: np.ndarray, judged: np.ndarr
         residual += (((y - phi @ beta) * test) ** 2).sum(axis=0)
         torque += ((y * test) ** 2).sum(axis=0)
     return float((residual / np.maximum(torque, 1e-300)).sum())
+
+
+def parts(n: int) -> np.ndarray:
+    """Each of ``n`` samples' part of the log (0..FOLDS-1): FOLDS contiguous parts, in time order."""
+    return np.minimum((np.arange(n) * FOLDS) // n, FOLDS - 1)
+
+
+def validate_gains(phi: np.ndarray, tau: np.ndarray, tau0: np.ndarray, moving: np.ndarray,
+                   prior: tuple[np.ndarray, np.ndarray] | None, free: tuple[int, ...]) -> tuple[float, float, int]:
+    """(the held-out weighted residual of the fit with every torque gain at 1; of the fit that
+    estimates the gains of the joints ``free`` (least_squares.solve_gains) on the other parts and
+    corrects the held-out part's torques by them; the number of parts on which the second is
+    below the first). The weighted residual is the module doc's (the sum over the joints of the
+    residual's mean square over the torque's), each part judged by the fit on the others.
+    ``phi`` (N, 3, P) zeroed outside ``moving`` (N, 3), ``tau`` and ``tau0`` (N, 3; N m) the
+    logged and the known torques, ``prior`` (beta_0, P) or None."""
+    part = parts(len(tau))
+    residual, torque = np.zeros((2, FOLDS, 3)), np.zeros((2, FOLDS, 3))
+    for k in range(FOLDS):
+        train, test = moving & (part != k)[:, None], moving & (part == k)[:, None]
+        for corrected in (0, 1):
+            if corrected:
+                solved = solve_gains(phi, tau, tau0, train, prior, free)
+                beta, gain = solved[0], solved[-1][0]
+            else:
+                beta, gain = least_squares(phi, tau - tau0, train, prior)[0], np.ones(3)
+            y = gain * tau - tau0                 # in joint 1's torque scale
+            residual[corrected, k] = (((y - phi @ beta) * test) ** 2).sum(axis=0)
+            torque[corrected, k] = ((y * test) ** 2).sum(axis=0)
+    each = (residual / np.maximum(torque, 1e-300)).sum(axis=-1)                  # (2, FOLDS)
+    total = (residual.sum(axis=1) / np.maximum(torque.sum(axis=1), 1e-300)).sum(axis=-1)
+    return float(total[0]), float(total[1]), int((each[1] < each[0]).sum())
+
+
+def choose_timing(samples: Samples, phi: np.ndarray, tau0: np.ndarray, delay: float,
+                  prior: tuple[np.ndarray, np.ndarray] | None) -> tuple[str, dict[str, float]]:
+    """(the torque timing chosen, each timing's held-out weighted residual: the module doc's) of
+    ``samples`` with the torques read at each timing's lag (timing.HOLD) and ``delay`` (s), on
+    ``phi`` (N, 3, P) zeroed outside ``samples.moving`` less ``tau0`` (N, 3; N m); ``prior``:
+    (beta_0, P) or None. "held" (a servo loop's commands) unless "sampled" leaves less than
+    (1 - TIE) times its residual."""
+    part, moving = parts(len(tau0)), samples.moving
+    scores = {name: _held_out(phi, samples.at(HOLD[name] / samples.rate - delay).tau - tau0, moving, moving, part,
+                              prior) for name in TIMINGS}
+    return ("sampled" if scores["sampled"] < (1 - TIE) * scores["held"] else "held"), scores
