@@ -20,7 +20,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # after the setting above
 
-from helpers import CONFIG, N_STATES, Six
+from helpers import CONFIG, N_STATES, Six, run_cli
 from phantom_pin import Phantom
 from phantom_pin.config.sampling import random_states
 
@@ -37,16 +37,10 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.fixture()
-def cli(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str, str]]:
-    """phantom-pin in this process: ``cli(*arguments)`` (each passed as str) runs the command
-    line's main() and gives (exit code, stdout, stderr)."""
-    from phantom_pin.cli import main
-
-    def run(*arguments: object) -> tuple[int, str, str]:
-        code = main([str(a) for a in arguments])
-        out, err = capsys.readouterr()
-        return code, out, err
-    return run
+def cli() -> Callable[..., tuple[int, str, str]]:
+    """phantom-pin in this process: ``cli(*arguments)`` gives (exit code, stdout, stderr)
+    (helpers.run_cli)."""
+    return run_cli
 
 
 @pytest.fixture()

@@ -8,6 +8,8 @@ import json
 import re
 import shutil
 import subprocess
+from contextlib import redirect_stderr, redirect_stdout
+from io import StringIO
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +27,18 @@ REPORT = CONFIG.report
 #: Its configuration folder and committed generated files.
 MODEL = config.MODELS["premium_1_5"]
 CONFIG_DIR, URDF_PATH, SRDF_PATH, MJCF_PATH, SCENE_PATH = MODEL.config, MODEL.urdf, MODEL.srdf, MODEL.mjcf, MODEL.scene
+
+
+def run_cli(*arguments: object) -> tuple[int, str, str]:
+    """phantom-pin in this process: the command line's main() on ``arguments`` (each passed as
+    str), and its (exit code, stdout, stderr). The one runner of the tests (conftest's ``cli``
+    fixture is this; a module fixture calls it directly)."""
+    from phantom_pin.cli import main
+
+    out, err = StringIO(), StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        code = main([str(a) for a in arguments])
+    return code, out.getvalue(), err.getvalue()
 
 
 def frame_pose(model: pin.Model, theta: np.ndarray, name: str) -> pin.SE3:

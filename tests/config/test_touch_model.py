@@ -7,8 +7,6 @@ import json
 import re
 import shlex
 import shutil
-from contextlib import redirect_stdout
-from io import StringIO
 
 import numpy as np
 import pytest
@@ -16,6 +14,7 @@ import yaml
 import yourdfpy
 
 from gimbal_reference import gimbal_gravity, gimbal_mass_matrix
+from helpers import run_cli
 from phantom_pin import (
     Device,
     MissingDataError,
@@ -193,9 +192,8 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     OpenHaptics' angles and mN m -> identify -> a --params overlay, judged on held-out torques."""
     estimate = config.read("touch")
     truth = dataclasses.replace(estimate.report, **{k: getattr(estimate.report, k) * f for k, f in FACTORS.items()})
-    with redirect_stdout(StringIO()):
-        assert main(["--model", "touch", "excite", "-o", str(tmp_path / "traj.csv"), "--duration", "10",
-                     "--iterations", "15", "--restarts", "1", "--convention", "openhaptics"]) == 0
+    assert run_cli("--model", "touch", "excite", "-o", tmp_path / "traj.csv", "--duration", "10",
+                   "--iterations", "15", "--restarts", "1", "--convention", "openhaptics")[0] == 0
     table = np.loadtxt(tmp_path / "traj.csv", delimiter=",", skiprows=1)
     t, theta, dtheta, tau = table[:, 0], *(drivers.theta_from_openhaptics(table[:, k:k + 3]) for k in (1, 4)), \
         drivers.tau_from_openhaptics_torque(table[:, 10:13])
@@ -211,9 +209,8 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     io.write_csv(tmp_path / "log.csv", io.LOG_COLUMNS,
                  np.column_stack([log.t, drivers.openhaptics_from_theta(log.theta),
                                   drivers.openhaptics_torque_from_tau(log.tau)]))
-    with redirect_stdout(StringIO()):
-        assert main(["--model", "touch", "identify", str(tmp_path / "log.csv"), "-o", str(tmp_path / "id.yaml"),
-                     "--convention", "openhaptics"]) == 0
+    assert run_cli("--model", "touch", "identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml",
+                   "--convention", "openhaptics")[0] == 0
     overlay = read_overrides(tmp_path / "id.yaml")
     assert not any("rotor" in key for key in overlay)           # the Touch has no public motor
     identified = Phantom(describe("touch", overrides=overlay))
@@ -283,20 +280,17 @@ def test_a_touch_trajectory_in_openhaptics_terms_is_tracked_and_identified(tmp_p
     against its torques), and --convention alone is refused."""
 
     traj, log_, overlay = tmp_path / "traj.csv", tmp_path / "log.csv", tmp_path / "id.yaml"
-    with redirect_stdout(StringIO()):
-        assert main(["--model", "touch", "excite", "-o", str(traj), "--duration", "5", "--iterations", "15",
-                     "--restarts", "1", "--convention", "openhaptics"]) == 0
-        assert main(["--model", "touch", "simulate", "--trajectory", str(traj), "--convention", "openhaptics",
-                     "--format", "csv", "-o", str(log_)]) == 0
-    printed = StringIO()
-    with redirect_stdout(printed):
-        assert main(["--model", "touch", "identify", str(log_), "-o", str(overlay)]) == 0
+    assert run_cli("--model", "touch", "excite", "-o", traj, "--duration", "5", "--iterations", "15",
+                   "--restarts", "1", "--convention", "openhaptics")[0] == 0
+    assert run_cli("--model", "touch", "simulate", "--trajectory", traj, "--convention", "openhaptics",
+                   "--format", "csv", "-o", log_)[0] == 0
+    code, printed, _ = run_cli("--model", "touch", "identify", log_, "-o", overlay)
+    assert code == 0
     # the command identify suggests, run as printed, writes the identified URDF (before, the hint
     # had no --model, and the overlay then applied to premium_1_5's lengths)
-    hint = re.search(r"\(phantom-pin (.*urdf --params .*)\)$", printed.getvalue(), re.MULTILINE).group(1)
+    hint = re.search(r"\(phantom-pin (.*urdf --params .*)\)$", printed, re.MULTILINE).group(1)
     assert hint.startswith("--model touch urdf")
-    with redirect_stdout(StringIO()):
-        assert main(shlex.split(hint.replace("my_phantom.urdf", str(tmp_path / "my_phantom.urdf")))) == 0
+    assert run_cli(*shlex.split(hint.replace("my_phantom.urdf", str(tmp_path / "my_phantom.urdf"))))[0] == 0
     written = (tmp_path / "my_phantom.urdf").read_text()
     assert written == describe("touch", overrides=read_overrides(overlay), robot_file="my_phantom.urdf").urdf
     estimate = describe("touch").config.report

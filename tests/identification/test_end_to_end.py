@@ -5,14 +5,12 @@ with friction, torque noise and encoder quantization, through excite -> log -> i
 
 import dataclasses
 import re
-from contextlib import redirect_stdout
-from io import StringIO
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from helpers import CONFIG, REPORT
+from helpers import CONFIG, REPORT, run_cli
 from phantom_pin import Device, Phantom, closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides
@@ -76,10 +74,9 @@ def identified(tmp_path_factory):
     np.testing.assert_array_equal(device.encoder_theta(counts), log.theta)
     io.write_log(folder / "log.csv", log.t, log.theta, log.tau)
     overlay = folder / "id.yaml"
-    printed = StringIO()
-    with redirect_stdout(printed):
-        assert main(["identify", str(folder / "log.csv"), "-o", str(overlay), "--structure", "report"]) == 0
-    (folder / "identify.txt").write_text(printed.getvalue())
+    code, printed, _ = run_cli("identify", folder / "log.csv", "-o", overlay, "--structure", "report")
+    assert code == 0
+    (folder / "identify.txt").write_text(printed)
     for kind in ("urdf", "srdf", "mjcf"):
         assert main([kind, "--params", str(overlay), "-o", str(folder / f"id.{kind}")]) == 0
     return folder

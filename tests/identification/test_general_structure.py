@@ -6,16 +6,13 @@ device itself on a held-out trajectory and on random states; then the logs a new
 (signs, units, ratios, degrees, unrelated torques, a slow log) must be refused."""
 
 import re
-from contextlib import redirect_stderr, redirect_stdout
-from io import StringIO
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from helpers import CONFIG
+from helpers import CONFIG, run_cli
 from phantom_pin import Device, Phantom, describe
-from phantom_pin.cli import main
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.identification import estimation, io, simulation
@@ -50,10 +47,7 @@ DEVICE = Device(Phantom(describe(overrides=device_overrides())))
 
 
 def cli(*arguments) -> tuple[int, str, str]:
-    out, err = StringIO(), StringIO()
-    with redirect_stdout(out), redirect_stderr(err):
-        code = main(["--quiet", *map(str, arguments)])
-    return code, out.getvalue(), err.getvalue()
+    return run_cli("--quiet", *arguments)
 
 
 def torques(device: Device, theta, dtheta, ddtheta) -> np.ndarray:
