@@ -4,10 +4,12 @@ prior, the estimated delay), judged on the WRITTEN model against the device.
 
     python benchmarks/identification_figures.py [--quick] [-o FILE [--force]]
 
-Measured on the shared 2-core machine (x86_64, Python 3.11): the full table (81 rows) in 12 min 48 s
-of wall time (11 min 15 s of CPU), before the two instrumental-variable conditions (12 rows more, not
-timed; the CAD's lab pair: 17 s); --quick (5 rows) in 13-24 s. Not run in CI: its --quick clean
-row is checked by tests/integration/test_identification_figures.py.
+Measured on the shared 2-core machine (x86_64, Python 3.11): the full table (105 rows) in 3 min 23 s
+of wall time; --quick (5 rows) in 13-24 s. One BLAS thread (OPENBLAS_NUM_THREADS=1, set here unless
+given, as the tests set it): OpenBLAS's threads change excite's trajectory in its last digits, and
+so the table (the Touch's excite row with a Stribeck peak: 0.58 % with one thread, 0.22 % with
+two), and took 3.8 times the time (12 min 48 s for 81 rows). Not run in CI: its --quick clean row
+is checked by tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
 - ``cad``: the Premium 1.5 built from independent CAD mass properties (``premium_1_5_cad``: full
@@ -63,7 +65,11 @@ within 10 %) is met. Progress goes to stderr.
 
 from __future__ import annotations
 
-import argparse
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before NumPy loads OpenBLAS (module doc)
+
+import argparse  # noqa: E402
 import dataclasses
 import sys
 import tempfile
