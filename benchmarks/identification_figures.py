@@ -2,14 +2,19 @@
 realistic sensing and identified by the shipped pipeline (estimate with its CLI defaults: the
 prior, the estimated delay), judged on the WRITTEN model against the device.
 
-    python benchmarks/identification_figures.py [--quick] [-o FILE [--force]]
+    python benchmarks/identification_figures.py [--quick] [--parts main touch rest bags] [-o FILE [--force]]
 
-Measured on the shared 2-core machine (x86_64, Python 3.11): the full table (105 rows) in 3 min 23 s
-of wall time; --quick (5 rows) in 13-24 s. One BLAS thread (OPENBLAS_NUM_THREADS=1, set here unless
-given, as the tests set it): OpenBLAS's threads change excite's trajectory in its last digits, and
-so the table (the Touch's excite row with a Stribeck peak: 0.58 % with one thread, 0.22 % with
-two), and took 3.8 times the time (12 min 48 s for 81 rows). Not run in CI: its --quick clean row
-is checked by tests/integration/test_identification_figures.py.
+Four tables, each selected by ``--parts`` (default all of them; --quick: main): ``main``, the
+conditions below; ``touch``, the issue's Touch case; ``rest``, gravity from rest postures; ``bags``,
+identify BAG against the same log's CSV (issue 39; each described at the end). Measured on the
+shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 23 s of wall time;
+--quick (5 rows) in 13-24 s; ``--parts touch`` in 7 s, ``--parts rest`` (3 setups x 4 seeds) in
+3 s, ``--parts bags`` in 13 s (the Touch's excite trajectory and log included). One BLAS thread
+(OPENBLAS_NUM_THREADS=1, set here unless given, as the tests set it): OpenBLAS's threads change
+excite's trajectory in its last digits, and so the table (the Touch's excite row with a Stribeck
+peak: 0.58 % with one thread, 0.22 % with two), and took 3.8 times the time (12 min 48 s for 81
+rows). Not run in CI: its --quick clean row and ``--parts rest`` on the CAD are checked by
+tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
 - ``cad``: the Premium 1.5 built from independent CAD mass properties (``premium_1_5_cad``: full
@@ -61,6 +66,36 @@ identify corrected it (the device's is 1.02 under the torque constant's error); 
 does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), result.timing_warning(),
 each listed under the table); and whether the issue's goal (held-out <= 0.5 %, written friction
 within 10 %) is met. Progress goes to stderr.
+
+The issue's Touch case (``touch``; tests/identification/test_selection.py): the shipped Touch but
+for viscous friction 7e-4 N m s/rad on joint 2 and Coulomb friction 0.02 N m on joint 3
+(TOUCH_CASE), through the command line with its defaults: ``phantom-pin --model touch excite``,
+``simulate --trajectory ... --set ...``, ``identify``; and ``identify --min-speed 0.01`` (the old
+default threshold) on the same log. Columns: the written model's held-out errors (as above,
+against the device), the two changed friction values written against the device's, the worst of
+the other four, the delay, joint 2's and 3's torque gains and whether they were corrected, the
+friction speed threshold (chosen or given), identify's verdict (its stderr) and the issue's goal:
+both friction values within 5 %, no torque-constant advice, the rigid body within 0.3 %.
+
+Rest postures (``rest``; identify --static, static.py; tests/identification/test_static.py): per
+setup (``--setups``) and seed (``--rest-seeds``, default 4), 12 seeded postures inside the stops
+(0.05 rad margin), their angles as the device's encoder reads them (the Touch's is not public:
+exact angles), the device's gravity torques with 1 % noise (relative, per entry), fitted on the
+setup's prior by static.estimate_gravity. Columns: what static says it determines (gravity
+directions, the fewest postures, the scale where fewer), its predicted uncertainty (1 sigma, worst
+joint), the written model's gravity error at 500 other seeded postures inside the stops (RMS per
+joint as a share of the device's, worst joint; joint 1 carries none), their ratio, the prior's
+error and the issue's goal: within 1 %.
+
+Bags (``bags``; bags.py, tests/identification/test_bags.py): for each driver profile that publishes
+efforts, the Touch setup's clean excite log (instantaneous torques, 60 s, 20 with --quick) taken
+at the driver's rate, written as a CSV in the report's convention and as a rosbag2 recording
+(sqlite3, rosbags' writer) in the profile's shape (its topic, joint names, signs and elbow, the
+stylus at the model's posture, OpenHaptics' mN m, header stamps at the log's times), and identified
+from each by the command line with ``--torque-timing sampled`` (and ``--cutoff`` rate / 25 below
+500 Hz; ``--driver`` where another profile publishes the same names on the same topic). Columns:
+both written models' held-out errors, their difference, the largest relative difference of the
+written friction, identify's verdicts.
 """
 
 from __future__ import annotations
@@ -71,6 +106,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before NumPy loads OpenBLA
 
 import argparse  # noqa: E402
 import dataclasses
+import re
 import sys
 import tempfile
 import time
@@ -81,16 +117,18 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import Device, Phantom, describe, drivers
+from phantom_pin import Device, Phantom, describe, drivers, profiles
 from phantom_pin.cli import main as cli
 from phantom_pin.config import Friction, read_overrides
-from phantom_pin.config.sampling import random_states
+from phantom_pin.config.sampling import random_states, sample_postures
 from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation
+from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation, static
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.filtering import MIN_SPEED
+from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.result import gain_warning, timing_warning
+from phantom_pin.identification.structures import General
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
 #: The report-structured devices: each report parameter (parameterization.SYMBOLS) times its
@@ -222,6 +260,8 @@ CONDITIONS = {
     "all_iv": Condition("all at once, the reference given (instrumental variables)", reference=True, **EVERYTHING),
 }
 QUICK = ("clean", "gain", "delay", "all")
+#: The tables the script makes (--parts).
+PARTS = ("main", "touch", "rest", "bags")
 
 
 def progress(text: str, start: float = time.perf_counter()) -> None:
@@ -504,6 +544,250 @@ def table(rows: list[Row], notes: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
+# -- the issue's Touch case: the shipped Touch but for two friction values, excite + simulate + identify ----------
+#: The issue's simulated Touch (tests/identification/test_selection.py): the shipped model but for viscous friction
+#: on joint 2 (N m s/rad) and Coulomb friction on joint 3 (N m, near joint 3's torque RMS).
+TOUCH_CASE = {"actuation.friction.viscous.joint2": 7e-4, "actuation.friction.coulomb.joint3": 0.02}
+#: The issue's goals for it: both friction values within 5 %, the rigid body within 0.3 % (held-out); for rest
+#: postures: gravity within 1 %.
+GOAL_CASE_FRICTION, GOAL_CASE_TORQUE, GOAL_GRAVITY = 0.05, 0.003, 0.01
+
+
+def quiet(argv: list[str]) -> tuple[int, str, str]:
+    """``phantom-pin ARGV`` in this process: (exit code, stdout, stderr)."""
+    printed, errors = StringIO(), StringIO()
+    with redirect_stdout(printed), redirect_stderr(errors):
+        code = cli([str(a) for a in argv])
+    return code, printed.getvalue(), errors.getvalue()
+
+
+def verdict(code: int, err: str) -> tuple[str, tuple[str, ...]]:
+    """identify's verdict from its exit code and stderr: accepted, warned or refused, and its messages."""
+    messages = tuple(line for line in err.strip().splitlines() if line.strip())
+    return ("refused" if code != 0 else "warned" if messages else "accepted"), messages
+
+
+def held_out_errors(model: Phantom, truth: Phantom, held_out: dict[str, tuple]) -> tuple[float, float]:
+    """The worst joint's held-out error on the trajectory and on the 500 states (shares)."""
+    return tuple(float(torque_error(model, truth, held_out[k]).max()) for k in ("trajectory", "states"))
+
+
+def printed(pattern: str, out: str) -> str:
+    """The first group of ``pattern`` in identify's printout (multiline), or "?"."""
+    found = re.search(pattern, out, re.MULTILINE)
+    return found.group(1) if found else "?"
+
+
+def touch_case(folder: Path) -> str:
+    """The issue's Touch case (TOUCH_CASE) through the command line with its defaults: phantom-pin --model touch
+    excite, simulate --trajectory --set ..., identify; and identify again at the old friction speed threshold
+    (--min-speed 0.01). The table (Markdown) and its messages."""
+    started = time.perf_counter()
+    sets = [a for key, value in TOUCH_CASE.items() for a in ("--set", f"{key}={value!r}")]
+    trajectory, log = folder / "touch_case_trajectory.csv", folder / "touch_case_log.csv"
+    progress("touch case: phantom-pin --model touch excite (its defaults)")
+    for argv in (["--model", "touch", "excite", "-o", trajectory, "--force"],
+                 ["--model", "touch", "simulate", "--trajectory", trajectory, *sets, "-o", log, "--force"]):
+        code, _, err = quiet(["-q", *argv])
+        if code != 0:
+            raise PhantomPinError(f"phantom-pin {' '.join(map(str, argv[2:4]))} failed: {err.strip()}")
+    device = describe("touch", overrides=TOUCH_CASE)
+    truth = device.config.actuation.friction
+    true = {"viscous": np.asarray(truth.viscous, float), "coulomb": np.asarray(truth.coulomb, float)}
+    prior = Phantom(describe("touch"))
+    held_out = {"trajectory": optimise(prior, iterations=5, restarts=1, seed=7).trajectory(np.arange(500) / 100.0),
+                "states": random_states(prior.config.limits, 500, 7)}
+    lines = ["| identify | held-out trajectory | 500 states | viscous joint 2 written (true) | Coulomb joint 3 "
+             "written (true) | other friction, worst | delay | gains 2, 3 | friction speed threshold | identify | "
+             "goal |", "|---|---:|---:|---:|---:|---:|---:|---|---|---|---|"]
+    messages: dict[str, int] = {}
+    for label, options in (("the defaults", []), ("--min-speed 0.01 (the old default)", ["--min-speed", "0.01"])):
+        progress(f"touch case: identify, {label}")
+        output = folder / "touch_case.yaml"
+        code, out, err = quiet(["-q", "--model", "touch", "identify", log, "-o", output, "--force", *options])
+        said, notes = verdict(code, err)
+        marks = "".join(f" [{messages.setdefault(m, len(messages) + 1)}]" for m in notes)
+        if code != 0:
+            lines.append(f"| {label} | | | | | | | | | {said}{marks} | refused |")
+            continue
+        overlay = read_overrides(output)
+        trajectory_error, states_error = held_out_errors(Phantom(describe("touch", overrides=overlay)),
+                                                         Phantom(device), held_out)
+        off = {(kind, j): overlay[f"actuation.friction.{kind}.joint{j + 1}"] / true[kind][j] - 1
+               for kind in ("viscous", "coulomb") for j in range(3)}
+        viscous, coulomb = off.pop(("viscous", 1)), off.pop(("coulomb", 2))
+        other = max(off, key=lambda k: abs(off[k]))
+        gains = re.findall(r"joint(\d) ([\d.]+) \+- (\S+) \(([^)]*)\)", printed(r"^torque gains relative[^:]*: (.*)$",
+                                                                                   out))
+        gain = ", ".join(f"{value} ± {sigma}" for _, value, sigma, _ in gains) + (
+            " (corrected)" if any("corrected" in state for *_, state in gains) else " (kept at 1)")
+        advice = "corrected in the written model" in out or "torque constant" in err
+        delay = printed(r"^delay between positions and torques: (\S+ ms)", out)
+        threshold = printed(r"^friction speed threshold: (.*)$", out)
+        threshold = f"{threshold.split(',')[0].split(' (')[0]} ({'chosen' if 'chosen' in threshold else 'given'})"
+        met = (max(abs(viscous), abs(coulomb)) <= GOAL_CASE_FRICTION and max(trajectory_error, states_error)
+               <= GOAL_CASE_TORQUE and not advice)
+        lines.append(
+            f"| {label} | {100 * trajectory_error:.3f} % | {100 * states_error:.3f} % | "
+            f"{100 * viscous:+.2f} % ({true['viscous'][1]:.2g}) | {100 * coulomb:+.2f} % ({true['coulomb'][2]:.2g}) | "
+            f"{100 * off[other]:+.2f} % ({other[0]} {other[1] + 1}) | "
+            f"{delay} | {gain} | {threshold} | {said}{marks}"
+            + (" (torque-constant advice)" if advice else "") + f" | {'yes' if met else 'no'} |")
+    lines += [""] + [f"[{k}] {m}" for m, k in messages.items()] if messages else []
+    lines += ["", f"- the Touch case in {time.perf_counter() - started:.0f} s (excite, simulate and two identify runs)"]
+    return "\n".join(lines) + "\n"
+
+
+# -- rest postures: gravity from 12 held postures (identify --static) ----------------------------------------------
+#: Rest postures per set, the torque noise (share, 1 sigma) and the check postures' number and seed.
+POSTURES, REST_NOISE, CHECKS, CHECK_SEED = 12, 0.01, 500, 7
+
+
+def rest_rows(setup: Setup, seeds: int) -> list[str]:
+    """Per seed: POSTURES seeded postures inside the stops (0.05 rad margin), their angles as the
+    device's encoder reads them (where public), the device's gravity torques with REST_NOISE, fitted
+    by static.estimate_gravity on the setup's prior; the written model's gravity against the
+    device's at CHECKS other postures. One Markdown row each."""
+    truth, prior = Phantom(setup.truth), setup.prior
+    device = Device(truth)
+    quantized = setup.truth.config.actuation.encoder is not None
+    checks = sample_postures(prior.config.limits, CHECKS, np.random.default_rng(CHECK_SEED))
+    true = truth.gravity(checks)
+    size = np.sqrt((true**2).mean(axis=0))
+    acting = size > 1e-9 * size.max()                  # joint 1's axis is vertical: no gravity
+
+    def error(model: Phantom) -> tuple[float, int]:
+        share = np.sqrt(((model.gravity(checks) - true)[:, acting] ** 2).mean(axis=0)) / size[acting]
+        return float(share.max()), int(np.flatnonzero(acting)[np.argmax(share)]) + 1
+
+    prior_error, prior_joint = error(prior)
+    rows = []
+    for seed in range(seeds):
+        rng = np.random.default_rng(seed)
+        theta = sample_postures(prior.config.limits, POSTURES, rng, margin=0.05)
+        tau = truth.gravity(theta)
+        tau = tau * (1 + REST_NOISE * rng.standard_normal(tau.shape))
+        read = device.encoder_theta(device.encoder_counts(theta)) if quantized else theta
+        result = static.estimate_gravity(static.Rest(read, tau), prior)
+        keys = identified_keys(General(prior).overrides(result.x), None, prior.config, None)
+        worst_error, joint = error(Phantom(describe(prior.config.folder, overrides=keys)))
+        predicted = np.nanmax(result.predicted)
+        says = (f"{result.determined} of {result.directions} directions, fewest {len(result.fewest)} postures"
+                + ("" if result.scale is None else f", a scale {result.scale:.4g}"))
+        rows.append(f"| {setup.label} | {seed} | {'yes' if quantized else 'n/a (not public)'} | {says} | "
+                    f"{100 * predicted:.2g} % | {100 * worst_error:.3f} % (joint {joint}) | "
+                    f"{worst_error / predicted:.1f} | {100 * prior_error:.1f} % (joint {prior_joint}) | "
+                    f"{'yes' if worst_error <= GOAL_GRAVITY else 'no'} |")
+    return rows
+
+
+def rest_table(names: list[str], seeds: int) -> str:
+    started = time.perf_counter()
+    lines = ["| setup | seed | encoder quantization | static says it determines | predicted (1 sigma, worst joint) "
+             f"| gravity error at {CHECKS} postures (worst joint) | error / predicted | the prior's | goal |",
+             "|---|---:|---|---|---:|---:|---:|---:|---|"]
+    for name in names:
+        progress(f"{name}: rest postures ({seeds} seeds)")
+        lines += rest_rows(setups()[name](), seeds)
+    lines += ["", f"- {POSTURES} postures, {100 * REST_NOISE:g} % torque noise; {len(lines) - 2} rows in "
+              f"{time.perf_counter() - started:.0f} s"]
+    return "\n".join(lines) + "\n"
+
+
+# -- bags: the same log as each effort-publishing driver's bag, identify BAG against identify CSV ------------------
+#: A recent wall clock's epoch (s) for the bags' header stamps, and the recorder's latency (ns).
+EPOCH, LATENCY = 1_764_200_000, 300_000
+
+
+def write_bag(path: Path, profile: profiles.Profile, log: io.Log, gimbal: np.ndarray) -> Path:
+    """``log`` as ``profile``'s driver publishes it, recorded in a rosbag2 folder (sqlite3, rosbags' writer):
+    sensor_msgs/JointState on its topic, its six joint names, its arm and gimbal angles (the stylus held at
+    ``gimbal``, OpenHaptics' raw angles), efforts OpenHaptics' joint torques in mN m (the gimbal's 0), stamped
+    at the log's times, received LATENCY later."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    types = get_typestore(Stores.ROS2_HUMBLE)
+    state, header, stamp_type = (types.types[name] for name in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header",
+                                                                 "builtin_interfaces/msg/Time"))
+    spec = profile.joint_states
+    efforts = drivers.openhaptics_torque_from_tau(log.tau)
+    held = profile.state_from_gimbal(gimbal)
+    with Writer(path, version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        connection = writer.add_connection(spec.topic, state.__msgtype__, typestore=types)
+        for t, theta, effort in zip(log.t, log.theta, efforts):
+            stamp = EPOCH * 10**9 + int(round(t * 1e9))
+            message = state(header=header(stamp=stamp_type(sec=stamp // 10**9, nanosec=stamp % 10**9), frame_id=""),
+                            name=list(spec.names), position=np.concatenate([profile.state_from_arm(theta), held]),
+                            velocity=np.array([], float), effort=np.concatenate([effort, np.zeros(3)]))
+            writer.write(connection, stamp + LATENCY, types.serialize_cdr(message, state.__msgtype__))
+    return path
+
+
+#: The cutoff (Hz) identify needs at a rate (Hz): 20 samples per second per hertz (docs/identification.md).
+def cutoff(rate: float) -> float:
+    return min(20.0, rate / 25.0)
+
+
+def bag_table(figures: Figures, duration: float, folder: Path) -> str:
+    """For each driver profile that publishes efforts: the Touch setup's clean excite log (instantaneous
+    torques) at the driver's rate, identified with the command line from a CSV (the report's convention) and
+    from the driver's bag (identify BAG), both with --torque-timing sampled (and --cutoff for the rate); the
+    written models' held-out errors and their difference."""
+    started = time.perf_counter()
+    setup = figures.setup
+    base = instantaneous(figures.log("excite", CONDITIONS["clean"], duration))
+    base = truncated(base, duration)
+    lines = ["| driver (topic) | rate | messages | CSV: held-out trajectory / 500 states | bag: held-out "
+             "trajectory / 500 states | bag - CSV (trajectory / states) | friction written, largest difference | "
+             "identify (CSV, bag) |",
+             "|---|---:|---:|---:|---:|---:|---:|---|"]
+    messages: dict[str, int] = {}
+    for name in (n for n in profiles.names() if profiles.load(n).joint_states.effort_unit is not None):
+        profile = profiles.load(name)
+        step = int(round(RATE / profile.joint_states.rate))
+        log = io.Log(base.t[::step], base.theta[::step], base.tau[::step])
+        options = ["--torque-timing", "sampled", "--structure", setup.structure, "--cutoff", f"{cutoff(log.rate):g}"]
+        spec = profile.joint_states
+        shared = [other for other in profiles.names() if other != name and (profiles.load(other).joint_states.names,
+                                                                             profiles.load(other).joint_states.topic)
+                  == (spec.names, spec.topic)]       # bags.read_bag cannot tell them apart: named with --driver
+        named = ["--driver", name] if shared else []
+        csv, bag = folder / f"{name}.csv", folder / f"{name}_bag"
+        io.write_log(csv, log.t, log.theta, log.tau)
+        progress(f"bags: {name}: writing {len(log.t)} messages at {log.rate:g} Hz")
+        write_bag(bag, profile, log, np.asarray(setup.truth.config.gimbal.locked_at, float))
+        results, verdicts = [], []
+        for source in (csv, bag):
+            progress(f"bags: {name}: identify {source.name}")
+            output = folder / f"{source.name}.yaml"
+            code, out, err = quiet(["-q", "--model", setup.prior.config.name, "identify", source, "-o", output,
+                                    "--force", *options, *(named if source == bag else [])])
+            said, notes = verdict(code, err)
+            verdicts.append(said + "".join(f" [{messages.setdefault(m, len(messages) + 1)}]" for m in notes))
+            overlay = read_overrides(output) if code == 0 else None
+            results.append(overlay)
+        label = f"{name} ({spec.topic}" + (f"; --driver given: {', '.join(shared)} shares its names and topic"
+                                            if shared else "") + ")"
+        if any(r is None for r in results):
+            lines.append(f"| {label} | {log.rate:g} Hz | {len(log.t)} | | | | | "
+                         f"{', '.join(verdicts)} |")
+            continue
+        errors = [held_out_errors(Phantom(describe(setup.prior.config.name, overrides=r)), figures.truth,
+                                  figures.held_out) for r in results]
+        friction = max(abs(results[1][k] - results[0][k]) / max(abs(results[0][k]), 1e-300)
+                       for k in results[0] if "friction" in k)
+        lines.append(f"| {label} | {log.rate:g} Hz | {len(log.t)} | "
+                     f"{100 * errors[0][0]:.4f} / {100 * errors[0][1]:.4f} % | "
+                     f"{100 * errors[1][0]:.4f} / {100 * errors[1][1]:.4f} % | "
+                     f"{100 * (errors[1][0] - errors[0][0]):+.1e} / {100 * (errors[1][1] - errors[0][1]):+.1e} % | "
+                     f"{friction:.1e} | {', '.join(verdicts)} |")
+    lines += [""] + [f"[{k}] {m}" for m, k in messages.items()] if messages else []
+    lines += ["", f"- {setup.label}, excite's trajectory, clean ({duration:g} s, instantaneous torques), taken at "
+              f"each driver's rate; {time.perf_counter() - started:.0f} s"]
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
@@ -514,13 +798,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--conditions", nargs="+", choices=tuple(CONDITIONS), default=None)
     parser.add_argument("--iterations", type=int, default=60, help="excite's SLSQP iterations per start (default 60)")
     parser.add_argument("--restarts", type=int, default=2, help="excite's starts (default 2)")
+    parser.add_argument("--parts", nargs="+", choices=PARTS, default=None,
+                        help="the tables to make: main (the conditions above), touch (the issue's Touch case), rest "
+                             "(gravity from rest postures), bags (identify BAG against its CSV); default all, "
+                             "--quick: main")
+    parser.add_argument("--rest-seeds", type=int, default=4, help="rest postures: seeded sets per setup (default 4)")
     parser.add_argument("--output", "-o", type=Path, help="also write the table to this file")
     parser.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     args = parser.parse_args(argv)
     if args.output is not None and args.output.exists() and not args.force:
         parser.error(f"--output: {args.output} exists; use --force to overwrite it")
-    if args.iterations < 1 or args.restarts < 1:
-        parser.error("--iterations, --restarts: expected integers of at least 1")
+    if args.iterations < 1 or args.restarts < 1 or args.rest_seeds < 1:
+        parser.error("--iterations, --restarts, --rest-seeds: expected integers of at least 1")
+    parts = args.parts or (["main"] if args.quick else list(PARTS))
     names = args.setups or (["cad"] if args.quick else list(setups()))
     kinds = tuple(args.trajectories or (["excite"] if args.quick else ["excite", "lab"]))
     conditions = tuple(args.conditions or (QUICK if args.quick else CONDITIONS))
@@ -528,15 +818,28 @@ def main(argv: list[str] | None = None) -> int:
     chosen = {name: dataclasses.replace(CONDITIONS[name], duration=SHORT) if args.quick else CONDITIONS[name]
               for name in conditions}          # the quick mode's logs are SHORT s long
     started = time.perf_counter()
-    rows, notes = [], []
+    rows, notes, tables = [], [], []
+    built: dict[str, Figures] = {}
     with tempfile.TemporaryDirectory() as folder:
-        for name in names:
-            progress(f"{name}: building the device and the held-out sets")
-            figures = Figures(setups()[name](), iterations, restarts)
-            rows += rows_of(figures, kinds, chosen, Path(folder), notes)
-    notes.append(f"{len(rows)} rows in {time.perf_counter() - started:.0f} s"
-                 + (" (--quick: logs of 20 s)" if args.quick else ""))
-    text = table(rows, notes)
+        def figures_of(name: str) -> Figures:
+            if name not in built:
+                progress(f"{name}: building the device and the held-out sets")
+                built[name] = Figures(setups()[name](), iterations, restarts)
+            return built[name]
+
+        if "main" in parts:
+            for name in names:
+                rows += rows_of(figures_of(name), kinds, chosen, Path(folder), notes)
+            notes.append(f"{len(rows)} rows in {time.perf_counter() - started:.0f} s"
+                         + (" (--quick: logs of 20 s)" if args.quick else ""))
+            tables.append(table(rows, notes))
+        if "touch" in parts:
+            tables.append(touch_case(Path(folder)))
+        if "rest" in parts:
+            tables.append(rest_table(names, args.rest_seeds))
+        if "bags" in parts:
+            tables.append(bag_table(figures_of("touch"), SHORT if args.quick else NOMINAL, Path(folder)))
+    text = "\n".join(tables)
     print(text, end="")
     if args.output is not None:
         args.output.write_text(text, encoding="utf-8")

@@ -159,7 +159,7 @@ def _recording(messages: list, profile: profiles.Profile, topic: str) -> Recordi
         efforts.append(np.asarray(message.effort, dtype=float)[index])
     ns, q, e = np.array(stamps, dtype=np.int64), np.array(positions), np.array(efforts)
     order = np.argsort(ns, kind="stable")
-    t = 1e-9 * (ns - ns.min())          # s from the first stamp
+    t = (ns - ns.min()) / 1e9           # s from the first stamp (divided: 1e-9 is inexact, 1e9 is not)
     reordered = bool((order != np.arange(len(t))).any())
     t, q, e = t[order], q[order], e[order]
     same = np.flatnonzero(np.diff(t) == 0)
