@@ -7,13 +7,14 @@ prior, the estimated delay), judged on the WRITTEN model against the device.
 Four tables, each selected by ``--parts`` (default all of them; --quick: main): ``main``, the
 conditions below; ``touch``, the issue's Touch case; ``rest``, gravity from rest postures; ``bags``,
 identify BAG against the same log's CSV (issue 39; each described at the end). Measured on the
-shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 23 s of wall time;
+shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 35 s of wall time;
 --quick (5 rows) in 13-24 s; ``--parts touch`` in 7 s, ``--parts rest`` (3 setups x 4 seeds) in
 3 s, ``--parts bags`` in 13 s (the Touch's excite trajectory and log included). One BLAS thread
 (OPENBLAS_NUM_THREADS=1, set here unless given, as the tests set it): OpenBLAS's threads change
-excite's trajectory in its last digits, and so the table (the Touch's excite row with a Stribeck
-peak: 0.58 % with one thread, 0.22 % with two), and took 3.8 times the time (12 min 48 s for 81
-rows). Not run in CI: its --quick clean row and ``--parts rest`` on the CAD are checked by
+excite's trajectory in its last digits, and so the table (at --min-speed 0.01, the Touch's excite
+row with a Stribeck peak: 0.58 % with one thread, 0.22 % with two), and took 3.8 times the time
+(12 min 48 s for 81 rows). A row that names neither the torque timing nor --min-speed runs
+identify's defaults: both chosen from the log. Not run in CI: its --quick clean row and ``--parts rest`` on the CAD are checked by
 tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
@@ -125,7 +126,6 @@ from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation, static
 from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.filtering import MIN_SPEED
 from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.result import gain_warning, timing_warning
 from phantom_pin.identification.structures import General
@@ -216,7 +216,8 @@ class Condition:
     """How the device is run and identified: the device's ``quantization``, ``noise`` (10 mA),
     ``gain`` (joint 2's torque constant 2 % high), ``friction`` (per joint, Stribeck); the log's
     ``duration`` (s), ``sampled`` (instantaneous torques, else the held commands), ``delay``
-    (samples late); identify's ``timing`` and ``min_speed`` (rad/s, --min-speed); ``reference``:
+    (samples late); identify's ``timing`` and ``min_speed`` (rad/s, --min-speed; None: chosen from the
+    log on held-out quarters, identify's defaults); ``reference``:
     identify is given the motion the loop tracked (instrumental variables, instruments.py)."""
 
     name: str
@@ -227,8 +228,8 @@ class Condition:
     duration: float = NOMINAL
     sampled: bool = True
     delay: int = 0
-    timing: str = "sampled"
-    min_speed: float = MIN_SPEED
+    timing: str | None = "sampled"
+    min_speed: float | None = None
     reference: bool = False
 
     @property
@@ -237,9 +238,9 @@ class Condition:
         return self.quantization, self.noise, self.gain, self.friction
 
 
-EVERYTHING = dict(quantization=True, noise=True, gain=True, friction=True, delay=1, timing="held")
+EVERYTHING = dict(quantization=True, noise=True, gain=True, friction=True, delay=1, timing=None)
 CONDITIONS = {
-    "servo": Condition("servo log: held commands, identify's defaults", sampled=False, timing="held"),
+    "servo": Condition("servo log: held commands, identify's defaults", sampled=False, timing=None),
     "clean": Condition("clean, instantaneous torques, --torque-timing sampled"),
     "quantization": Condition("encoder quantization", quantization=True),
     "noise": Condition("10 mA current noise", noise=True),
