@@ -14,8 +14,8 @@ shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 
 excite's trajectory in its last digits, and so the table (at --min-speed 0.01, the Touch's excite
 row with a Stribeck peak: 0.58 % with one thread, 0.22 % with two), and took 3.8 times the time
 (12 min 48 s for 81 rows). A row that names neither the torque timing nor --min-speed runs
-identify's defaults: both chosen from the log. Not run in CI: its --quick clean row and ``--parts rest`` on the CAD are checked by
-tests/integration/test_identification_figures.py.
+identify's defaults: both chosen from the log. Not run in CI: its --quick clean row and
+``--parts rest`` on the CAD are checked by tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
 - ``cad``: the Premium 1.5 built from independent CAD mass properties (``premium_1_5_cad``: full
