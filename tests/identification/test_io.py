@@ -1,0 +1,41 @@
+"""identification.io's CSV reading: every dialect it takes gives the numbers Python's float()
+reads from the text, bit for bit, whichever way it parses them (NumPy at once, or line by line
+where a value is quoted); a bad line is named."""
+
+import numpy as np
+import pytest
+
+from phantom_pin.exceptions import LogError
+from phantom_pin.identification import io
+
+HEADER = "t,theta1,theta2,theta3,tau1,tau2,tau3"
+
+
+def _table(rng: np.random.Generator) -> np.ndarray:
+    return np.column_stack([np.arange(3000) / 1000, rng.normal(0, 0.5, (3000, 3)), rng.normal(0, 0.1, (3000, 3))])
+
+
+@pytest.mark.parametrize("dialect", ["plain", "spaces", "semicolons", "quoted"])
+def test_every_dialect_reads_the_numbers_pythons_float_reads(tmp_path, dialect):
+    table = _table(np.random.default_rng(3))
+    texts = [[f"{v:.17g}" for v in row] for row in table]
+    separator = ";" if dialect == "semicolons" else ","
+    if dialect == "spaces":
+        texts = [[f" {v} " for v in row] for row in texts]
+    if dialect == "quoted":
+        texts = [[f'"{v}"' for v in row] for row in texts]
+    path = tmp_path / "log.csv"
+    path.write_text("\n".join([HEADER.replace(",", separator)] + [separator.join(row) for row in texts]) + "\n")
+    log = io.read_log(path)
+    expected = np.array([[float(v.strip().strip('"')) for v in row] for row in texts])
+    assert np.array_equal(np.column_stack([log.t, log.theta, log.tau]), expected)
+
+
+@pytest.mark.parametrize("bad, message", [("1,2", "line 4 has 2 values, the header 7"),
+                                          ("0.002,0,0,0,0,0,x", "line 4 holds a value that is not a number"),
+                                          ("0.002,0,0,0,0,,0", "line 4 holds a value that is not a number")])
+def test_a_bad_line_is_named(tmp_path, bad, message):
+    path = tmp_path / "log.csv"
+    path.write_text(f"{HEADER}\n0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0\n{bad}\n0.003,0,0,0,0,0,0\n")
+    with pytest.raises(LogError, match=message):
+        io.read_log(path)
