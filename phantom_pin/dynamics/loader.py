@@ -11,9 +11,10 @@ from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config import DEFAULT, MODELS, Config
 from phantom_pin.description.build import Description, shipped
 from phantom_pin.description.physical import check_urdf
+from phantom_pin.dynamics._refusals import shown
 from phantom_pin.dynamics.build import build_model, has_rotors, load_rotor_parameters
 from phantom_pin.dynamics.build import gravity_of as gravity_of  # (where it lived before)
-from phantom_pin.dynamics.model import Phantom, shown
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 
 
