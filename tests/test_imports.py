@@ -1,5 +1,6 @@
-"""The package's import graph: no cycle between its modules, counting function-local imports
-(which would only hide one), and every module imports in a fresh interpreter, leaves first.
+"""The package's shape: no import cycle between its modules, counting function-local imports
+(which would only hide one), every module imports in a fresh interpreter, leaves first, and
+every module and function stays a size a reader can follow.
 
 The graph is read from the source (ast), one edge per ``import phantom_pin.x`` or ``from
 phantom_pin.x import y`` (to phantom_pin.x.y where y is a module), wherever it stands in the
@@ -98,3 +99,19 @@ def test_every_module_imports_in_a_fresh_interpreter_leaves_first():
     script = f"import importlib\nfor name in {order!r}:\n    importlib.import_module(name)\n"
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
+
+
+#: The sizes a reader can follow (issue 40's aim): lines of a module, lines of a function or method.
+MODULE_LINES, FUNCTION_LINES = 500, 80
+
+
+def test_every_module_and_function_stays_readable():
+    """No module over MODULE_LINES lines, no function or method over FUNCTION_LINES (its def to
+    its last line, docstring included), read from the source with ast."""
+    lines = {name: len(path.read_text().splitlines()) for name, path in MODULES.items()}
+    long_modules = {name: n for name, n in lines.items() if n > MODULE_LINES}
+    long_functions = {f"{name}.{node.name}": node.end_lineno - node.lineno + 1
+                      for name, path in MODULES.items() for node in ast.walk(ast.parse(path.read_text()))
+                      if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+                      and node.end_lineno - node.lineno + 1 > FUNCTION_LINES}
+    assert not long_modules and not long_functions, (long_modules, long_functions)
