@@ -120,7 +120,7 @@ def _reference(path: Path | None, model: str) -> tuple[np.ndarray, np.ndarray] |
     try:
         t, theta = io.read_trajectory(path)[:2]
     except PhantomPinError as error:
-        raise PhantomPinError(str(error), argument="--reference") from None
+        raise PhantomPinError(error.detail, argument="--reference") from None
     return t, theta
 
 
