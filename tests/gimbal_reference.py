@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from touch_reference import GIMBAL_REFERENCE
+import touch_reference
 
 L1 = L2 = 0.13335   # m, Ubitrack's PhantomForwardKinematics.xml "defaults to Phantom Omni: 133.35mm"
 G = 9.80665         # m/s^2, standard gravity (config/touch's)
@@ -69,8 +69,8 @@ def gimbal_potential(theta: np.ndarray, gimbal: np.ndarray) -> complex:
     gimbal centre) + g (R h)_y, h each link's first moment about the centre (y is up)."""
     position, _ = ubitrack(openhaptics(theta, gimbal))
     energy = 0j
-    for name, rotation in zip(GIMBAL_REFERENCE, link_rotations(theta, gimbal)):
-        reference = GIMBAL_REFERENCE[name]
+    for name, rotation in zip(touch_reference.GIMBAL_REFERENCE, link_rotations(theta, gimbal)):
+        reference = touch_reference.GIMBAL_REFERENCE[name]
         energy += G * (reference["mass"] * position[1] + (rotation @ np.array(reference["first"]))[1])
     return energy
 
@@ -92,8 +92,8 @@ def gimbal_mass_matrix(theta: np.ndarray, gimbal: np.ndarray) -> np.ndarray:
         derivatives.append((ubitrack(openhaptics(shifted, gimbal))[0].imag / H,
                             [r.imag / H for r in link_rotations(shifted, gimbal)]))
     total = np.zeros((3, 3))
-    for index, name in enumerate(GIMBAL_REFERENCE):
-        ref = GIMBAL_REFERENCE[name]
+    for index, name in enumerate(touch_reference.GIMBAL_REFERENCE):
+        ref = touch_reference.GIMBAL_REFERENCE[name]
         mass, first, second = ref["mass"], np.array(ref["first"]), ref["second"]
         about_centre = np.diag([second["xx"], second["yy"], second["zz"]])  # products vanish
         rotation = rotations[index]

@@ -20,6 +20,8 @@ with l1 = l2 = 0.13335 m (Ubitrack), l3 = 0.020 m, density 2700 kg/m^3.
 
 from __future__ import annotations
 
+import functools
+
 import sympy as sp
 
 RHO = sp.Rational(2700)
@@ -90,14 +92,18 @@ def _reference() -> dict[str, dict]:
     }
 
 
-REFERENCE = {segment: {key: (None if value is None else
-                             {k: float(x) for k, x in value.items()} if isinstance(value, dict) else float(value))
-                       for key, value in entry.items()}
-             for segment, entry in _reference().items()}
+@functools.cache
+def reference() -> dict[str, dict]:
+    """The segments' mass properties as floats (computed on first use: SymPy takes a second,
+    which every pytest worker paid at collection when this was a module constant)."""
+    return {segment: {key: (None if value is None else
+                            {k: float(x) for k, x in value.items()} if isinstance(value, dict) else float(value))
+                      for key, value in entry.items()}
+            for segment, entry in _reference().items()}
 
 
 if __name__ == "__main__":
-    for segment, entry in REFERENCE.items():
+    for segment, entry in reference().items():
         print(segment, entry)
 
 
@@ -124,6 +130,18 @@ def _gimbal() -> dict[str, tuple]:
             for name, (mass, first, second) in bodies.items()}
 
 
-GIMBAL_REFERENCE = {name: {"mass": float(mass), "first": [float(f) for f in first],
-                           "second": {k: float(v) for k, v in second.items()}}
-                    for name, (mass, first, second) in _gimbal().items()}
+@functools.cache
+def gimbal_reference() -> dict[str, dict]:
+    """GIMBAL_REFERENCE as floats, computed on first use (as reference())."""
+    return {name: {"mass": float(mass), "first": [float(f) for f in first],
+                   "second": {k: float(v) for k, v in second.items()}}
+            for name, (mass, first, second) in _gimbal().items()}
+
+
+def __getattr__(name: str) -> dict:
+    """REFERENCE and GIMBAL_REFERENCE, computed when first read."""
+    if name == "REFERENCE":
+        return reference()
+    if name == "GIMBAL_REFERENCE":
+        return gimbal_reference()
+    raise AttributeError(name)

@@ -13,6 +13,7 @@ import pytest
 import yaml
 import yourdfpy
 
+import touch_reference
 from gimbal_reference import gimbal_gravity, gimbal_mass_matrix
 from helpers import run_cli
 from phantom_pin import (
@@ -31,7 +32,6 @@ from phantom_pin.config import MODELS, read_overrides
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.identification import io, simulation
 from phantom_pin.identification import parameterization as pz
-from touch_reference import REFERENCE
 
 #: config/touch/gimbal.yaml's locked_at: the gimbal angles (rad) the arm's dynamics hold it at
 LOCKED = np.array(yaml.safe_load((MODELS["touch"].config / "gimbal.yaml").read_text())["locked_at"], float)
@@ -63,13 +63,13 @@ def test_estimated_segments_are_the_stated_geometry_to_four_digits():
     rounded to four significant digits, exactly."""
     physical = _yaml("physical_parameters.yaml")
     for segment in ("segment_a", "segment_c", "segment_be", "segment_df"):
-        reference = REFERENCE[segment]
+        reference = touch_reference.REFERENCE[segment]
         assert physical[segment]["mass"] == four_digits(reference["mass"]), segment
         for axis in ("xx", "yy", "zz"):
             assert physical[segment]["inertia"][axis] == four_digits(reference["inertia"][axis]), (segment, axis)
         if reference["com"] is not None:
             assert physical[segment]["com"] == four_digits(reference["com"]), segment
-    turret = REFERENCE["segment_g"]
+    turret = touch_reference.REFERENCE["segment_g"]
     assert physical["segment_g"]["mass"] == four_digits(turret["mass"])
     for key, axis in (("inertia_yy", "yy"), ("inertia_xx", "xx"), ("inertia_zz", "zz")):
         assert physical["segment_g"][key] == four_digits(turret["inertia"][axis])

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import yaml
 
+import touch_reference
 from gimbal_reference import H, gimbal_gravity, gimbal_mass_matrix, openhaptics, step, ubitrack
 from helpers import CONFIG_DIR
 from phantom_pin import InvalidInputError, ParameterFileError, Phantom, config, drivers
 from phantom_pin.report import closed_form
-from touch_reference import GIMBAL_REFERENCE
 
 TOUCH = CONFIG_DIR.parent / "touch"
 GIMBAL_YAML = yaml.safe_load((TOUCH / "gimbal.yaml").read_text())
@@ -50,7 +50,7 @@ def test_the_gimbal_links_are_the_integrals_of_their_stated_solids():
     integrals of gimbal.yaml's solids, to 1e-12 relative."""
     links = config.read("touch").gimbal.links
     axes = {"xx": "zz", "yy": "xx", "zz": "yy"}  # link axis -> report axis
-    for name, reference in GIMBAL_REFERENCE.items():
+    for name, reference in touch_reference.GIMBAL_REFERENCE.items():
         link, mass = links[name], reference["mass"]
         assert link.mass == pytest.approx(mass, rel=1e-12)
         com = np.array(reference["first"]) / mass  # report axes
