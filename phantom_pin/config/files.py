@@ -36,9 +36,10 @@ OPTIONAL = ("gimbal_file",)
 PER_JOINT = {"actuation_file": (("friction", "viscous"), ("friction", "coulomb"))}
 
 
-class _Loader(yaml.SafeLoader):
-    """PyYAML's safe loader, which also reads 1e-6 and 1.0e6 as numbers, and refuses a key
-    given twice in one mapping (PyYAML silently keeps the last; YAML 1.2 forbids it).
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # type: ignore[misc]
+    """PyYAML's safe loader (libyaml's parser where PyYAML has it: the same documents, a tenth of
+    the parsing time), which also reads 1e-6 and 1.0e6 as numbers, and refuses a key given
+    twice in one mapping (PyYAML silently keeps the last; YAML 1.2 forbids it).
 
     PyYAML follows YAML 1.1, whose floats need a dot and a signed exponent: it reads
     ``1e-6`` and ``1.0e6`` as strings (``1.0e-6`` and ``1.0e+6`` as numbers). YAML 1.2
