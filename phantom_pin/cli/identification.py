@@ -111,17 +111,18 @@ def _held_stylus(gimbal: np.ndarray) -> dict[str, float]:
     return {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(middle)}
 
 
-def _reference(path: Path | None, model: str) -> tuple[np.ndarray, np.ndarray] | None:
-    """--reference's trajectory (excite's CSV in the report's convention, for ``model``): its times
-    (s) and angles (rad), or None; a file that is not one is refused naming --reference."""
+def _reference(path: Path | None, model: str, convention: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """--reference's trajectory (excite's CSV for ``model``, in the log's ``convention``, as excite
+    --convention writes it): its times (s) and angles in the report's theta (rad), or None; a file
+    that is not one is refused naming --reference."""
     if path is None:
         return None
-    check_record(path, model, "report", "--reference")
+    check_record(path, model, convention, "--reference")
     try:
         t, theta = io.read_trajectory(path)[:2]
     except PhantomPinError as error:
         raise PhantomPinError(error.detail, argument="--reference") from None
-    return t, theta
+    return t, (drivers.theta_from_openhaptics(theta) if convention == "openhaptics" else theta)
 
 
 def _delay(text: str | None) -> float | None:
@@ -178,7 +179,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                + ", ".join(f"{v:g}" for v in selection.MIN_SPEEDS) + " rad/s on held-out quarters "
                                "of it, docs/identification.md, step 4)")
     identify.add_argument("--reference", type=Path, default=None, metavar="TRAJ.csv",
-                          help="the trajectory the servo loop tracked (excite's CSV, the report's convention, read "
+                          help="the trajectory the servo loop tracked (excite's CSV in the log's --convention, read "
                                "from the log's start): the log is a closed loop on it, identified with instrumental "
                                "variables against the noise the loop feeds back into the motion")
     identify.add_argument("--fixed-gains", action="store_true",
@@ -331,7 +332,7 @@ def identify_command(args: argparse.Namespace) -> int:
                           prior_spread=args.prior_spread, delay=delay, gains=not args.fixed_gains,
                           min_speed=args.min_speed, accept=args.accept, given=given, source=args.log.name,
                           progress=bar.update,
-                          reference=_reference(args.reference, phantom.config.name))
+                          reference=_reference(args.reference, phantom.config.name, args.convention))
     except RefusedError as error:
         raise PhantomPinError(f"{refusal(error.problems)}; nothing written (--accept writes it anyway)") from None
     finally:

@@ -193,6 +193,9 @@ def gain_lines(fit: Fit) -> list[str]:
     """The joints' torque gains relative to joint 1, as estimated (the corrected ones as
     applied: estimated again with the others at 1) and what became of them, one line."""
     values, sigma = fit.gains_estimated
+    if not sigma.any() and fit.closed_loop:
+        return ["torque gains: not estimated (a closed loop given its reference: instrumented, unmodelled friction "
+                "biases them): the log's torques taken as they are"]
     if not sigma.any():
         return ["torque gains: not estimated (--fixed-gains / gains=False): the log's torques taken as they are"]
     rejected = rejected_gains(fit)

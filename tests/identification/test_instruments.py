@@ -13,7 +13,9 @@ import functools
 import numpy as np
 import pytest
 
-from phantom_pin import Device, Phantom, describe
+from helpers import run_cli
+from phantom_pin import Device, Phantom, describe, drivers
+from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, LogError, PhantomPinError
 from phantom_pin.identification import estimate, overlay, simulation
@@ -114,6 +116,21 @@ def test_identify_reference_on_the_command_line(tmp_path, capsys):
     assert code == 0, err
     assert "closed loop: the log follows the reference given" in out and (tmp_path / "id.yaml").is_file()
     assert "the torque gains not estimated" in out
+    assert "torque gains: not estimated (a closed loop given its reference" in out     # not --fixed-gains
+    # the same in OpenHaptics' convention, as `excite --convention openhaptics` writes the reference
+    oh = drivers.openhaptics_from_theta
+    io.write_csv(tmp_path / "log_oh.csv", io.LOG_COLUMNS,
+                 np.column_stack([log.t, oh(log.theta), drivers.openhaptics_torque_from_tau(log.tau)]))
+    io.write_csv(tmp_path / "traj_oh.csv", io.TRAJECTORY_COLUMNS,
+                 np.column_stack([t_, oh(theta_), oh(dtheta), oh(ddtheta), np.zeros_like(theta_)]))
+    code, out_oh, err = run_cli("-q", *lengths, "identify", tmp_path / "log_oh.csv", "--convention", "openhaptics",
+                                "--reference", tmp_path / "traj_oh.csv", "-o", tmp_path / "id_oh.yaml")
+    assert code == 0, err
+    assert "closed loop: the log follows the reference given" in out_oh
+    written, written_oh = read_overrides(tmp_path / "id.yaml"), read_overrides(tmp_path / "id_oh.yaml")
+    assert written.keys() == written_oh.keys()
+    assert all(np.isclose(written_oh[k], v, rtol=1e-6, atol=1e-9) if isinstance(v, float) else written_oh[k] == v
+               for k, v in written.items())       # one log in two conventions: one model (rounding apart)
     # the reference played backwards: a trajectory file of its own, which the log does not follow
     reversed_ = np.column_stack([t_, theta_[::-1], -dtheta[::-1], ddtheta[::-1], np.zeros_like(theta_)])
     io.write_csv(tmp_path / "backwards.csv", io.TRAJECTORY_COLUMNS, reversed_)
