@@ -11,7 +11,7 @@ import numpy as np
 
 from phantom_pin.config.sampling import random_states
 from phantom_pin.description.gimbal import arm_only
-from phantom_pin.dynamics._refusals import constructor, shown
+from phantom_pin.dynamics._refusals import refusal
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.report import appendix, closed_form
@@ -72,8 +72,7 @@ def check(phantom: Phantom, states: int = 1000, seed: int = 0,
     written in the report's terms (no closed form applies).
     """
     if not isinstance(phantom, Phantom):
-        raise InvalidInputError(f"expected a phantom_pin.Phantom, got {shown(phantom)}; "
-                                f"{constructor('Phantom', phantom)}", argument="phantom")
+        raise refusal("Phantom", "a phantom_pin.Phantom", phantom, "phantom")
     if isinstance(states, bool) or not isinstance(states, int | np.integer) or states < 1:
         raise InvalidInputError(f"expected a whole number of states >= 1, got {states!r}", argument="states")
     if states > MAX_STATES:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import drivers, plots
+from phantom_pin import plots
 from phantom_pin._progress import Progress
 from phantom_pin._validation import fixed_rate
 from phantom_pin.cli.common import (
@@ -128,10 +128,7 @@ def _tracking(args: argparse.Namespace) -> _Run:
                                   argument="--" + name)
     if args.controller is not None:
         raise PhantomPinError("--trajectory is the controller", argument="--controller")
-    t, theta, dtheta, _, tau = io.read_trajectory(args.trajectory)
-    if args.convention == "openhaptics":  # a linear map: rates as angles
-        theta, dtheta = drivers.theta_from_openhaptics(theta), drivers.theta_from_openhaptics(dtheta)
-        tau = drivers.tau_from_openhaptics_torque(tau)
+    t, theta, dtheta, _, tau = io.read_trajectory(args.trajectory, args.convention or "report")
     return _Run(theta[0].tolist(), dtheta[0].tolist(), float(t[-1] - t[0]), fixed_rate(t),
                 tracking(t, theta, dtheta, tau))
 

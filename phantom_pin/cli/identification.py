@@ -119,10 +119,10 @@ def _reference(path: Path | None, model: str, convention: str) -> tuple[np.ndarr
         return None
     check_record(path, model, convention, "--reference")
     try:
-        t, theta = io.read_trajectory(path)[:2]
+        t, theta = io.read_trajectory(path, convention)[:2]
     except PhantomPinError as error:
         raise PhantomPinError(error.detail, argument="--reference") from None
-    return t, (drivers.theta_from_openhaptics(theta) if convention == "openhaptics" else theta)
+    return t, theta
 
 
 def _delay(text: str | None) -> float | None:

@@ -11,7 +11,7 @@ import numpy as np
 from phantom_pin._validation import as_states, finite_result, same_batch
 from phantom_pin.config import Config
 from phantom_pin.config.types import STOP_COORDINATES, Motor
-from phantom_pin.dynamics._refusals import constructor, shown
+from phantom_pin.dynamics._refusals import refusal
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.report import closed_form
@@ -51,8 +51,7 @@ class Device:
         if phantom is None:
             phantom = Phantom()
         elif not isinstance(phantom, Phantom):
-            raise InvalidInputError(f"expected a phantom_pin.Phantom or None, got {shown(phantom)}; "
-                                    f"{constructor('Device', phantom)}", argument="phantom")
+            raise refusal("Device", "a phantom_pin.Phantom or None", phantom, "phantom")
         self.phantom = phantom
         self.config: Config = phantom.config
         actuation = self.config.actuation

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from phantom_pin.config import MODELS
 from phantom_pin.description.build import Description
+from phantom_pin.exceptions import InvalidInputError
 
 
 def shown(value: object) -> str:
@@ -30,3 +31,10 @@ def constructor(cls: str, given: object) -> str:
     if isinstance(given, Description):
         return f"a Description is {wrap('Phantom(description)')}"
     return f"a model name ({', '.join(MODELS)}) is {cls}.from_model(name), a folder {wrap('Phantom.from_folder(path)')}"
+
+
+def refusal(cls: str, expected: str, given: object, argument: str) -> InvalidInputError:
+    """The error of ``cls``'s plain call (or of a function taking one) given what it does not
+    take: ``expected`` (e.g. "a phantom_pin.Phantom or None"), what was given, and the call
+    that makes the object of it (constructor), naming ``argument``."""
+    return InvalidInputError(f"expected {expected}, got {shown(given)}; {constructor(cls, given)}", argument=argument)

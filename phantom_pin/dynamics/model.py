@@ -15,7 +15,7 @@ from phantom_pin._validation import as_states, finite_result, same_batch, within
 from phantom_pin.config import MODELS, Config, resolve
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, shipped
-from phantom_pin.dynamics._refusals import constructor, shown
+from phantom_pin.dynamics._refusals import refusal
 from phantom_pin.dynamics.build import rooted_at_frame
 from phantom_pin.dynamics.fast import (
     BOOL,
@@ -75,8 +75,7 @@ class Phantom:
         if description is None:
             description = shipped()
         elif not isinstance(description, Description):
-            raise InvalidInputError(f"expected a phantom_pin.Description or None, got {shown(description)}; "
-                                    f"{constructor('Phantom', description)}", argument="description")
+            raise refusal("Phantom", "a phantom_pin.Description or None", description, "description")
         self.description = description
         self.config: Config = description.config
         gimbal, prefix = self.config.gimbal, description.prefix

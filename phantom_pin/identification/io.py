@@ -148,9 +148,13 @@ def read_postures(path: Path | str) -> tuple[np.ndarray, np.ndarray] | None:
             np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)]))
 
 
-def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
-    """(t, theta, dtheta, ddtheta, tau) of an excitation trajectory (excite's CSV, the report's
-    convention: s, rad, rad/s, rad/s^2, N m), each (N,) or (N, 3), at a fixed rate."""
+def read_trajectory(path: Path | str, convention: str = "report") -> tuple[np.ndarray, ...]:
+    """(t, theta, dtheta, ddtheta, tau) of an excitation trajectory (excite's CSV: s, rad, rad/s,
+    rad/s^2, N m), each (N,) or (N, 3), at a fixed rate, in the report's theta and N m: its columns
+    are in the ``convention`` "report" or "openhaptics" (as read_log's; angles, rates and
+    accelerations by the same linear map, torques in mN m)."""
+    if convention not in ("report", "openhaptics"):
+        raise LogError(f"expected 'report' or 'openhaptics', got {convention!r}", argument="convention")
     path = Path(path)
     _, column = _read_table(path, TRAJECTORY_COLUMNS)
     t = column["t"]
@@ -161,6 +165,9 @@ def read_trajectory(path: Path | str) -> tuple[np.ndarray, ...]:
                                    for name in ("theta", "dtheta", "ddtheta", "tau"))
     _consistent(path, "theta", "dtheta", t, theta, dtheta)
     _consistent(path, "dtheta", "ddtheta", t, dtheta, ddtheta)
+    if convention == "openhaptics":
+        theta, dtheta, ddtheta = (drivers.theta_from_openhaptics(x) for x in (theta, dtheta, ddtheta))
+        tau = drivers.tau_from_openhaptics_torque(tau)
     return t, theta, dtheta, ddtheta, tau
 
 
