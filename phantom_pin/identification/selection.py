@@ -1,4 +1,6 @@
-"""The friction speed threshold chosen from the log itself, on held-out parts of it.
+"""What identify chooses from the log itself, each on FOLDS held-out parts of it: the friction
+speed threshold (choose_min_speed), the torque timing (choose_timing), and whether a torque gain
+the evidence rule found is corrected (validate_gains). The threshold:
 
 Near rest a joint sticks and its torque is whatever holds it, not the sliding friction law the
 regressor describes (filtering.MIN_SPEED). How far from rest that reaches depends on the device:
