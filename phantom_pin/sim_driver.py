@@ -7,7 +7,8 @@ its damping and start-up spring, its NaN handling, its norm clamp, the command h
 for one tick: phantom_pin.profiles), applies J_p(theta)^T F at the gimbal centre to the plant
 (Device's gravity, friction, stops and saturation; device.plant), and gives the joint states in
 the driver's conventions. No hand holds the stylus, except that ``hold`` keeps it at theta0 for
-its first seconds, as a user's hand would until a node started alongside connects.
+its first seconds, as a user's hand would until a node started alongside connects (``release()``
+lets go sooner: the command-line driver calls it on SIGUSR1).
 
 ``make_node`` and ``spin`` put it on ROS 2: the profile's joint-state topic at its rate and
 quality of service (positions, rad, in its conventions; efforts, where the driver publishes
@@ -20,6 +21,7 @@ end the log says for how many ticks after the release a command arrived.
 from __future__ import annotations
 
 import math
+import signal
 import threading
 import time
 from collections.abc import Sequence
@@ -120,6 +122,11 @@ class DriverSimulation:
             self.q, self.v = self.plant.hold(self.q, self.v, self.applied.tolist(), PERIOD, self.steps)
         self.fresh = False
         self.time += PERIOD
+
+    def release(self) -> None:
+        """Let the stylus go at the end of the next servo tick, however long ``hold`` has left
+        (nothing if it was let go already)."""
+        self.hold = min(self.hold, self.time + PERIOD)
 
     def joint_state(self, gimbal: Sequence[float]) -> tuple[list[str], list[float], list[float]]:
         """(names, positions (rad), efforts) of the driver's joint_states: the arm and the stylus
@@ -252,14 +259,19 @@ def loop(simulation: DriverSimulation, node, executor, stop: threading.Event) ->
 
 
 def spin(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str = "") -> int:
-    """Run the simulated driver until SIGINT or SIGTERM; 0 on a clean stop."""
+    """Run the simulated driver until SIGINT or SIGTERM; 0 on a clean stop. SIGUSR1 lets the
+    stylus go (``DriverSimulation.release``) where ``hold`` still holds it."""
     nodes: list = []
+    previous = signal.signal(signal.SIGUSR1, lambda *_: simulation.release())
 
     def make():
         nodes.append(make_node(simulation, gimbal, prefix))
         return nodes[0]
 
     profile = simulation.profile
-    return run(make, f"sim-driver {profile.name}: {profile.force.topic} -> {profile.joint_states.topic} at "
-                     f"{profile.joint_states.rate:g} Hz", lambda executor, stop: loop(simulation, nodes[0], executor,
-                                                                                     stop))
+    try:
+        return run(make, f"sim-driver {profile.name}: {profile.force.topic} -> {profile.joint_states.topic} at "
+                         f"{profile.joint_states.rate:g} Hz", lambda executor, stop: loop(simulation, nodes[0],
+                                                                                         executor, stop))
+    finally:
+        signal.signal(signal.SIGUSR1, previous)

@@ -87,6 +87,29 @@ def test_a_command_counts_for_the_servo_tick_after_it_arrived(device):
             assert np.abs(simulation.applied - want).max() < 1e-12, (name, k)
 
 
+def test_release_lets_the_stylus_go_at_the_next_tick_and_not_before(device):
+    """hold=10 s, no command: the stylus stays at theta0 (to the bit) for 50 ticks; release()
+    lets it go at the end of the next tick, the same state as a hold of 51 ticks given at the start
+    (to the bit), and gravity then pulls the tip down (frame s's -y: more than 0.1 mm in 0.1 s, where
+    gravity beats the static friction); a second release() changes nothing."""
+    simulation = DriverSimulation(device, profiles.load("sawsensablephantom"), RELEASES[0], hold=10.0)
+    for _ in range(50):
+        simulation.tick()
+    assert simulation.q == list(RELEASES[0]) and simulation.ticks == 0
+    simulation.release()
+    simulation.tick()
+    assert simulation.ticks == 0 and simulation.q == list(RELEASES[0])   # let go at the end of this tick
+    given = DriverSimulation(device, profiles.load("sawsensablephantom"), RELEASES[0], hold=0.051)
+    for _ in range(51):
+        given.tick()
+    for _ in range(100):
+        simulation.tick()
+        given.tick()
+    simulation.release()
+    assert simulation.ticks == given.ticks == 100 and simulation.q == given.q
+    assert tip(device, RELEASES[0])[1] - tip(device, simulation.q)[1] > 1e-4
+
+
 class SimpleWrench:
     """A WrenchStamped-shaped holder of a force in CalaW's driver frame R."""
 

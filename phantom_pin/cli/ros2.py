@@ -141,7 +141,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     simulated.add_argument("--gimbal", type=float, nargs=3, metavar=("G1", "G2", "G3"),
                            help="the stylus's raw gimbal angles, held (rad; default the model's locked_at)")
     simulated.add_argument("--hold", type=float, default=0.0, metavar="S",
-                           help="hold the stylus at theta0 for the first S seconds, then let go (default 0)")
+                           help="hold the stylus at theta0 for the first S seconds, or until the process gets SIGUSR1, "
+                                "then let go (default 0)")
     simulated.add_argument("--rate", type=float, metavar="HZ",
                            help="the joint states' rate (Hz; default the driver's)")
     simulated.add_argument("--prefix", default="", help="the joint names' prefix (default none)")

@@ -1,8 +1,8 @@
 """End to end over ROS 2 on loopback, with the real rclpy: for every driver profile whose message
 types install here, the simulated driver (phantom-pin sim-driver) and the node (phantom-pin ros2
---driver) as two processes. Released after --hold, the stylus floats (within 2 mm for FLOAT s; for
-kinisi's one-tick driver only the node's part is asserted, docs/drivers.md); a user's 0.5 N up
-lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
+--driver) as two processes. Let go (SIGUSR1) once this test's own node receives the states and the
+forces, the stylus floats (within 2 mm for FLOAT s; for kinisi's one-tick driver only the node's
+part is asserted, docs/drivers.md); a user's 0.5 N up lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
 driver's own formula (driver_reference), holds the Touch's gravity from the closed form (1e-9 N m);
 without the node the stylus falls. omni_msgs (geomagic_touch_ros2) is not on PyPI: the node
 refuses that profile in one line, and the documents' one-file relay (`--relay`) is run as printed
@@ -49,7 +49,11 @@ BAD_WRENCH = {"sawsensablephantom": ("base_link", (float("nan"), 0.0, 0.0), "for
               "geomagic_touch_x_ros2": ("base_link", (1e9, 0.0, 0.0), "force"),
               "geomagic_touch_ros2": ("stylus", (0.0, -float("inf"), 0.0), "force"),
               "phantom_touch_ros2": ("touch_b_stylus", (0.0, 0.0, 0.1), "frame_id")}
-HOLD = 4.5                           # s, before the simulated driver lets go: the node starts meanwhile
+#: s, the most the simulated driver holds the stylus: SIGUSR1 lets it go once this test's watcher
+#: has received READY joint states and forces, the forces over READY_SPAN s (ROS discovery now and then
+#: takes seconds here; kinisi's check needs 100 forces answering still states, 0.2 s before it moves)
+HOLD = 30.0
+READY, READY_SPAN = 100, 0.5
 #: s watched after the release: an uncompensated stylus falls 2 mm in 20 ms; a compensated one moves
 #: not at all (within 1e-12 m: its static friction holds it), so 0.5 s tells them apart 25 times over.
 FLOAT = 0.5
@@ -187,9 +191,9 @@ def test_every_kind_of_force_message_is_run_over_loopback():
 @pytest.mark.slow
 @pytest.mark.parametrize("name", LOOPBACK)
 def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
-    """The node and the simulated driver started together (the driver holds the stylus for HOLD
-    s meanwhile); after the release the tip stays within 2 mm for FLOAT s, every force received holds
-    the closed form's gravity at the release posture by the driver's own formula (1e-9 N m), and
+    """The node and the simulated driver started together (the driver holds the stylus until the
+    watcher has the states and the node's forces, then SIGUSR1 lets it go); after the release the
+    tip stays within 2 mm for FLOAT s, every force received holds the closed form's gravity at the release posture by the driver's own formula (1e-9 N m), and
     0.5 N up on `wrench` lifts the tip (kinisi's one-tick driver: _one_tick); a bad wrench is
     dropped with one warning naming its field. The simulated driver's count of ticks with a
     command is printed."""
@@ -216,11 +220,18 @@ def _clean_stops(name: str, results: list[tuple[int, str]]) -> None:
 
 
 def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) -> None:
-    _wait_for(simulated, "released", watcher=watcher)
-    # the node must have connected while the driver held the stylus (ROS discovery now and then takes
-    # seconds here: HOLD leaves it 2.5-3 s after the node is up)
-    assert watcher.states and watcher.forces, (f"within the {HOLD} s hold: {len(watcher.states)} states, "
-                                               f"{len(watcher.forces)} forces")
+    # held until the watcher has the driver's states and the node's forces, then let go (SIGUSR1)
+    def ready() -> bool:
+        return (min(len(watcher.states), len(watcher.forces)) >= READY
+                and watcher.received[-1] - watcher.received[0] >= READY_SPAN)
+
+    deadline = time.monotonic() + HOLD
+    while not ready() and time.monotonic() < deadline:
+        watcher.spin(0.05)
+        assert simulated.poll() is None, simulated.communicate()[1]
+    assert ready(), f"within the {HOLD} s hold: {len(watcher.states)} states, {len(watcher.forces)} forces"
+    simulated.send_signal(signal.SIGUSR1)
+    _wait_for(simulated, "released", timeout=10.0, watcher=watcher)   # at once, not after HOLD
     watcher.spin(0.05)
     released = watcher.states[-1][0]
     watcher.spin(FLOAT)
