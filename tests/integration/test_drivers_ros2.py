@@ -1,12 +1,12 @@
-"""End to end over ROS 2 on loopback, with the real rclpy: for every driver profile whose message
-types install here, the simulated driver (phantom-pin sim-driver) and the node (phantom-pin ros2
---driver) as two processes. Let go (SIGUSR1) once this test's own node receives the states and the
-forces, the stylus floats (within 2 mm for FLOAT s; for kinisi's one-tick driver only the node's
-part is asserted, docs/drivers.md); a user's 0.5 N up lifts it; the force the node publishes, taken back to OpenHaptics' frame by the
-driver's own formula (driver_reference), holds the Touch's gravity from the closed form (1e-9 N m);
-without the node the stylus falls. omni_msgs (geomagic_touch_ros2) is not on PyPI: the node
-refuses that profile in one line, and the documents' one-file relay (`--relay`) is run as printed
-with a stand-in for omni_msgs."""
+"""End to end over ROS 2 on loopback, with the real rclpy: for every driver profile whose message types
+install here, the simulated driver (phantom-pin sim-driver) and the node (phantom-pin ros2 --driver)
+as two processes. Let go (SIGUSR1) once this test's own node receives the states and the forces, the
+stylus floats (within 2 mm for FLOAT s; for kinisi's one-tick driver only the node's part is
+asserted, docs/drivers.md); a user's 0.5 N up lifts it; the force the node publishes, taken back to
+OpenHaptics' frame by the driver's own formula (driver_reference), holds the Touch's gravity from
+the closed form (1e-9 N m); without the node the stylus falls. omni_msgs (geomagic_touch_ros2) is
+not on PyPI: the node refuses that profile in one line, and the documents' one-file relay
+(`--relay`) is run as printed with a stand-in for omni_msgs."""
 
 from __future__ import annotations
 
@@ -29,7 +29,9 @@ import driver_reference as ref
 from phantom_pin import Phantom, closed_form, profiles
 from phantom_pin.exceptions import MissingDataError
 from phantom_pin.ros2 import message_type
+from test_ros2 import _environment as environment
 from test_ros2 import _stop as stop
+from test_ros2 import in_process
 
 
 def _installed(name: str) -> bool:
@@ -63,11 +65,10 @@ FLOAT = 0.5
 LOOPBACK = ("geomagic_touch_x_ros2", "phantom_touch_ros2", "sawsensablephantom")
 
 
-def _environment(offset: int = 0) -> dict[str, str]:
-    """Loopback only, a ROS domain of this module alone (its tests run one after another, each
-    stopping its processes before the next starts)."""
-    return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-            "ROS_DOMAIN_ID": str(1 + (os.getpid() + 37) % 100), "PYTHONUNBUFFERED": "1"}
+def _environment() -> dict[str, str]:
+    """test_ros2's (loopback, its discovery), in a ROS domain of this module alone (its tests run
+    one after another, each stopping its processes before the next starts)."""
+    return environment(1 + (os.getpid() + 37) % 100)
 
 
 @functools.cache
@@ -111,7 +112,7 @@ class Watcher:
     formulas inverted here) and force commands, with their receipt times; a user's wrench out."""
 
     def __init__(self, name: str, env: dict[str, str]) -> None:
-        os.environ.update({k: v for k, v in env.items() if k.startswith("ROS_")})
+        in_process(env)
         import rclpy
         from geometry_msgs.msg import WrenchStamped
         from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -193,11 +194,11 @@ def test_every_kind_of_force_message_is_run_over_loopback():
 def test_the_stylus_floats_with_the_node_and_a_users_force_lifts_it(name):
     """The node and the simulated driver started together (the driver holds the stylus until the
     watcher has the states and the node's forces, then SIGUSR1 lets it go); after the release the
-    tip stays within 2 mm for FLOAT s, every force received holds the closed form's gravity at the release posture by the driver's own formula (1e-9 N m), and
-    0.5 N up on `wrench` lifts the tip (kinisi's one-tick driver: _one_tick); a bad wrench is
-    dropped with one warning naming its field. The simulated driver's count of ticks with a
-    command is printed."""
-    env = _environment(LOOPBACK.index(name))
+    tip stays within 2 mm for FLOAT s, every force received holds the closed form's gravity at the
+    release posture by the driver's own formula (1e-9 N m), and 0.5 N up on `wrench` lifts the tip
+    (kinisi's one-tick driver: _one_tick); a bad wrench is dropped with one warning naming its
+    field. The simulated driver's count of ticks with a command is printed."""
+    env = _environment()
     node = _start(env, "ros2", "--driver", name)
     simulated = _start(env, "sim-driver", "--driver", name, "--hold", str(HOLD), "--theta0", *map(str, THETA0))
     watcher = Watcher(name, env)
@@ -380,7 +381,7 @@ def test_the_documented_relay_carries_the_nodes_force_to_the_geomagic_driver(doc
 @pytest.mark.slow
 def test_without_the_node_the_stylus_falls():
     """The simulated driver alone (sawsensablephantom): more than 10 mm down within 3 s of the release."""
-    env = _environment(len(INSTALLED))
+    env = _environment()
     watcher = Watcher("sawsensablephantom", env)
     simulated = _start(env, "sim-driver", "--driver", "sawsensablephantom", "--hold", "0.5",
                        "--theta0", *map(str, THETA0))
