@@ -1,6 +1,6 @@
-"""identification.io's CSV reading: every dialect it takes gives the numbers Python's float()
-reads from the text, bit for bit, whichever way it parses them (NumPy at once, or line by line
-where a value is quoted); a bad line is named."""
+"""identification.io's CSV files: written, the bytes np.savetxt writes; read, in every dialect it
+takes, the numbers Python's float() reads from the text, bit for bit, whichever way it parses them
+(NumPy at once, or line by line where a value is quoted); a bad line is named."""
 
 import numpy as np
 import pytest
@@ -39,3 +39,17 @@ def test_a_bad_line_is_named(tmp_path, bad, message):
     path.write_text(f"{HEADER}\n0,0,0,0,0,0,0\n0.001,0,0,0,0,0,0\n{bad}\n0.003,0,0,0,0,0,0\n")
     with pytest.raises(LogError, match=message):
         io.read_log(path)
+
+
+@pytest.mark.parametrize("shape", [(2001, 7), (5, 1), (7,), (0, 7)])
+def test_a_written_csv_is_what_numpys_savetxt_writes_byte_for_byte(tmp_path, shape):
+    """io.write_csv against np.savetxt(fmt="%.17g") itself, on seeded numbers of every size
+    (subnormal, 1e300, -0.0, integers): the same bytes, header included."""
+    rng = np.random.default_rng(4)
+    table = rng.normal(size=shape) * 10.0 ** rng.integers(-310, 300, shape)
+    if table.size:
+        table.flat[: min(3, table.size)] = [-0.0, 3.0, 5e-324][: min(3, table.size)]
+    columns = tuple(f"c{k}" for k in range(shape[1] if len(shape) == 2 else 1))
+    io.write_csv(tmp_path / "ours.csv", columns, table)
+    np.savetxt(tmp_path / "numpy.csv", table, delimiter=",", header=",".join(columns), comments="", fmt="%.17g")
+    assert (tmp_path / "ours.csv").read_bytes() == (tmp_path / "numpy.csv").read_bytes()
