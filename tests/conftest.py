@@ -112,7 +112,9 @@ MESHCAT_SERVERS = ("viewer/test_viewer.py::", "viewer/test_server.py::", "cli/te
                    "description/test_gimbal.py::test_the_viewer_",
                    "config/test_touch_model.py::test_the_command_line_serves_the_touch",
                    "integration/test_examples.py::test_visualize_",
-                   "integration/test_examples.py::test_existing_output_is_kept_without_force")
+                   "integration/test_examples.py::test_existing_output_is_kept_without_force",
+                   "integration/test_pictures.py::test_the_script_",           # docs/pictures.py's Viewer
+                   "integration/test_docs_site.py::test_the_python_blocks_")   # docs/tools.md's Viewer
 MESHCAT_URL_CHECKS = ("cli/test_cli.py::test_show_serves_", "cli/test_cli.py::test_show_stops_")
 
 
