@@ -96,6 +96,9 @@ GROUPS = {
     "identification/test_prior.py::": "lab_log",
     "identification/test_timing.py::": "lab_log",
     "identification/test_end_to_end.py::": "identification_end_to_end",
+    "identification/test_instruments.py::": "instruments",        # closed_loop(): 60 s simulated, 2-3 s
+    "identification/test_bags.py::": "bags",                      # report_csv: an identify
+    "viewer/test_viewer.py::": "viewer",                          # two meshcat servers and their robots
     "integration/test_gazebo.py::": "gazebo",
     "codegen/test_generate.py::": "codegen",
     "config/test_cad_model.py::": "cad_model",
