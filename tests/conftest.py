@@ -20,18 +20,21 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # after the setting above
 
-from helpers import CONFIG, N_STATES, Six, run_cli
-from phantom_pin import Phantom
-from phantom_pin.config.sampling import random_states
+# The fixtures import helpers (Pinocchio, the package) when first used: pytest's own process,
+# which hands the tests to the xdist workers, needs none of it and starts them a second sooner.
 
 
 @pytest.fixture(scope="session")
-def phantom() -> Phantom:
+def phantom():
+    from phantom_pin import Phantom
+
     return Phantom()
 
 
 @pytest.fixture(scope="session")
 def limits() -> tuple[np.ndarray, np.ndarray]:
+    from helpers import CONFIG
+
     p = CONFIG.limits
     return np.array(p.lower), np.array(p.upper)
 
@@ -40,19 +43,26 @@ def limits() -> tuple[np.ndarray, np.ndarray]:
 def cli() -> Callable[..., tuple[int, str, str]]:
     """phantom-pin in this process: ``cli(*arguments)`` gives (exit code, stdout, stderr)
     (helpers.run_cli)."""
+    from helpers import run_cli
+
     return run_cli
 
 
 @pytest.fixture()
 def states():
     """N_STATES seeded (theta, dtheta, ddtheta) inside the joint limits (config.sampling.random_states)."""
+    from helpers import CONFIG, N_STATES
+    from phantom_pin.config.sampling import random_states
+
     return random_states(CONFIG.limits, N_STATES, seed=20261121)
 
 
 @pytest.fixture(scope="module")
-def six() -> Six:
+def six():
     """The Touch's six-joint model built from its committed URDF by Pinocchio alone (helpers.Six):
     the reference of the arm's dynamics with the gimbal held at given angles."""
+    from helpers import Six
+
     return Six()
 
 
@@ -99,6 +109,8 @@ GROUPS = {
     "identification/test_instruments.py::": "instruments",        # closed_loop(): 60 s simulated, 2-3 s
     "identification/test_bags.py::": "bags",                      # report_csv: an identify
     "viewer/test_viewer.py::": "viewer",                          # two meshcat servers and their robots
+    "description/test_srdf.py::": "srdf",                         # each model's collision geometry
+    "integration/test_interop.py::": "interop",                   # each model's Drake plant
     "integration/test_gazebo.py::": "gazebo",
     "codegen/test_generate.py::": "codegen",
     "config/test_cad_model.py::": "cad_model",
