@@ -17,6 +17,9 @@ import pytest
 # take minutes (`check -n 2e7` took 64 s to answer Ctrl-C). The xdist workers inherit it; the
 # docs quote examples/identify_simulated.py's figures as printed with it.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# SymPy's cache unbounded, set before SymPy loads (its default keeps 1000 results): the C headers'
+# generation (codegen) takes 18 % less CPU (8.2 s against 6.7 s for the three models), the same bytes.
+os.environ.setdefault("SYMPY_CACHE_SIZE", "none")
 
 import numpy as np  # after the setting above
 
