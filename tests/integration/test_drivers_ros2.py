@@ -221,16 +221,21 @@ def _clean_stops(name: str, results: list[tuple[int, str]]) -> None:
 
 
 def _float_and_lift(name: str, watcher: Watcher, simulated: subprocess.Popen) -> None:
-    # held until the watcher has the driver's states and the node's forces, then let go (SIGUSR1)
+    """Held until the watcher has the driver's states and the node's forces and the node's
+    subscription to the watcher's wrench matched (a wrench pushed before is lost: the node's
+    warning about the bad one below went missing once), then let go (SIGUSR1); the float (or
+    kinisi's node part), the lift and a bad wrench."""
     def ready() -> bool:
         return (min(len(watcher.states), len(watcher.forces)) >= READY
-                and watcher.received[-1] - watcher.received[0] >= READY_SPAN)
+                and watcher.received[-1] - watcher.received[0] >= READY_SPAN
+                and watcher.wrench.get_subscription_count() >= 1)
 
     deadline = time.monotonic() + HOLD
     while not ready() and time.monotonic() < deadline:
         watcher.spin(0.05)
         assert simulated.poll() is None, simulated.communicate()[1]
-    assert ready(), f"within the {HOLD} s hold: {len(watcher.states)} states, {len(watcher.forces)} forces"
+    assert ready(), (f"within the {HOLD} s hold: {len(watcher.states)} states, {len(watcher.forces)} forces, "
+                     f"{watcher.wrench.get_subscription_count()} subscriptions to wrench")
     simulated.send_signal(signal.SIGUSR1)
     _wait_for(simulated, "released", timeout=10.0, watcher=watcher)   # at once, not after HOLD
     watcher.spin(0.05)
@@ -281,8 +286,6 @@ def _floats_and_lifts(name: str, watcher: Watcher, drift: float) -> None:
     errors = [np.abs(jacobian.T @ ref.FORCE[name](force) - gravity).max() for force in watcher.forces]
     assert drift < 1e-12 and len(errors) > 100 and max(errors) < 1e-9, (drift, len(errors), max(errors))
     # a user's 0.5 N up (base_link +z = frame s's +y) for 0.1 s: the tip rises
-    while watcher.wrench.get_subscription_count() < 1:   # the node's wrench subscription matched
-        watcher.spin(0.05)
     count, before = len(watcher.states), tip(watcher.states[-1][1])[1]
     for _ in range(10):   # then none: the node holds the last wrench, as drivers hold a force
         watcher.push("base_link", (0.0, 0.0, 0.5))
