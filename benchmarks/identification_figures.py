@@ -2,7 +2,8 @@
 realistic sensing and identified by the shipped pipeline (estimate with its CLI defaults: the
 prior, the estimated delay), judged on the WRITTEN model against the device.
 
-    python benchmarks/identification_figures.py [--quick] [--parts main touch rest bags] [-o FILE [--force]]
+    python benchmarks/identification_figures.py [--quick] [--parts main touch rest bags] [--seed K]
+        [-o FILE [--force]]
 
 Four tables, each selected by ``--parts`` (default all of them; --quick: main): ``main``, the
 conditions below; ``touch``, the issue's Touch case; ``rest``, gravity from rest postures; ``bags``,
@@ -65,8 +66,13 @@ written model, viscous / Coulomb, against the device's per joint; the delay (ms,
 estimated torque gain of joint 2 relative to joint 1 +- its standard deviation, and whether
 identify corrected it (the device's is 1.02 under the torque constant's error); what identify
 does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), result.timing_warning(),
-each listed under the table); and whether the issue's goal (held-out <= 0.5 %, written friction
-within 10 %) is met. Progress goes to stderr.
+each listed under the table); whether the issue's goal (held-out <= 0.5 %, written friction
+within 10 %) is met; and the held-out trajectory's error over the printed 2 sigma (identify's
+expected error on unseen motion, prediction.Prediction.expected; worst joint: 1 or less is
+covered), with a note of how many written models it covers and of the split-conformal factor the
+rows give: ``--seed 1`` (every seed of the table plus 1: other excitations, sines, noise and
+held-out motion) is the calibration set prediction.CALIBRATION was set from. Progress goes to
+stderr.
 
 The issue's Touch case (``touch``; tests/identification/test_selection.py): the shipped Touch but
 for viscous friction 7e-4 N m s/rad on joint 2 and Coulomb friction 0.02 N m on joint 3
@@ -127,6 +133,7 @@ from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation, static
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.overlays import identified_keys
+from phantom_pin.identification.prediction import CALIBRATION
 from phantom_pin.identification.result import gain_warning, timing_warning
 from phantom_pin.identification.structures import General
 
@@ -346,6 +353,11 @@ class Row:
     gain: str = "n/a"
     verdict: str = ""
     messages: tuple[str, ...] = ()
+    #: the held-out trajectory's error over the printed 2 sigma (Prediction.expected), worst joint
+    coverage: float = np.nan
+    #: the held-out trajectory's error over the log's-noise sigma (Prediction.states), worst joint:
+    #: the split-conformal score (calibration)
+    score: float = np.nan
 
     def goal(self) -> str:
         if not np.isfinite(self.states_error) or self.verdict == "-":
@@ -356,16 +368,18 @@ class Row:
 
 
 class Figures:
-    """The setups' trajectories and simulated logs, computed once each (in memory)."""
+    """The setups' trajectories and simulated logs, computed once each (in memory); ``seed`` is
+    added to every seed (excite's 0, the lab's sines' and the simulation's 1, the held-out 7):
+    another set of the same cases (--seed)."""
 
-    def __init__(self, setup: Setup, iterations: int, restarts: int) -> None:
-        self.setup, self.iterations, self.restarts = setup, iterations, restarts
+    def __init__(self, setup: Setup, iterations: int, restarts: int, seed: int = 0) -> None:
+        self.setup, self.iterations, self.restarts, self.seed = setup, iterations, restarts, seed
         self.truth = Phantom(setup.truth)
         self.device = Device(self.truth)
         self.uneven = Device(Phantom(setup.uneven))         # the same rigid body, each joint's own friction
         self.logs: dict[tuple, io.Log] = {}
-        held_out = optimise(setup.prior, iterations=5, restarts=1, seed=7).trajectory(np.arange(500) / 100.0)
-        self.held_out = {"trajectory": held_out, "states": random_states(setup.prior.config.limits, 500, 7)}
+        held_out = optimise(setup.prior, iterations=5, restarts=1, seed=7 + seed).trajectory(np.arange(500) / 100.0)
+        self.held_out = {"trajectory": held_out, "states": random_states(setup.prior.config.limits, 500, 7 + seed)}
         self.excitation = None
 
     def trajectory(self, kind: str, duration: float) -> tuple[np.ndarray, ...]:
@@ -375,11 +389,12 @@ class Figures:
             if self.excitation is None:
                 progress(f"{self.setup.name}: excite's trajectory ({self.iterations} iterations x "
                          f"{self.restarts} starts)")
-                self.excitation = optimise(prior, iterations=self.iterations, restarts=self.restarts)
+                self.excitation = optimise(prior, iterations=self.iterations, restarts=self.restarts, seed=self.seed)
             t = np.arange(int(round(duration * RATE)) + 1) / RATE
             theta, dtheta, ddtheta = self.excitation.trajectory(t)
         else:
-            t, theta, dtheta, ddtheta = sum_of_sines(duration, np.array(self.setup.posture), self.setup.amplitude, 1)
+            t, theta, dtheta, ddtheta = sum_of_sines(duration, np.array(self.setup.posture), self.setup.amplitude,
+                                                     1 + self.seed)
             slack = prior.config.limits.slack(theta).min()
             if slack < 0.05:
                 raise InvalidInputError(f"the lab's motion comes within {slack:.3g} rad of a stop (0.05 needed) on "
@@ -397,7 +412,7 @@ class Figures:
             t, theta, dtheta, tau = self.trajectory(kind, duration)
             device = self.uneven if condition.friction else self.device
             self.logs[key] = simulation.track(
-                device, t, theta, dtheta, tau, quantization=condition.quantization, seed=1,
+                device, t, theta, dtheta, tau, quantization=condition.quantization, seed=1 + self.seed,
                 torque_noise=current_noise(device) if condition.noise else 0.0,
                 gains=(1.0, 1.02, 1.0) if condition.gain else 1.0,
                 disturbance=stribeck(device.config.actuation.friction) if condition.friction else None)
@@ -441,8 +456,11 @@ def judge(figures: Figures, fit: Fit, row: Row, condition: Condition) -> None:
         return
     written = describe(prior.folder, overrides=keys)
     model = Phantom(written)
-    row.trajectory_error = float(torque_error(model, figures.truth, figures.held_out["trajectory"]).max())
+    trajectory = torque_error(model, figures.truth, figures.held_out["trajectory"])
+    row.trajectory_error = float(trajectory.max())
     row.states_error = float(torque_error(model, figures.truth, figures.held_out["states"]).max())
+    row.coverage = float((trajectory / (2 * fit.prediction.expected)).max())
+    row.score = float((trajectory / fit.prediction.states).max())
     truth = (setup.uneven if condition.friction else setup.truth).config.actuation.friction
     viscous, coulomb = np.asarray(truth.viscous), np.asarray(truth.coulomb)
     estimated = fit.x[-6:]                         # the projection's physical values, per joint
@@ -523,8 +541,8 @@ def rows_of(figures: Figures, kinds: tuple[str, ...], conditions: dict[str, Cond
 def table(rows: list[Row], notes: list[str]) -> str:
     """The Markdown table, then the messages of every warned or refused row and the notes."""
     lines = ["| setup | trajectory | condition | held-out trajectory | 500 states | friction estimated (viscous / "
-             "Coulomb) | friction written | delay | gain 2/1 | identify | goal |",
-             "|---|---|---|---:|---:|---:|---:|---:|---:|---|---|"]
+             "Coulomb) | friction written | delay | gain 2/1 | identify | goal | held-out / printed 2 sigma |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|"]
     messages: dict[str, int] = {}
 
     def percent(value: float) -> str:
@@ -539,10 +557,30 @@ def table(rows: list[Row], notes: list[str]) -> str:
                      f"{percent(row.states_error)} | {pair(row.estimated_friction)} | {pair(row.written_friction)} | "
                      + ("" if not np.isfinite(row.delay) else f"{row.delay:.2f} ms")
                      + f" | {row.gain if row.verdict not in ('-', '') and np.isfinite(row.delay) else ''} | "
-                     f"{row.verdict}{marks} | {row.goal()} |")
+                     f"{row.verdict}{marks} | {row.goal()} | "
+                     + ("" if not np.isfinite(row.coverage) else f"{row.coverage:.2f}") + " |")
     lines += [""] + [f"[{k}] {message}" for message, k in messages.items()]
-    lines += [""] + [f"- {note}" for note in notes]
+    lines += [""] + [f"- {note}" for note in [*notes, *coverage_notes(rows)]]
     return "\n".join(lines) + "\n"
+
+
+def coverage_notes(rows: list[Row]) -> list[str]:
+    """The printed uncertainty against the held-out errors (issue 39, 3; prediction.py): how many
+    written models' held-out trajectory errors lie within the printed 2 sigma (the expected error,
+    Prediction.expected) on every joint; and the split-conformal factor these rows give (the
+    ceil(0.9 (n + 1))-th smallest score halved), to set prediction.CALIBRATION from a calibration
+    set (--seed 1) and not from the table it is judged on."""
+    written = [row for row in rows if np.isfinite(row.coverage)]
+    if not written:
+        return []
+    covered = sum(row.coverage <= 1 for row in written)
+    scores = np.sort([row.score for row in written])
+    rank = min(len(scores), int(np.ceil(0.9 * (len(scores) + 1))))
+    return [f"the held-out trajectory's error within the printed 2 sigma (the expected error on unseen motion, "
+            f"{CALIBRATION:g} x the log's-noise sigma) on every joint: {covered} of {len(written)} written models "
+            f"({100 * covered / len(written):.0f} %); the held-out error over the log's-noise sigma, worst joint: "
+            f"median {np.median(scores):.2f}, the {rank}-th of {len(scores)} {scores[rank - 1]:.2f} (its half, "
+            f"{scores[rank - 1] / 2:.2f}, is the split-conformal factor this set gives)"]
 
 
 # -- the issue's Touch case: the shipped Touch but for two friction values, excite + simulate + identify ----------
@@ -804,6 +842,9 @@ def main(argv: list[str] | None = None) -> int:
                              "(gravity from rest postures), bags (identify BAG against its CSV); default all, "
                              "--quick: main")
     parser.add_argument("--rest-seeds", type=int, default=4, help="rest postures: seeded sets per setup (default 4)")
+    parser.add_argument("--seed", type=int, default=0,
+                        help="added to the main table's seeds (default 0, the documented table; 1: the calibration "
+                             "set of prediction.CALIBRATION)")
     parser.add_argument("--output", "-o", type=Path, help="also write the table to this file")
     parser.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     args = parser.parse_args(argv)
@@ -811,6 +852,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--output: {args.output} exists; use --force to overwrite it")
     if args.iterations < 1 or args.restarts < 1 or args.rest_seeds < 1:
         parser.error("--iterations, --restarts, --rest-seeds: expected integers of at least 1")
+    if args.seed < 0:
+        parser.error("--seed: expected an integer of at least 0")
     parts = args.parts or (["main"] if args.quick else list(PARTS))
     names = args.setups or (["cad"] if args.quick else list(setups()))
     kinds = tuple(args.trajectories or (["excite"] if args.quick else ["excite", "lab"]))
@@ -825,7 +868,7 @@ def main(argv: list[str] | None = None) -> int:
         def figures_of(name: str) -> Figures:
             if name not in built:
                 progress(f"{name}: building the device and the held-out sets")
-                built[name] = Figures(setups()[name](), iterations, restarts)
+                built[name] = Figures(setups()[name](), iterations, restarts, args.seed)
             return built[name]
 
         if "main" in parts:

@@ -305,3 +305,26 @@ def test_a_gain_the_held_out_quarters_do_not_confirm_is_kept_at_1(run, tmp_path)
                      out), out
     assert "joint 2's torque gain" in err and "kept at 1 (the prior's), the log cannot tell" in err, err
     assert "torque constant in your driver" not in err
+
+
+def _printed_shares(output: str, start: str, part: int = 0) -> np.ndarray:
+    """The ``part``-th three per-joint shares (%) of the printed line that starts with ``start``."""
+    line = next(line for line in output.splitlines() if line.startswith(start))
+    shares = [float(v) for v in re.findall(r"([0-9.e+-]+) %", line.split(": ", 1)[1])]
+    return np.array(shares[3 * part:3 * part + 3]) / 100
+
+
+def test_the_printed_expected_error_covers_the_held_out_trajectory(run):
+    """Issue 39, 3: the expected error on unseen motion that identify prints (1 sigma per joint,
+    prediction.CALIBRATION times the log's-noise sigma) covers at 2 sigma the written model's
+    rigid-body error on the held-out trajectory on every joint, against the device's own inverse
+    dynamics (rotors included, friction not: the figures table's measure)."""
+    expected = _printed_shares(run.general, "expected error on unseen motion")
+    noise = _printed_shares(run.general, "predicted torque uncertainty", part=1)    # over the states
+    np.testing.assert_allclose(expected, 5.5 * noise, rtol=0.05)       # both printed to 2 digits
+    _, theta, dtheta, ddtheta, _ = io.read_trajectory(run.folder / "held_out.csv")
+    truth = DEVICE.phantom.inverse_dynamics(theta, dtheta, ddtheta)
+    error = np.sqrt(((run.identified.phantom.inverse_dynamics(theta, dtheta, ddtheta) - truth) ** 2).mean(0)
+                    / (truth**2).mean(0))
+    print("held-out error per joint", error, "printed 2 sigma", 2 * expected, "the log's noise alone", 2 * noise)
+    assert (error <= 2 * expected).all(), (error, expected)
