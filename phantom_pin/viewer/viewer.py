@@ -20,12 +20,33 @@ import numpy as np
 import pinocchio as pin
 import umsgpack
 from meshcat.animation import Animation
-from pinocchio.visualize import MeshcatVisualizer
 
 from phantom_pin._validation import as_state, as_states, output_path
 from phantom_pin.dynamics.loader import load
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.viewer.server import MeshcatServer
+
+
+def _meshcat_visualizer() -> type:
+    """pinocchio.visualize.MeshcatVisualizer. The package's __init__ also loads its viser viewer,
+    which imports trimesh (0.47 s of CPU, scipy.spatial's among it) before it finds viser
+    missing; where viser is not installed that viewer cannot work, so trimesh is held back for
+    that import (unless something imported it already) and released after it (DEVELOPERS.md)."""
+    import importlib.util
+    import sys
+
+    held = "trimesh" not in sys.modules and importlib.util.find_spec("viser") is None
+    if held:
+        sys.modules["trimesh"] = None  # type: ignore[assignment]   # import trimesh: ImportError
+    try:
+        from pinocchio.visualize import MeshcatVisualizer
+    finally:
+        if held and sys.modules.get("trimesh", False) is None:
+            del sys.modules["trimesh"]
+    return MeshcatVisualizer
+
+
+MeshcatVisualizer = _meshcat_visualizer()
 
 #: Camera position (m, base_link) from which the whole workspace is in view. meshcat
 #: 0.3's orbit controls always look at the world origin, here the shoulder.

@@ -286,3 +286,20 @@ def test_show_trajectory_refuses_what_it_cannot_play(tmp_path, cli):
         assert not html.exists()
     code, out, err = cli("--model", "touch", "show", "--trajectory", files["six"], "--html", html)
     assert code == 0 and err.count("\n") == 1 and "warning: --trajectory: gimbal" in err and "t = 1 s" in err, err
+
+
+def test_the_viewer_holds_back_trimesh_and_leaves_it_importable():
+    """pinocchio.visualize's viser viewer imports trimesh (0.47 s) even where viser is missing;
+    the viewer holds it back for that import alone. In a fresh interpreter: after importing the
+    viewer, trimesh is not loaded, and then imports (with yourdfpy, which needs it) and works."""
+    import subprocess
+    import sys
+
+    script = ("import importlib.util, sys\n"
+              "assert importlib.util.find_spec('viser') is None\n"
+              "import phantom_pin.viewer\n"
+              "assert 'trimesh' not in sys.modules, 'the viewer loaded trimesh'\n"
+              "import trimesh, yourdfpy\n"
+              "assert trimesh.creation.box().volume == 1.0\n")
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
