@@ -96,7 +96,6 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
                 pytest.fail(missing, pytrace=False)
 
 
-
 #: Tests kept on one pytest-xdist worker, in the order collected (pyproject's addopts: -n auto
 #: --dist loadgroup; every other test is handed out one by one): a group name for each test
 #: whose node id contains the key. A module whose module-scoped fixture (or a cache of its
@@ -122,37 +121,6 @@ GROUPS = {
     "integration/test_drivers_ros2.py::test_the_stylus_floats": "ros2",
     "integration/test_drivers_ros2.py::test_without_the_node": "ros2",
 }
-
-#: Tests that start a meshcat server (a share of the lock below), and those that check that a
-#: server's URL is dead once it stopped (the whole lock): meshcat takes the first free port
-#: from 7000, so a server another worker started meanwhile would answer there.
-MESHCAT_SERVERS = ("viewer/test_viewer.py::", "viewer/test_server.py::", "cli/test_cli.py::test_show_html_",
-                   "description/test_gimbal.py::test_the_viewer_",
-                   "config/test_touch_model.py::test_the_command_line_serves_the_touch",
-                   "integration/test_examples.py::test_visualize_",
-                   "integration/test_examples.py::test_existing_output_is_kept_without_force",
-                   "integration/test_pictures.py::test_the_script_",           # docs/pictures.py's Viewer
-                   "integration/test_docs_site.py::test_the_python_blocks_")   # docs/tools.md's Viewer
-MESHCAT_URL_CHECKS = ("cli/test_cli.py::test_show_serves_", "cli/test_cli.py::test_show_stops_")
-
-
-@pytest.hookimpl(wrapper=True)
-def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> object:
-    """Under xdist, a lock file the workers share, held over a test's setup, call and teardown
-    (module fixtures' servers included): MESHCAT_SERVERS share it, MESHCAT_URL_CHECKS hold it
-    alone (no other worker's server starts during them)."""
-    exclusive = any(key in item.nodeid for key in MESHCAT_URL_CHECKS)
-    if not os.environ.get("PYTEST_XDIST_WORKER") or not (
-            exclusive or any(key in item.nodeid for key in MESHCAT_SERVERS)):
-        return (yield)
-    import fcntl
-
-    # the run's temporary root, shared by its workers (each has its own basetemp below it)
-    path = item.config._tmp_path_factory.getbasetemp().parent / "meshcat-ports.lock"  # type: ignore[attr-defined]
-    with open(path, "a") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
-        return (yield)
-
 
 def group(nodeid: str) -> str | None:
     """The GROUPS name of a test's node id, or None."""
