@@ -575,7 +575,10 @@ def coverage_notes(rows: list[Row]) -> list[str]:
         return []
     covered = sum(row.coverage <= 1 for row in written)
     scores = np.sort([row.score for row in written])
-    rank = min(len(scores), int(np.ceil(0.9 * (len(scores) + 1))))
+    rank = int(np.ceil(0.9 * (len(scores) + 1)))
+    if rank > len(scores):      # fewer than 9 rows: no 90 % quantile
+        return [f"the held-out trajectory's error within the printed 2 sigma on every joint: {covered} of "
+                f"{len(written)} written models (too few for a split-conformal factor: 9 or more)"]
     return [f"the held-out trajectory's error within the printed 2 sigma (the expected error on unseen motion, "
             f"{CALIBRATION:g} x the log's-noise sigma) on every joint: {covered} of {len(written)} written models "
             f"({100 * covered / len(written):.0f} %); the held-out error over the log's-noise sigma, worst joint: "
@@ -843,8 +846,9 @@ def main(argv: list[str] | None = None) -> int:
                              "--quick: main")
     parser.add_argument("--rest-seeds", type=int, default=4, help="rest postures: seeded sets per setup (default 4)")
     parser.add_argument("--seed", type=int, default=0,
-                        help="added to the main table's seeds (default 0, the documented table; 1: the calibration "
-                             "set of prediction.CALIBRATION)")
+                        help="added to the seeds of the main table and of the bags table, which takes the Touch's "
+                             "log from it (default 0, the documented tables; 1: the calibration set of "
+                             "prediction.CALIBRATION)")
     parser.add_argument("--output", "-o", type=Path, help="also write the table to this file")
     parser.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     args = parser.parse_args(argv)

@@ -105,8 +105,9 @@ def test_release_lets_the_stylus_go_at_the_next_tick_and_not_before(device):
     for _ in range(100):
         simulation.tick()
         given.tick()
-    simulation.release()
-    assert simulation.ticks == given.ticks == 100 and simulation.q == given.q
+    hold = simulation.hold
+    simulation.release()                                                  # let go already: nothing
+    assert simulation.hold == hold and simulation.ticks == given.ticks == 100 and simulation.q == given.q
     assert tip(device, RELEASES[0])[1] - tip(device, simulation.q)[1] > 1e-4
 
 

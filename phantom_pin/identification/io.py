@@ -61,11 +61,21 @@ class Log:
 
 def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> None:
     """``columns`` as a header line, then ``table``'s rows, each number with 17 significant digits
-    (what np.savetxt(..., fmt="%.17g") writes, byte for byte, formatted in one pass: half its time)."""
+    (what np.savetxt(..., fmt="%.17g") writes, byte for byte), formatted 10 000 rows at a time in
+    one pass each: half savetxt's time, and memory bounded for any length."""
     rows = np.asarray(table, dtype=float)
     rows = rows[:, None] if rows.ndim == 1 else rows
     line = ",".join(["%.17g"] * rows.shape[1]) + "\n"
-    Path(path).write_text(",".join(columns) + "\n" + (line * len(rows)) % tuple(rows.ravel().tolist()))
+    with open(path, "w", encoding="ascii") as file:
+        if columns:
+            file.write(",".join(columns) + "\n")
+        for start in range(0, len(rows), _CHUNK):
+            part = rows[start:start + _CHUNK]
+            file.write((line * len(part)) % tuple(part.ravel().tolist()))
+
+
+#: Rows formatted at once by write_csv.
+_CHUNK = 10_000
 
 
 def write_log(path: Path | str, t: object, theta: object, tau: object, force: bool = False) -> None:

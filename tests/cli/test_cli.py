@@ -11,6 +11,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -182,6 +183,29 @@ def _server_child(pid: int) -> int | None:
     return None
 
 
+def _holding(token: str) -> set[int]:
+    """The pids of the processes whose environment holds ``token`` (a command's and its
+    children's: they inherit it), from /proc."""
+    found = set()
+    for path in Path("/proc").glob("[0-9]*/environ"):
+        try:
+            if token.encode() in path.read_bytes():
+                found.add(int(path.parent.name))
+        except OSError:                  # a process that ended meanwhile
+            continue
+    return found
+
+
+def _none_left(token: str, within: float = 10.0) -> bool:
+    """True once no process holds ``token`` (zombies count as gone: their environment is empty)."""
+    deadline = time.monotonic() + within
+    while _holding(token):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.05)
+    return True
+
+
 @pytest.mark.parametrize("stop, parent_ignores_sigint", [
     (signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, True)])
 def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
@@ -193,8 +217,10 @@ def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
     def ignore_sigint():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
 
+    token = f"PHANTOM_PIN_TEST={uuid.uuid4()}"
     process = subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "show"], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True, start_new_session=True,
+                               env={**os.environ, "PHANTOM_PIN_TEST": token.split("=")[1]},
                                preexec_fn=ignore_sigint if parent_ignores_sigint else None)
     try:
         line = process.stdout.readline()
@@ -203,7 +229,7 @@ def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
         with urllib.request.urlopen(url, timeout=10) as response:
             assert response.status == 200
         server = _server_child(process.pid)
-        assert server is not None
+        assert server is not None and server in _holding(token)    # how the test below finds it
         process.send_signal(stop)
         assert process.wait(30) == 0
     finally:
@@ -220,15 +246,17 @@ def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
 def test_show_stops_the_same_way_on_a_signal_right_after_the_url(stop):
     """The signal sent the moment the URL line arrives, twice: `show` exits 0 and takes its
     server with it every time (before: the handler came after the URL, so a SIGINT in between
-    ended it with 130, 1 run in 3 under load). The server child is looked up right after the
-    signal: found, it must be gone once `show` exited; not found, it went already."""
+    ended it with 130, 1 run in 3 under load). No process of the command's (its environment's
+    token, which its server inherits: test_show_serves_on_loopback_until_interrupted checks that)
+    is left once it exited."""
     for _ in range(2):
+        token = f"PHANTOM_PIN_TEST={uuid.uuid4()}"
         process = subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "show"], stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE, text=True, start_new_session=True)
+                                   stderr=subprocess.PIPE, text=True, start_new_session=True,
+                                   env={**os.environ, "PHANTOM_PIN_TEST": token.split("=")[1]})
         try:
             line = process.stdout.readline()
             process.send_signal(stop)
-            server = _server_child(process.pid)
             assert line.split(" at ")[1].startswith("http://127.0.0.1:"), line
             assert process.wait(30) == 0, process.stderr.read()
         finally:
@@ -237,7 +265,7 @@ def test_show_stops_the_same_way_on_a_signal_right_after_the_url(stop):
                 process.wait()
             process.stdout.close()
             process.stderr.close()
-        assert server is None or gone(server)
+        assert _none_left(token)
 
 
 def _config(tmp_path, file, old, new):
