@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -124,16 +125,20 @@ def test_a_bad_message_is_refused_naming_its_field(touch, names, position, field
 RATE, SECONDS = 1000.0, 2.0
 
 
+#: Fast DDS's discovery announcements for processes on loopback (the file says why).
+DISCOVERY = str(Path(__file__).with_name("fastdds_loopback.xml"))
+
+
 def _environment(domain: int | None = None) -> dict[str, str]:
-    """Loopback only, and a ROS domain of this test run alone (``domain``, else one from the
-    process id)."""
-    return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+    """Loopback only, Fast DDS's discovery of DISCOVERY, and a ROS domain of this test run alone
+    (``domain``, else one from the process id)."""
+    return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "FASTDDS_DEFAULT_PROFILES_FILE": DISCOVERY,
             "ROS_DOMAIN_ID": str(1 + os.getpid() % 100 if domain is None else domain), "PYTHONUNBUFFERED": "1"}
 
 
 def in_process(environment: dict[str, str]) -> None:
-    """This process's own nodes (rclpy in the test) in ``environment``'s domain."""
-    os.environ.update({k: v for k, v in environment.items() if k.startswith("ROS_")})
+    """This process's own nodes (rclpy in the test) in ``environment``'s domain and discovery."""
+    os.environ.update({k: v for k, v in environment.items() if k.startswith(("ROS_", "FASTDDS_"))})
 
 
 def _start_node() -> subprocess.Popen:

@@ -67,8 +67,8 @@ LOOPBACK = ("geomagic_touch_x_ros2", "phantom_touch_ros2", "sawsensablephantom")
 
 
 def _environment() -> dict[str, str]:
-    """test_ros2's (loopback), in a ROS domain of this module alone (its tests run one after
-    another, each stopping its processes before the next starts)."""
+    """test_ros2's (loopback, its discovery), in a ROS domain of this module alone (its tests run
+    one after another, each stopping its processes before the next starts)."""
     return environment(1 + (os.getpid() + 37) % 100)
 
 
