@@ -353,11 +353,15 @@ class Row:
     gain: str = "n/a"
     verdict: str = ""
     messages: tuple[str, ...] = ()
-    #: the held-out trajectory's error over the printed 2 sigma (Prediction.expected), worst joint
-    coverage: float = np.nan
     #: the held-out trajectory's error over the log's-noise sigma (Prediction.states), worst joint:
     #: the split-conformal score (calibration)
     score: float = np.nan
+
+    @property
+    def coverage(self) -> float:
+        """The held-out trajectory's error over the printed 2 sigma (Prediction.expected: the
+        log's-noise sigma times CALIBRATION), worst joint: 1 or less is covered."""
+        return self.score / (2 * CALIBRATION)
 
     def goal(self) -> str:
         if not np.isfinite(self.states_error) or self.verdict == "-":
@@ -459,7 +463,6 @@ def judge(figures: Figures, fit: Fit, row: Row, condition: Condition) -> None:
     trajectory = torque_error(model, figures.truth, figures.held_out["trajectory"])
     row.trajectory_error = float(trajectory.max())
     row.states_error = float(torque_error(model, figures.truth, figures.held_out["states"]).max())
-    row.coverage = float((trajectory / (2 * fit.prediction.expected)).max())
     row.score = float((trajectory / fit.prediction.states).max())
     truth = (setup.uneven if condition.friction else setup.truth).config.actuation.friction
     viscous, coulomb = np.asarray(truth.viscous), np.asarray(truth.coulomb)

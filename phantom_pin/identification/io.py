@@ -59,6 +59,10 @@ class Log:
         return fixed_rate(self.t)
 
 
+#: Rows formatted at once by write_csv.
+_CHUNK = 10_000
+
+
 def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> None:
     """``columns`` as a header line, then ``table``'s rows, each number with 17 significant digits
     (what np.savetxt(..., fmt="%.17g") writes, byte for byte), formatted 10 000 rows at a time in
@@ -72,10 +76,6 @@ def write_csv(path: Path | str, columns: tuple[str, ...], table: np.ndarray) -> 
         for start in range(0, len(rows), _CHUNK):
             part = rows[start:start + _CHUNK]
             file.write((line * len(part)) % tuple(part.ravel().tolist()))
-
-
-#: Rows formatted at once by write_csv.
-_CHUNK = 10_000
 
 
 def write_log(path: Path | str, t: object, theta: object, tau: object, force: bool = False) -> None:

@@ -23,7 +23,6 @@ from phantom_pin import closed_form as cf
 from phantom_pin import describe
 from phantom_pin.config import MODELS, read
 from phantom_pin.config.sampling import random_states
-from test_server import gone
 
 CONFIG_DIR, URDF_PATH = MODELS["premium_1_5"].config, MODELS["premium_1_5"].urdf
 
@@ -238,7 +237,7 @@ def test_show_serves_on_loopback_until_interrupted(stop, parent_ignores_sigint):
             process.wait()
         process.stdout.close()
         process.stderr.close()
-    assert gone(server)  # the server went with the command
+    assert _none_left(token)  # the server went with the command
 
 
 @pytest.mark.slow

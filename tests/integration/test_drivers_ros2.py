@@ -1,12 +1,12 @@
-"""End to end over ROS 2 on loopback, with the real rclpy: for every driver profile whose message types
-install here, the simulated driver (phantom-pin sim-driver) and the node (phantom-pin ros2 --driver)
-as two processes. Let go (SIGUSR1) once this test's own node receives the states and the forces, the
-stylus floats (within 2 mm for FLOAT s; for kinisi's one-tick driver only the node's part is
-asserted, docs/drivers.md); a user's 0.5 N up lifts it; the force the node publishes, taken back to
-OpenHaptics' frame by the driver's own formula (driver_reference), holds the Touch's gravity from
-the closed form (1e-9 N m); without the node the stylus falls. omni_msgs (geomagic_touch_ros2) is
-not on PyPI: the node refuses that profile in one line, and the documents' one-file relay
-(`--relay`) is run as printed with a stand-in for omni_msgs."""
+"""End to end over ROS 2 on loopback, with the real rclpy: for one driver profile per kind of force
+message among those whose message types install here (LOOPBACK), the simulated driver (phantom-pin
+sim-driver) and the node (phantom-pin ros2 --driver) as two processes. Let go (SIGUSR1) once this
+test's own node receives the states and the forces, the stylus floats (within 2 mm for FLOAT s; for
+kinisi's one-tick driver only the node's part is asserted, docs/drivers.md); a user's 0.5 N up lifts
+it; the force the node publishes, taken back to OpenHaptics' frame by the driver's own formula
+(driver_reference), holds the Touch's gravity from the closed form (1e-9 N m); without the node the
+stylus falls. omni_msgs (geomagic_touch_ros2) is not on PyPI: the node refuses that profile in one
+line, and the documents' one-file relay (`--relay`) is run as printed with a stand-in for omni_msgs."""
 
 from __future__ import annotations
 
