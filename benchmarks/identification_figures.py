@@ -8,7 +8,7 @@ prior, the estimated delay), judged on the WRITTEN model against the device.
 Four tables, each selected by ``--parts`` (default all of them; --quick: main): ``main``, the
 conditions below; ``touch``, the issue's Touch case; ``rest``, gravity from rest postures; ``bags``,
 identify BAG against the same log's CSV (issue 39; each described at the end). Measured on the
-shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 35 s of wall time;
+shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 48 s of wall time;
 --quick (5 rows) in 13-24 s; ``--parts touch`` in 7 s, ``--parts rest`` (3 setups x 4 seeds) in
 3 s, ``--parts bags`` in 13 s (the Touch's excite trajectory and log included). One BLAS thread
 (OPENBLAS_NUM_THREADS=1, set here unless given, as the tests set it): OpenBLAS's threads change

@@ -4,7 +4,8 @@
    log's length and motion, the torques' size and sign against the prior's prediction; the
    friction speed threshold and the torque timing, where not given, chosen on held-out
    quarters of the log (selection.py);
-2. timing (timing.py): the delay between positions and torques, estimated or given; for a
+2. timing (timing.py): the delay between positions and torques, estimated (where the angles are
+   noisy, on the log filtered at a lower cutoff: filtering.quiet_cutoff) or given; for a
    closed-loop log with its reference, every stage from here uses instrumental variables
    (instruments.py: the torque noise the loop feeds back into the motion biases least squares);
 3. gains (least_squares.solve_gains): each joint's torque gain relative to joint 1, corrected
@@ -30,7 +31,7 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
 from phantom_pin.identification import checks
 from phantom_pin.identification import prior as priors
-from phantom_pin.identification.filtering import MIN_CYCLES, MIN_SPEED, Samples, filtered
+from phantom_pin.identification.filtering import MIN_CYCLES, MIN_SPEED, Samples, filtered, quiet_cutoff
 from phantom_pin.identification.fit import Curves, Fit
 from phantom_pin.identification.instruments import Instruments, instrumented_delay, instruments, reference_angles
 from phantom_pin.identification.io import Log
@@ -137,7 +138,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     ``Fit.timing_scores``); both timings are also fitted (``Fit.timing_residual``). ``prior_spread``: the prior's
     relative standard deviation of every physical parameter (prior.py; inf: the log alone).
     ``delay`` (s): how long after the positions they belong to the torques were logged, or
-    None to estimate it (timing.py). ``gains``: estimate each joint's torque gain relative to
+    None to estimate it (timing.py; where the angles are noisy, on the log filtered at a lower
+    cutoff: filtering.quiet_cutoff, ``Fit.delay_cutoff``). ``gains``: estimate each joint's torque gain relative to
     joint 1 (``Fit.gains``), or take the log's torques as they are (False). ``min_speed``
     (rad/s): a joint's equation is fitted where its rate stays above it (filtering.MIN_SPEED);
     None: chosen from the log on held-out parts of it (selection.py; ``Fit.min_speed``).
@@ -161,8 +163,7 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
             progress(share)
 
     angles = None if reference is None else reference_angles(log, reference)
-    # instrumented gains are biased under unmodelled friction and quantization (docs/identification.md:
-    # joint 2's came out 1.185 for a true 1.02, and corrected, on the CAD's "all at once" lab log): kept at 1
+    # instrumented, the gains are biased (joint 2: 1.185 for a true 1.02; docs/identification.md): kept at 1
     gains = gains and angles is None
     checks.refuse_log(log, phantom)
     ready = _regression(log, phantom, cutoff, structure, timing, spread, 0.0 if delay is None else delay,
@@ -171,8 +172,9 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     if angles is not None:
         ready = dataclasses.replace(ready, instruments=instruments(
             log, angles, ready.structure, cutoff, ready.samples, phantom.config.actuation.friction, timing))
+    quiet = _quiet(log, phantom, ready, cutoff, delay, timing)
     stage(0.4)
-    timed = _timing_and_gains(ready, timing, delay, gains)
+    timed = _timing_and_gains(ready, timing, delay, gains, quiet[2])
     stage(0.5)
     chosen, phi, moving, p = ready.structure, ready.phi, ready.moving, ready.phi.shape[-1]
     log_sigma = np.sqrt(np.diag(inverse_information(timed.information)))[:p]
@@ -185,15 +187,14 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
     fit = Fit(structure=chosen.name, names=chosen.base_names, units=chosen.units, beta=timed.beta, sigma=sigma,
               rms=rms(y - phi @ timed.beta, moving), written_rms=rms(y - phi @ written, moving),
               torque_rms=rms(y, moving), condition=condition_number(phi.reshape(-1, phi.shape[-1])),
-              samples=len(samples.theta), x=x,
-              written=written, overrides=chosen.overrides(x), comparison=_comparison(chosen, phantom, samples),
-              gains=timed.gains, gains_estimated=timed.estimated, prior_beta=ready.beta0,
-              log_beta=timed.log_beta[:p], log_sigma=log_sigma, log_rms=timed.log_rms,
+              samples=len(samples.theta), x=x, written=written, overrides=chosen.overrides(x),
+              comparison=_comparison(chosen, phantom, samples), gains=timed.gains, gains_estimated=timed.estimated,
+              prior_beta=ready.beta0, log_beta=timed.log_beta[:p], log_sigma=log_sigma, log_rms=timed.log_rms,
               prediction=judge(chosen.regressor_of, phantom.config.limits, phi, y, moving, written, covariance,
                                ready.beta0, information, priors.typical(chosen.matrix, chosen.scale),
                                chosen.base_names, spread),
-              delay=timed.delay, delay_estimated=delay is None, timing=timing, timing_residual=timed.residuals,
-              timing_scores=ready.timing_scores,
+              delay=timed.delay, delay_estimated=delay is None, delay_cutoff=quiet[:2], timing=timing,
+              timing_residual=timed.residuals, timing_scores=ready.timing_scores,
               ratios=phantom.config.actuation.ratios, min_speed=ready.min_speed,
               min_speed_scores=ready.min_speed_scores, gain_scores=timed.gain_scores,
               closed_loop="" if ready.instruments is None else ready.instruments.words(),
@@ -269,9 +270,31 @@ def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timin
                        timing_scores=timing_scores)
 
 
-def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gains: bool) -> _Timed:
-    """Stages 2-4: the delay (s; estimated when None) and the torque gains (corrected where the
-    log shows them), then the fit with the prior; each timing's weighted residual."""
+def _quiet(log: Log, phantom: Phantom, ready: _Regression, cutoff: float, delay: float | None, timing: str
+           ) -> tuple[float, dict[float, float], tuple[Samples, np.ndarray, Callable[[np.ndarray], float]] | None]:
+    """Where the delay is estimated from the residual (``delay`` None, no instruments: theirs is
+    instrumented), the cutoff (Hz) the angles' noise allows below the fit's ``cutoff`` and each
+    cutoff's noise share (filtering.quiet_cutoff), and where it is lower, the equations the delay
+    is estimated on: the log filtered there at ``timing``, with the fit's threshold and structure
+    (the samples, the known torques tau0 (N, 3; N m), the weighted residual: timing.criterion);
+    else (``cutoff``, {}, None)."""
+    if delay is not None or ready.instruments is not None:
+        return cutoff, {}, None
+    quiet, shares = quiet_cutoff(log, cutoff)
+    if quiet == cutoff:
+        return cutoff, shares, None
+    samples = filtered(log, quiet, phantom.config.actuation.friction, timing, 0.0, ready.min_speed)
+    phi, tau0 = ready.structure.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
+    moving = samples.moving
+    return quiet, shares, (samples, tau0, criterion(phi * moving[..., None], moving,
+                                                    rms(samples.filtered_tau[samples.index] - tau0, moving)))
+
+
+def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gains: bool,
+                      quiet: tuple[Samples, np.ndarray, Callable[[np.ndarray], float]] | None = None) -> _Timed:
+    """Stages 2-4: the delay (s; estimated when None, on the ``quiet`` equations where given:
+    ``_quiet``) and the torque gains (corrected where the log shows them), then the fit with the
+    prior; each timing's weighted residual."""
     samples, tau0, moving, measured, prior = ready.samples, ready.tau0, ready.moving, ready.phi, ready.prior
     phi = ready.solved                     # measured, or its projection on the instruments
     residuals_with = None if ready.instruments is None else measured       # least_squares.fit's measured
@@ -280,8 +303,8 @@ def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gain
     def lag(scale: np.ndarray) -> tuple[float, Samples]:
         """The delay estimated on the torques times ``scale`` (joint 1's scale), and the samples at it."""
         if ready.instruments is None:
-            found = estimate_delay(samples.filtered_tau * scale, samples.rate, samples.index, tau0, weighted,
-                                   HOLD[timing])
+            on, known, residual = quiet or (samples, tau0, weighted)
+            found = estimate_delay(on.filtered_tau * scale, on.rate, on.index, known, residual, HOLD[timing])
         else:
             found = instrumented_delay(ready.instruments, samples, measured, phi, tau0, moving, prior,
                                        HOLD[timing], scale)

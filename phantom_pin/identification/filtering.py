@@ -10,6 +10,25 @@ torque are smeared alike in the regressor (without it, viscous friction came out
 depending on the cutoff). The rigid-body columns, smooth functions of a motion far below the
 cutoff, pass the filter unchanged and are computed at the kept samples. The filter's edge
 transients are cut and the samples decimated to about 5 times the cutoff.
+
+The delay between positions and torques (timing.py) is estimated from a second filtering where
+the log's angles are noisy (``quiet_cutoff``): at the highest of CUTOFFS, up to the fit's, at
+which the angles' noise stays within NOISE_SHARE (1 %) of the filtered acceleration on every joint. The
+filter differentiates the angles twice, so their noise (an encoder's steps) reaches the
+acceleration column amplified about as the cutoff's 2.5th power; a servo loop's controller feeds
+the same steps into the logged torques through its rate gain, and a torque read a little early
+then cancels part of the acceleration's noise: the residual's delay estimate comes out early.
+Measured on a lab's 60 s sum of sines with the CAD device's encoder quantization
+(benchmarks/identification_figures.py): at 20 Hz the noise was 2.6 % of the acceleration and the
+delay came out -0.56 ms (true 0), writing viscous friction 10.5 % high; estimated at 14 Hz
+(1.05 %), -0.18 ms; at 10 Hz (0.45 %), 0.05 ms, and the fit at 20 Hz with it wrote friction within
+1.4 %. The fit itself stays at the cutoff given: on the tests' lab logs with 1 % torque noise and
+quantization, fitting at 10 Hz instead of 20 made the narrow log's written model worse (joint 2:
+2.7 -> 8.2 % on 500 states). The noise is estimated from the angles alone: the third difference
+of what the highest cutoff removes, whose standard deviation is sqrt(20) times a white noise's;
+its share is that times the filter's noise gain (the root sum of squares of its impulse
+response, filtered forwards and backwards and differentiated twice) over the filtered
+acceleration's RMS.
 """
 
 from __future__ import annotations
@@ -43,6 +62,9 @@ RATE_PER_CUTOFF = 20.0
 #: uncertainty of a wide one optimistic (0.15 % predicted, 0.66 % shown), the samples it drops
 #: having carried the noise's share of the residual.
 MIN_SPEED = 0.01
+#: The cutoffs (Hz) quiet_cutoff tries below the fit's, highest first, and the share of each
+#: joint's filtered acceleration RMS the angles' noise may reach at the one chosen (module doc).
+CUTOFFS, NOISE_SHARE = (14.0, 10.0), 0.01
 
 
 @dataclasses.dataclass(frozen=True)
@@ -71,6 +93,54 @@ class Samples:
         return dataclasses.replace(self, tau=scale * lagged(self.filtered_tau, self.rate, self.index, lag))
 
 
+def _butterworth(cutoff: float, rate: float) -> np.ndarray:
+    """The filter's second-order sections at ``cutoff`` (Hz) for a log at ``rate`` (Hz);
+    LogError naming ``cutoff`` where the rate is too low for central differences at it."""
+    if not 0 < cutoff * RATE_PER_CUTOFF <= rate:
+        raise LogError(f"{cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
+                       f"(this one: {rate:.4g} Hz; central differences need {RATE_PER_CUTOFF:g} samples per "
+                       "second per hertz of cutoff); lower --cutoff or log faster", argument="cutoff")
+    # imported here: scipy.signal takes 0.4 s, which every command line start paid
+    import scipy.signal
+
+    return scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
+
+
+def _acceleration(theta: np.ndarray, sos: np.ndarray, rate: float) -> np.ndarray:
+    """``theta`` (N, ...) rad low-passed forwards and backwards by ``sos`` and differentiated
+    twice by central differences at ``rate`` (Hz): rad/s^2."""
+    import scipy.signal
+
+    smooth = scipy.signal.sosfiltfilt(sos, theta, axis=0)
+    return np.gradient(np.gradient(smooth, 1.0 / rate, axis=0), 1.0 / rate, axis=0)
+
+
+def quiet_cutoff(log: Log, highest: float) -> tuple[float, dict[float, float]]:
+    """(the cutoff chosen, Hz; each cutoff tried and its noise share: the largest over the joints
+    of the angles' noise in the filtered acceleration over its RMS) of ``log``: the highest of
+    ``highest`` (Hz, the fit's cutoff, valid for the log) and the CUTOFFS below it whose share is
+    NOISE_SHARE or less, else the lowest of them the log's length allows (module doc)."""
+    import scipy.signal
+
+    rate, duration = log.rate, float(log.t[-1] - log.t[0])
+    tried = [highest] + [c for c in CUTOFFS if c < highest and c * duration >= MIN_CYCLES]
+    edge = int(np.ceil(EDGE * rate))
+    inside = slice(edge, len(log.t) - edge)
+    residual = log.theta - scipy.signal.sosfiltfilt(_butterworth(highest, rate), log.theta, axis=0)
+    noise = np.diff(residual[inside], 3, axis=0).std(axis=0) / np.sqrt(20.0)        # rad, per joint
+    impulse = np.zeros(2 * int(np.ceil(rate)) + 1)
+    impulse[len(impulse) // 2] = 1.0
+    shares: dict[float, float] = {}
+    for cutoff in tried:
+        sos = _butterworth(cutoff, rate)
+        gain = float(np.sqrt((_acceleration(impulse, sos, rate) ** 2).sum()))        # 1/s^2 per rad of noise
+        signal = np.sqrt((_acceleration(log.theta, sos, rate)[inside] ** 2).mean(axis=0))
+        shares[cutoff] = float((noise * gain / np.maximum(signal, 1e-300)).max())
+        if shares[cutoff] <= NOISE_SHARE:
+            return cutoff, shares
+    return tried[-1], shares
+
+
 def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay: float = 0.0,
              min_speed: float = MIN_SPEED) -> Samples:
     """The log filtered at ``cutoff`` (Hz), with the friction columns of ``law`` (Friction.torque
@@ -78,15 +148,11 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay
     ``delay`` (s): the torques were logged that long after the positions they belong to, so
     the torque of the positions at t_k is read at t_k + delay (then the hold's half sample)."""
     rate = log.rate
-    if not 0 < cutoff * RATE_PER_CUTOFF <= rate:
-        raise LogError(f"{cutoff:g} Hz needs a log at {RATE_PER_CUTOFF * cutoff:g} Hz or faster "
-                       f"(this one: {rate:.4g} Hz; central differences need {RATE_PER_CUTOFF:g} samples per "
-                       "second per hertz of cutoff); lower --cutoff or log faster", argument="cutoff")
+    sos = _butterworth(cutoff, rate)
     # imported here: scipy.signal and scipy.ndimage take 0.4 s, which every command line start paid
     import scipy.ndimage
     import scipy.signal
 
-    sos = scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
     theta = scipy.signal.sosfiltfilt(sos, log.theta, axis=0)
     tau = scipy.signal.sosfiltfilt(sos, log.tau, axis=0)
     smooth = tau

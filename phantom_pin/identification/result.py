@@ -151,7 +151,11 @@ def speed_line(fit: Fit) -> str:
 
 def timing_lines(fit: Fit) -> list[str]:
     """The delay (estimated or given, ms) and which timing fits the log better, one line each."""
+    cutoff, shares = fit.delay_cutoff
     how = "estimated from the log" if fit.delay_estimated else "given"
+    if len(shares) > 1:
+        how += (f" filtered at {cutoff:g} Hz, where the angles' noise is " + ", ".join(
+            f"{100 * share:.2g} % at {c:g} Hz" for c, share in shares.items()) + " of the filtered acceleration")
     lines = [f"delay between positions and torques: {1e3 * fit.delay:.3f} ms ({how}; the torques are read "
              f"that long after their positions, then the {fit.timing} timing's lag)"]
     if fit.timing_scores:
