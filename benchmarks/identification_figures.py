@@ -65,7 +65,7 @@ error (%, signed) of the estimate (the projection's physical values, per joint) 
 written model, viscous / Coulomb, against the device's per joint; the delay (ms, estimated); the
 estimated torque gain of joint 2 relative to joint 1 +- its standard deviation, and whether
 identify corrected it (the device's is 1.02 under the torque constant's error); what identify
-does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), result.timing_warning(),
+does (accepted, warned, refused: Fit.problems, Fit.prediction.warnings(), result.fit_warnings(),
 each listed under the table); whether the issue's goal (held-out <= 0.5 %, written friction
 within 10 %) is met; and the held-out trajectory's error over the printed 2 sigma (identify's
 expected error on unseen motion, prediction.Prediction.expected; worst joint: 1 or less is
@@ -134,7 +134,7 @@ from phantom_pin.identification import Fit, estimate, io, optimise, overlay, sim
 from phantom_pin.identification import parameterization as pz
 from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.prediction import CALIBRATION
-from phantom_pin.identification.result import gain_warning, timing_warning
+from phantom_pin.identification.result import fit_warnings
 from phantom_pin.identification.structures import General
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
@@ -475,7 +475,7 @@ def judge(figures: Figures, fit: Fit, row: Row, condition: Condition) -> None:
     # conditions: the log's torques times 1.02 are the applied ones, the gain to find)
     values, sigma = fit.gains_estimated
     row.gain = f"{values[1]:.4f} ± {sigma[1]:.1g}" + (" (corrected)" if fit.gains[1] != 1 else "")
-    warnings = [*fit.prediction.warnings(), *(w for w in (timing_warning(fit), gain_warning(fit)) if w)]
+    warnings = [*fit.prediction.warnings(), *fit_warnings(fit)]
     if fit.problems:
         row.verdict, row.messages = "refused", fit.problems + tuple(warnings)
     elif warnings:

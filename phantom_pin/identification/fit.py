@@ -50,9 +50,9 @@ class Fit:
     motion at all); ``prediction``: the predicted torque uncertainty of the written parameters
     (prediction.Prediction). ``delay`` (s): how long after their positions the torques were
     logged, corrected for in the fit; ``delay_estimated``: whether it came from the log;
-    ``delay_cutoff``: (the cutoff it was estimated at, Hz; each cutoff tried and the share of the
-    angles' noise in its filtered acceleration, worst joint: filtering.quiet_cutoff; empty where
-    not estimated or where instrumented);
+    ``rate`` (Hz): the log's; ``delay_cutoff``: (the cutoff it was estimated at, Hz; each
+    cutoff tried and the share of the angles' noise in its filtered acceleration, worst joint:
+    filtering.quiet_cutoff; empty where not estimated or where instrumented);
     ``timing`` the torque timing fitted (timing.TIMINGS); ``timing_residual``: each timing's
     weighted residual (the sum over the joints of the residual's mean square over the
     torque's, at zero delay when it is estimated, else at the given one), the smaller fitting
@@ -90,6 +90,7 @@ class Fit:
     delay: float = 0.0
     delay_estimated: bool = False
     delay_cutoff: tuple[float, dict[float, float]] = (20.0, {})
+    rate: float = 1000.0
     timing: str = "held"
     timing_residual: dict[str, float] = dataclasses.field(default_factory=dict)
     ratios: tuple[float, float, float] | None = None

@@ -22,7 +22,7 @@ from phantom_pin.identification.overlays import overlay
 __all__ = ["Identification", "RefusedError", "identify", "refusal"]
 from phantom_pin._validation import output_path
 from phantom_pin.identification.selection import FOLDS, TIE
-from phantom_pin.identification.timing import TIMING_MARGIN
+from phantom_pin.identification.timing import LEAD_SAMPLES, TIMING_MARGIN
 
 
 @dataclasses.dataclass(frozen=True)
@@ -72,7 +72,7 @@ class Identification:
         """The warnings (one line each): the prediction's, the timing's and the gains', then the
         problems of a fit accepted despite them."""
         fit = self.fit
-        return (fit.prediction.warnings() + [w for w in (timing_warning(fit), gain_warning(fit)) if w]
+        return (fit.prediction.warnings() + fit_warnings(fit)
                 + [f"(written with --accept) {problem}" for problem in fit.problems])
 
     def write(self, path: Path | str, force: bool = False) -> None:
@@ -89,7 +89,7 @@ class Identification:
                  f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
                  "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms)]
         lines += [f"# {line}" for line in timing_lines(fit) + [speed_line(fit)] + gain_lines(fit)]
-        lines += [f"# warning: {w}" for w in (timing_warning(fit), gain_warning(fit)) if w is not None]
+        lines += [f"# warning: {w}" for w in fit_warnings(fit)]
         lines += [f"# {line}" for line in fit.prediction.lines()]
         lines += [f"# warning: {line}" for line in fit.prediction.warnings()]
         lines += ["# base parameters (estimate with the prior +- standard deviation; of the written parameters; "
@@ -175,6 +175,25 @@ def timing_lines(fit: Fit) -> list[str]:
                      + ("; the estimated delay absorbs the timings' half-sample difference" if
                         fit.delay_estimated else ""))
     return lines
+
+
+def fit_warnings(fit: Fit) -> list[str]:
+    """The timing's, the delay's and the gains' warnings (one line each; the prediction's are
+    Prediction.warnings)."""
+    return [w for w in (timing_warning(fit), lead_warning(fit), gain_warning(fit)) if w]
+
+
+def lead_warning(fit: Fit) -> str | None:
+    """One line when the delay estimated from the residual has the torques lead their positions
+    by more than timing.LEAD_SAMPLES samples: a servo loop's noise fed back into the motion, which
+    biases the fit (instrumented, with --reference, the delay is estimated otherwise), else None."""
+    if not fit.delay_estimated or fit.closed_loop or fit.delay >= -LEAD_SAMPLES / fit.rate:
+        return None
+    return (f"the estimated delay, {1e3 * fit.delay:.3f} ms, has the torques logged before the positions they "
+            f"belong to, by more than {LEAD_SAMPLES:g} sample: no logger's, but how torque noise a servo loop feeds "
+            "back into the motion (an amplifier's current noise) looks to the residual, and the friction, gains and "
+            "rigid body are then biased; give the trajectory the loop tracked (--reference TRAJ.csv: instrumental "
+            "variables), or --delay where you know the logger's")
 
 
 def timing_warning(fit: Fit) -> str | None:

@@ -5,7 +5,7 @@ noise back into the motion. Least squares on that log is biased: the delay it es
 to the bracket's -4 ms and viscous friction to +60 %. Given the reference the loop tracked,
 the instrumental-variable estimate finds the simulation's own delay (none) and friction (the
 device's configured law), and a written model within the log's predicted uncertainty.
-Seeded; one 60 s simulation (about 2 s) and two estimates."""
+Seeded; two 60 s simulations (about 2 s each, one without the noise) and three estimates."""
 
 import dataclasses
 import functools
@@ -18,7 +18,7 @@ from phantom_pin import Device, Phantom, describe, drivers
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, LogError, PhantomPinError
-from phantom_pin.identification import estimate, overlay, simulation
+from phantom_pin.identification import estimate, overlay, result, simulation
 from test_prior import sum_of_sines
 
 TRUTH = describe("premium_1_5_cad")
@@ -30,13 +30,14 @@ CLI_DURATION = 20.0
 
 
 @functools.cache
-def closed_loop():
+def closed_loop(current: float = 0.010):
     """(the log, the reference (t, theta)): the device tracking the sum of sines with the prior's
-    torques and friction as feed-forward, PD feedback, 10 mA of current noise in the plant."""
+    torques and friction as feed-forward, PD feedback, ``current`` A (1 sigma) of current noise
+    in the plant (10 mA)."""
     device = Device(Phantom(TRUTH))
     t, theta, dtheta, ddtheta = sum_of_sines(DURATION, AMPLITUDE, SEED)
     tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + PRIOR.config.actuation.friction.torque(dtheta)
-    noise = np.asarray(device.joint_torques(np.full(3, 0.010)), float)       # 10 mA, N m per joint
+    noise = np.asarray(device.joint_torques(np.full(3, current)), float)       # N m per joint
     log = simulation.track(device, t, theta, dtheta, tau, torque_noise=noise, quantization=False, seed=SEED)
     return log, (t, theta)
 
@@ -66,10 +67,23 @@ def fits():
 
 
 def test_least_squares_is_biased_in_the_loop(fits):
-    least_squares, _ = fits
+    """And identify says so: the delay it estimates has the torques lead their positions by more
+    than a sample (result.lead_warning, naming --reference); instrumented, not."""
+    least_squares, iv = fits
     assert least_squares.closed_loop == ""
     assert least_squares.delay < -2e-3                       # the simulation has none
     assert friction_error(least_squares)[0] > 0.3
+    warning = result.lead_warning(least_squares)
+    assert warning.startswith(f"the estimated delay, {1e3 * least_squares.delay:.3f} ms, has the torques logged "
+                              "before the positions") and "--reference TRAJ.csv" in warning, warning
+    assert warning in result.fit_warnings(least_squares) and result.lead_warning(iv) is None
+
+
+def test_the_same_loop_without_its_noise_is_not_warned():
+    """The loop above without current noise: least squares estimates the simulation's delay
+    (none) within 0.1 ms, and there is no lead warning."""
+    fit = estimate(closed_loop(0.0)[0], PRIOR, structure="general", timing="held", delay=None)
+    assert abs(fit.delay) < 1e-4 and result.lead_warning(fit) is None, fit.delay
 
 
 def test_instrumental_variables_find_the_simulation(fits):
