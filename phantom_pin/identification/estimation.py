@@ -193,8 +193,8 @@ def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = 
               prediction=judge(chosen.regressor_of, phantom.config.limits, phi, y, moving, written, covariance,
                                ready.beta0, information, priors.typical(chosen.matrix, chosen.scale),
                                chosen.base_names, spread),
-              delay=timed.delay, delay_estimated=delay is None, delay_cutoff=quiet[:2], rate=log.rate,
-              timing=timing, timing_residual=timed.residuals, timing_scores=ready.timing_scores,
+              delay=timed.delay, delay_estimated=delay is None, delay_cutoff=quiet[:2], timing=timing,
+              timing_residual=timed.residuals, timing_scores=ready.timing_scores,
               ratios=phantom.config.actuation.ratios, min_speed=ready.min_speed,
               min_speed_scores=ready.min_speed_scores, gain_scores=timed.gain_scores,
               closed_loop="" if ready.instruments is None else ready.instruments.words(),
@@ -276,14 +276,19 @@ def _quiet(log: Log, phantom: Phantom, ready: _Regression, cutoff: float, delay:
     instrumented), the cutoff (Hz) the angles' noise allows below the fit's ``cutoff`` and each
     cutoff's noise share (filtering.quiet_cutoff), and where it is lower, the equations the delay
     is estimated on: the log filtered there at ``timing``, with the fit's threshold and structure
-    (the samples, the known torques tau0 (N, 3; N m), the weighted residual: timing.criterion);
-    else (``cutoff``, {}, None)."""
+    (the samples, the known torques tau0 (N, 3; N m), the weighted residual: timing.criterion),
+    unless they leave too little motion (checks.refuse_motion: then the fit's ``cutoff``, the
+    shares and None); else (``cutoff``, {}, None)."""
     if delay is not None or ready.instruments is not None:
         return cutoff, {}, None
     quiet, shares = quiet_cutoff(log, cutoff)
     if quiet == cutoff:
         return cutoff, shares, None
     samples = filtered(log, quiet, phantom.config.actuation.friction, timing, 0.0, ready.min_speed)
+    try:                      # the lower cutoff's longer span around rest leaves fewer equations
+        checks.refuse_motion(samples.moving, quiet, ready.min_speed)
+    except LogError:          # estimated at the fit's cutoff, and the delay line says why
+        return cutoff, shares, None
     phi, tau0 = ready.structure.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     moving = samples.moving
     return quiet, shares, (samples, tau0, criterion(phi * moving[..., None], moving,

@@ -50,7 +50,7 @@ class Fit:
     motion at all); ``prediction``: the predicted torque uncertainty of the written parameters
     (prediction.Prediction). ``delay`` (s): how long after their positions the torques were
     logged, corrected for in the fit; ``delay_estimated``: whether it came from the log;
-    ``rate`` (Hz): the log's; ``delay_cutoff``: (the cutoff it was estimated at, Hz; each
+    ``delay_cutoff``: (the cutoff it was estimated at, Hz; each
     cutoff tried and the share of the angles' noise in its filtered acceleration, worst joint:
     filtering.quiet_cutoff; empty where not estimated or where instrumented);
     ``timing`` the torque timing fitted (timing.TIMINGS); ``timing_residual``: each timing's
@@ -89,8 +89,7 @@ class Fit:
     prediction: Prediction
     delay: float = 0.0
     delay_estimated: bool = False
-    delay_cutoff: tuple[float, dict[float, float]] = (20.0, {})
-    rate: float = 1000.0
+    delay_cutoff: tuple[float, dict[float, float]] = dataclasses.field(default_factory=lambda: (20.0, {}))
     timing: str = "held"
     timing_residual: dict[str, float] = dataclasses.field(default_factory=dict)
     ratios: tuple[float, float, float] | None = None

@@ -16,13 +16,14 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.checks import GAIN_BOUNDS, RefusedError, refusal
 from phantom_pin.identification.estimation import GAIN_EVIDENCE, GAIN_NOTED, NEEDS_GENERAL, Fit, estimate
+from phantom_pin.identification.filtering import NOISE_SHARE
 from phantom_pin.identification.io import Log
 from phantom_pin.identification.overlays import overlay
 
 __all__ = ["Identification", "RefusedError", "identify", "refusal"]
 from phantom_pin._validation import output_path
 from phantom_pin.identification.selection import FOLDS, TIE
-from phantom_pin.identification.timing import LEAD_SAMPLES, TIMING_MARGIN
+from phantom_pin.identification.timing import LEAD, TIMING_MARGIN
 
 
 @dataclasses.dataclass(frozen=True)
@@ -153,9 +154,12 @@ def timing_lines(fit: Fit) -> list[str]:
     """The delay (estimated or given, ms) and which timing fits the log better, one line each."""
     cutoff, shares = fit.delay_cutoff
     how = "estimated from the log" if fit.delay_estimated else "given"
-    if len(shares) > 1:
+    if shares and (len(shares) > 1 or shares[cutoff] > NOISE_SHARE):
         how += (f" filtered at {cutoff:g} Hz, where the angles' noise is " + ", ".join(
             f"{100 * share:.2g} % at {c:g} Hz" for c, share in shares.items()) + " of the filtered acceleration")
+        if shares[cutoff] > NOISE_SHARE:
+            why = "; the quieter cutoffs leave too little motion" if min(shares.values()) <= NOISE_SHARE else ""
+            how += f" (above the {100 * NOISE_SHARE:g} % aimed at{why})"
     lines = [f"delay between positions and torques: {1e3 * fit.delay:.3f} ms ({how}; the torques are read "
              f"that long after their positions, then the {fit.timing} timing's lag)"]
     if fit.timing_scores:
@@ -185,15 +189,15 @@ def fit_warnings(fit: Fit) -> list[str]:
 
 def lead_warning(fit: Fit) -> str | None:
     """One line when the delay estimated from the residual has the torques lead their positions
-    by more than timing.LEAD_SAMPLES samples: a servo loop's noise fed back into the motion, which
-    biases the fit (instrumented, with --reference, the delay is estimated otherwise), else None."""
-    if not fit.delay_estimated or fit.closed_loop or fit.delay >= -LEAD_SAMPLES / fit.rate:
+    by more than timing.LEAD: a servo loop's noise fed back into the motion, which biases the fit
+    (instrumented, with --reference, the delay is estimated otherwise), else None."""
+    if not fit.delay_estimated or fit.closed_loop or fit.delay >= -LEAD:
         return None
     return (f"the estimated delay, {1e3 * fit.delay:.3f} ms, has the torques logged before the positions they "
-            f"belong to, by more than {LEAD_SAMPLES:g} sample: no logger's, but how torque noise a servo loop feeds "
-            "back into the motion (an amplifier's current noise) looks to the residual, and the friction, gains and "
-            "rigid body are then biased; give the trajectory the loop tracked (--reference TRAJ.csv: instrumental "
-            "variables), or --delay where you know the logger's")
+            f"belong to, by more than {1e3 * LEAD:g} ms: not a servo loop's logger, but how torque noise the loop "
+            "feeds back into the motion (an amplifier's current noise) looks to the residual, and the friction, gains "
+            "and rigid body are then biased; give the trajectory the loop tracked (--reference TRAJ.csv: "
+            "instrumental variables), or --delay where you know the logger's")
 
 
 def timing_warning(fit: Fit) -> str | None:

@@ -14,8 +14,9 @@ log 0.23 / 0.29 %; with 0.2, 0.3 and 0.5 tried, the choice is 0.5 rad/s and 0.06
 0.017 / 0.020 %. Tried up to 1 rad/s the choice stayed at or below 0.5 on those logs. So each
 threshold of MIN_SPEEDS is tried on FOLDS contiguous parts of the log:
 fitted (least squares with the prior, at the delay given or zero, gains at 1) on the others and
-judged on the held-out part's samples where every threshold fits (the largest's equations), by
-the sum over the joints of the residual's mean square over the torque's. The smallest threshold
+judged on the held-out part's samples where every threshold fits (the largest's equations; a
+threshold that leaves a joint fewer than checks.MIN_SAMPLES / FOLDS equations in some part is not
+tried), by the sum over the joints of the residual's mean square over the torque's. The smallest threshold
 within SPEED_TIE of the best is chosen (it keeps the most samples).
 """
 
@@ -66,12 +67,16 @@ def choose_min_speed(log: Log, phantom: Phantom, structure: Structure, cutoff: f
     if not candidates:
         assert refused is not None
         raise refused
-    moving = {speed: candidate.moving for speed, candidate in candidates.items()}
     samples = next(iter(candidates.values()))         # all alike but for moving
+    part = parts(len(samples.theta))
+    # judged on the largest threshold's equations: each joint needs some in every part
+    counts = {speed: min(int((c.moving & (part == k)[:, None]).sum(axis=0).min()) for k in range(FOLDS))
+              for speed, c in candidates.items()}
+    moving = {speed: c.moving for speed, c in candidates.items() if counts[speed] >= checks.MIN_SAMPLES / FOLDS
+              or speed == min(candidates)}
     phi, tau0 = structure.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
     y = samples.tau - tau0
     judged = moving[max(moving)]                                           # where every threshold fits
-    part = parts(len(y))
     scores = {speed: _held_out(phi, y, mask, judged, part, prior) for speed, mask in moving.items()}
     best = min(scores.values())
     chosen = min(speed for speed, score in scores.items() if score <= (1 + SPEED_TIE) * best)

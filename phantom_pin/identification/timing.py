@@ -29,14 +29,15 @@ DELAY_BRACKET, GRID_STEP = (-5e-3, 5e-3), 2.5e-4
 #: The delays (s) accepted when given: from the bracket's start to a tenth of a second (less
 #: than the filter's edge cut, filtering.EDGE: the shifted torques stay inside the log).
 DELAY_RANGE = (DELAY_BRACKET[0], 0.1)
-#: An estimated delay below -LEAD_SAMPLES samples (torques logged more than a sample before the
+#: An estimated delay below -LEAD (s: torques logged more than a 1 kHz loop's sample before the
 #: positions they belong to) is not a logger's: it is what torque noise a servo loop feeds back
 #: into the motion looks like to the residual (the loop's reaction to the noise-driven motion fits
 #: a torque read early). Measured on the figures table's lab logs with 10 mA of current noise
 #: (benchmarks/identification_figures.py): -4.15 ms (CAD device) and -1.54 ms (report-structured);
-#: no other row of the table below -0.1 ms. A warning (result.lead_warning), which names
-#: --reference.
-LEAD_SAMPLES = 1.0
+#: no other row of the table below -0.1 ms. In seconds, not samples: a driver's record at 200 Hz
+#: has a 5 ms sample, the bracket's edge. A warning (result.lead_warning), which names --reference
+#: and --delay (a logger known to lead).
+LEAD = 1e-3
 #: The timing given fits "markedly" worse than the other when its weighted residual (the sum
 #: of the joints' squared residual shares) exceeds the other's by this share: then a warning.
 TIMING_MARGIN = 0.05

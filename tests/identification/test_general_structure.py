@@ -323,7 +323,7 @@ def test_the_printed_expected_error_covers_the_held_out_trajectory(run):
     dynamics (rotors included, friction not: the figures table's measure)."""
     expected = _printed_shares(run.general, "expected error on unseen motion")
     noise = _printed_shares(run.general, "predicted torque uncertainty", part=1)    # over the states
-    np.testing.assert_allclose(expected, 5.0 * noise, rtol=0.11)       # each printed to 2 digits: 5.5 % apiece
+    np.testing.assert_allclose(expected, 5.0 * noise, rtol=0.11)   # printed to 2 digits: up to 5.5 % off apiece
     _, theta, dtheta, ddtheta, _ = io.read_trajectory(run.folder / "held_out.csv")
     truth = DEVICE.phantom.inverse_dynamics(theta, dtheta, ddtheta)
     error = np.sqrt(((run.identified.phantom.inverse_dynamics(theta, dtheta, ddtheta) - truth) ** 2).mean(0)

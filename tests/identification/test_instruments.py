@@ -68,7 +68,7 @@ def fits():
 
 def test_least_squares_is_biased_in_the_loop(fits):
     """And identify says so: the delay it estimates has the torques lead their positions by more
-    than a sample (result.lead_warning, naming --reference); instrumented, not."""
+    than 1 ms (result.lead_warning, naming --reference); instrumented, not."""
     least_squares, iv = fits
     assert least_squares.closed_loop == ""
     assert least_squares.delay < -2e-3                       # the simulation has none

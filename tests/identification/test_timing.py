@@ -7,6 +7,7 @@ n samples late (1 kHz: n ms), so the true delay is known exactly; friction is ju
 the device's own (VISCOUS, COULOMB), held-out torques against its own inverse dynamics on 500
 seeded states inside the stops."""
 
+import dataclasses
 import re
 
 import numpy as np
@@ -226,3 +227,43 @@ def test_a_delay_between_the_grid_points_is_estimated_to_a_tenth_of_the_grid_ste
     fit = estimation.estimate(io.Log(T10, theta, model_torques(phantom, *sines(T10 - delay))), phantom,
                               timing="sampled", delay=None)
     assert fit.delay_estimated and abs(fit.delay - delay) < 2.5e-5, fit.delay
+
+
+def test_the_delay_line_says_where_the_angles_noise_stays_above_its_aim(held_log):
+    """result.timing_lines on one fit with each quiet-cutoff outcome put in (dataclasses.replace):
+    the fit's own cutoff within filtering.NOISE_SHARE, nothing said; a lower one chosen, the shares
+    (test_identify_reports_the_delay_and_refuses_a_bad_one); every cutoff above the aim, the
+    lowest chosen and said to be above it; the quieter cutoff within it but left for too little
+    motion, the fit's cutoff and why. A delay leading its positions by 1 ms is a logger's, by more
+    a closed loop's noise (result.lead_warning, timing.LEAD); a given one is never warned."""
+    fit = estimation.estimate(held_log, PRIOR, delay=None)
+
+    def line(cutoff, shares):
+        return result.timing_lines(dataclasses.replace(fit, delay_cutoff=(cutoff, shares)))[0]
+    assert "estimated from the log; the torques" in line(20.0, {20.0: 0.005})
+    assert ("filtered at 10 Hz, where the angles' noise is 8 % at 20 Hz, 3 % at 14 Hz, 1.5 % at 10 Hz of the filtered "
+            "acceleration (above the 1 % aimed at); the torques") in line(10.0, {20.0: 0.08, 14.0: 0.03, 10.0: 0.015})
+    left = line(20.0, {20.0: 0.02, 14.0: 0.008})
+    assert ("filtered at 20 Hz, where the angles' noise is 2 % at 20 Hz, 0.8 % at 14 Hz of the filtered acceleration "
+            "(above the 1 % aimed at; the quieter cutoffs leave too little motion)") in left
+    assert result.lead_warning(dataclasses.replace(fit, delay=-1.0e-3)) is None
+    assert "-1.010 ms, has the torques logged before" in result.lead_warning(dataclasses.replace(fit, delay=-1.01e-3))
+    assert result.lead_warning(dataclasses.replace(fit, delay=-4e-3, delay_estimated=False)) is None
+
+
+def test_a_quieter_cutoff_that_leaves_too_little_motion_is_not_used(held_log, monkeypatch):
+    """Where the log filtered at the quieter cutoff leaves too little motion (checks.refuse_motion
+    made to refuse every cutoff but the fit's 20 Hz), the delay is estimated at 20 Hz, as with no
+    quieter cutoff at all (NOISE_SHARE inf: the same delay to 1e-12 s), and the shares are kept."""
+    refuse = estimation.checks.refuse_motion
+
+    def refusing(moving, cutoff, min_speed):
+        if cutoff != 20.0:
+            raise estimation.LogError("too little motion")
+        refuse(moving, cutoff, min_speed)
+    monkeypatch.setattr(estimation.checks, "refuse_motion", refusing)
+    fit = estimation.estimate(held_log, PRIOR, delay=None)
+    assert fit.delay_cutoff[0] == 20.0 and list(fit.delay_cutoff[1]) == [20.0, 14.0]
+    monkeypatch.setattr(estimation.checks, "refuse_motion", refuse)
+    monkeypatch.setattr(filtering, "NOISE_SHARE", np.inf)
+    assert fit.delay == pytest.approx(estimation.estimate(held_log, PRIOR, delay=None).delay, abs=1e-12)
