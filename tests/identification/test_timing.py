@@ -40,17 +40,25 @@ def device():
 
 
 @pytest.fixture(scope="module")
+def estimated(held_log):
+    """The held log delayed by 0 and by 1 sample, each with its delay estimated: {n: Fit}."""
+    return {n: estimation.estimate(delayed(held_log, n), PRIOR, delay=None) for n in (0, 1)}
+
+
+@pytest.fixture(scope="module")
 def held_log():
     return truth_log(60, 0.4, 1)          # lab_log(device[0], 60, 0.4, 1), simulated once
 
 
-def test_the_delay_is_estimated_and_corrected(device, held_log, monkeypatch):
+def test_the_delay_is_estimated_and_corrected(device, held_log, estimated, monkeypatch):
     """On the log delayed by 0 and by 1.0 ms (1 sample): the estimates differ by 1.0 ms within
     0.02 ms (measured 1.000) and each lies within 0.12 ms of the truth (measured -0.09 and 0.91
     ms). The encoder's quantization, which the PD controller feeds back into the logged torques,
     biases the estimate early: it is made at 14 Hz, where the angles' noise is 0.96 % of the
     filtered acceleration (filtering.quiet_cutoff); at the fit's 20 Hz (2.3 %) it errs by more
-    than 0.15 ms (measured -0.18 and 0.82 ms; without quantization 0.08 ms). Without the
+    than 0.15 ms (measured -0.18 and 0.82 ms; without quantization 0.08 ms), and at 20 Hz too
+    where the quieter filtering leaves too little motion (checks.refuse_motion made to refuse it:
+    the same delay to 1e-12 s, the shares kept for the printed line). Without the
     correction the delay biases viscous friction by more than 10 % on joints 1 and 3 (measured
     +13 %, +15 %); the 1 ms delay given (--delay) brings every friction coefficient back within 5 %
     of the device's (measured 2.2-3.0 % viscous, 0.1 % Coulomb: the undelayed fit), estimated within
@@ -62,16 +70,26 @@ def test_the_delay_is_estimated_and_corrected(device, held_log, monkeypatch):
     late = delayed(held_log, 1)
     uncorrected = estimation.estimate(late, PRIOR, delay=0.0)
     given = estimation.estimate(late, PRIOR, delay=1e-3)
-    estimated = {n: estimation.estimate(delayed(held_log, n), PRIOR, delay=None) for n in (0, 1)}
     print("estimated delays (ms):", {n: 1e3 * fit.delay for n, fit in estimated.items()})
     assert estimated[1].delay - estimated[0].delay == pytest.approx(1e-3, abs=2e-5)
     for n, fit in estimated.items():
         assert fit.delay_estimated and abs(fit.delay - n * 1e-3) < 1.2e-4 and fit.delay_cutoff[0] == 14.0
     monkeypatch.setattr(filtering, "NOISE_SHARE", np.inf)           # every cutoff quiet: the fit's 20 Hz
-    for n in (0, 1):
-        fit = estimation.estimate(delayed(held_log, n), PRIOR, delay=None)
+    loud = {n: estimation.estimate(delayed(held_log, n), PRIOR, delay=None) for n in (0, 1)}
+    for n, fit in loud.items():
         assert fit.delay_cutoff == (20.0, {20.0: pytest.approx(0.023, abs=1e-3)})
         assert abs(fit.delay - n * 1e-3) > 1.5e-4
+    monkeypatch.undo()
+    refuse = estimation.checks.refuse_motion
+
+    def refusing(moving, cutoff, min_speed):                 # the quieter cutoff: too little motion
+        if cutoff != 20.0:
+            raise estimation.LogError("too little motion")
+        refuse(moving, cutoff, min_speed)
+    monkeypatch.setattr(estimation.checks, "refuse_motion", refusing)
+    fit = estimation.estimate(held_log, PRIOR, delay=None)
+    assert fit.delay_cutoff[0] == 20.0 and list(fit.delay_cutoff[1]) == [20.0, 14.0]
+    assert fit.delay == pytest.approx(loud[0].delay, abs=1e-12)
     friction = {name: fit.x[-6:] / TRUE_FRICTION - 1 for name, fit in
                 (("uncorrected", uncorrected), ("given", given), ("estimated", estimated[1]))}
     print("friction errors:", friction)
@@ -229,14 +247,14 @@ def test_a_delay_between_the_grid_points_is_estimated_to_a_tenth_of_the_grid_ste
     assert fit.delay_estimated and abs(fit.delay - delay) < 2.5e-5, fit.delay
 
 
-def test_the_delay_line_says_where_the_angles_noise_stays_above_its_aim(held_log):
+def test_the_delay_line_says_where_the_angles_noise_stays_above_its_aim(estimated):
     """result.timing_lines on one fit with each quiet-cutoff outcome put in (dataclasses.replace):
     the fit's own cutoff within filtering.NOISE_SHARE, nothing said; a lower one chosen, the shares
     (test_identify_reports_the_delay_and_refuses_a_bad_one); every cutoff above the aim, the
     lowest chosen and said to be above it; the quieter cutoff within it but left for too little
     motion, the fit's cutoff and why. A delay leading its positions by 1 ms is a logger's, by more
     a closed loop's noise (result.lead_warning, timing.LEAD); a given one is never warned."""
-    fit = estimation.estimate(held_log, PRIOR, delay=None)
+    fit = estimated[0]
 
     def line(cutoff, shares):
         return result.timing_lines(dataclasses.replace(fit, delay_cutoff=(cutoff, shares)))[0]
@@ -250,20 +268,3 @@ def test_the_delay_line_says_where_the_angles_noise_stays_above_its_aim(held_log
     assert "-1.010 ms, has the torques logged before" in result.lead_warning(dataclasses.replace(fit, delay=-1.01e-3))
     assert result.lead_warning(dataclasses.replace(fit, delay=-4e-3, delay_estimated=False)) is None
 
-
-def test_a_quieter_cutoff_that_leaves_too_little_motion_is_not_used(held_log, monkeypatch):
-    """Where the log filtered at the quieter cutoff leaves too little motion (checks.refuse_motion
-    made to refuse every cutoff but the fit's 20 Hz), the delay is estimated at 20 Hz, as with no
-    quieter cutoff at all (NOISE_SHARE inf: the same delay to 1e-12 s), and the shares are kept."""
-    refuse = estimation.checks.refuse_motion
-
-    def refusing(moving, cutoff, min_speed):
-        if cutoff != 20.0:
-            raise estimation.LogError("too little motion")
-        refuse(moving, cutoff, min_speed)
-    monkeypatch.setattr(estimation.checks, "refuse_motion", refusing)
-    fit = estimation.estimate(held_log, PRIOR, delay=None)
-    assert fit.delay_cutoff[0] == 20.0 and list(fit.delay_cutoff[1]) == [20.0, 14.0]
-    monkeypatch.setattr(estimation.checks, "refuse_motion", refuse)
-    monkeypatch.setattr(filtering, "NOISE_SHARE", np.inf)
-    assert fit.delay == pytest.approx(estimation.estimate(held_log, PRIOR, delay=None).delay, abs=1e-12)
