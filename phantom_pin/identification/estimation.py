@@ -290,9 +290,14 @@ def _quiet(log: Log, phantom: Phantom, ready: _Regression, cutoff: float, delay:
     except LogError:          # estimated at the fit's cutoff, and the delay line says why
         return cutoff, shares, None
     phi, tau0 = ready.structure.regressor_of(samples.theta, samples.dtheta, samples.ddtheta, samples.friction)
-    moving = samples.moving
-    return quiet, shares, (samples, tau0, criterion(phi * moving[..., None], moving,
-                                                    rms(samples.filtered_tau[samples.index] - tau0, moving)))
+    return quiet, shares, (samples, tau0, _delay_criterion(samples, phi * samples.moving[..., None], tau0))
+
+
+def _delay_criterion(samples: Samples, phi: np.ndarray, tau0: np.ndarray) -> Callable[[np.ndarray], float]:
+    """The weighted residual the delay is estimated by (timing.criterion) on ``phi`` (N, 3, P),
+    zeroed outside ``samples.moving``, each joint weighted by its filtered torque's RMS less
+    ``tau0`` (N, 3; N m, the known torques) over the fitted equations (any timing)."""
+    return criterion(phi, samples.moving, rms(samples.filtered_tau[samples.index] - tau0, samples.moving))
 
 
 def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gains: bool,
@@ -303,7 +308,7 @@ def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gain
     samples, tau0, moving, measured, prior = ready.samples, ready.tau0, ready.moving, ready.phi, ready.prior
     phi = ready.solved                     # measured, or its projection on the instruments
     residuals_with = None if ready.instruments is None else measured       # least_squares.fit's measured
-    weighted = criterion(measured, moving, rms(samples.filtered_tau[samples.index] - tau0, moving))  # any timing
+    weighted = _delay_criterion(samples, measured, tau0)
 
     def lag(scale: np.ndarray) -> tuple[float, Samples]:
         """The delay estimated on the torques times ``scale`` (joint 1's scale), and the samples at it."""

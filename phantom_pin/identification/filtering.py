@@ -106,13 +106,11 @@ def _butterworth(cutoff: float, rate: float) -> np.ndarray:
     return scipy.signal.butter(FILTER_ORDER, cutoff, fs=rate, output="sos")
 
 
-def _acceleration(theta: np.ndarray, sos: np.ndarray, rate: float) -> np.ndarray:
-    """``theta`` (N, ...) rad low-passed forwards and backwards by ``sos`` and differentiated
-    twice by central differences at ``rate`` (Hz): rad/s^2."""
-    import scipy.signal
-
-    smooth = scipy.signal.sosfiltfilt(sos, theta, axis=0)
-    return np.gradient(np.gradient(smooth, 1.0 / rate, axis=0), 1.0 / rate, axis=0)
+def _derivatives(theta: np.ndarray, rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """The rates (rad/s) and accelerations (rad/s^2) of low-passed angles ``theta`` (N, ...) rad
+    at ``rate`` (Hz), by central differences."""
+    dtheta = np.gradient(theta, 1.0 / rate, axis=0)
+    return dtheta, np.gradient(dtheta, 1.0 / rate, axis=0)
 
 
 def quiet_cutoff(log: Log, highest: float) -> tuple[float, dict[float, float]]:
@@ -126,15 +124,16 @@ def quiet_cutoff(log: Log, highest: float) -> tuple[float, dict[float, float]]:
     tried = [highest] + [c for c in CUTOFFS if c < highest and c * duration >= MIN_CYCLES]
     edge = int(np.ceil(EDGE * rate))
     inside = slice(edge, len(log.t) - edge)
-    residual = log.theta - scipy.signal.sosfiltfilt(_butterworth(highest, rate), log.theta, axis=0)
-    noise = np.diff(residual[inside], 3, axis=0).std(axis=0) / np.sqrt(20.0)        # rad, per joint
     impulse = np.zeros(2 * int(np.ceil(rate)) + 1)
     impulse[len(impulse) // 2] = 1.0
     shares: dict[float, float] = {}
     for cutoff in tried:
         sos = _butterworth(cutoff, rate)
-        gain = float(np.sqrt((_acceleration(impulse, sos, rate) ** 2).sum()))        # 1/s^2 per rad of noise
-        signal = np.sqrt((_acceleration(log.theta, sos, rate)[inside] ** 2).mean(axis=0))
+        smooth = scipy.signal.sosfiltfilt(sos, log.theta, axis=0)
+        if cutoff == highest:         # the noise: what the highest cutoff removes
+            noise = np.diff((log.theta - smooth)[inside], 3, axis=0).std(axis=0) / np.sqrt(20.0)     # rad, per joint
+        gain = float(np.sqrt((_derivatives(scipy.signal.sosfiltfilt(sos, impulse), rate)[1] ** 2).sum()))  # 1/s^2/rad
+        signal = np.sqrt((_derivatives(smooth, rate)[1][inside] ** 2).mean(axis=0))
         shares[cutoff] = float((noise * gain / np.maximum(signal, 1e-300)).max())
         if shares[cutoff] <= NOISE_SHARE:
             return cutoff, shares
@@ -161,9 +160,7 @@ def filtered(log: Log, cutoff: float, law: Friction, timing: str = "held", delay
         # smooth signal half a period late; read it at t_k - 1/(2 rate), halfway back (without
         # this, viscous friction came out up to 20 % low)
         tau = np.concatenate([tau[:1], 0.5 * (tau[1:] + tau[:-1])])
-    dt = 1.0 / rate
-    dtheta = np.gradient(theta, dt, axis=0)
-    ddtheta = np.gradient(dtheta, dt, axis=0)
+    dtheta, ddtheta = _derivatives(theta, rate)
     columns = scipy.signal.sosfiltfilt(sos, np.concatenate([dtheta, law.unit_coulomb().torque(dtheta)], axis=1),
                                        axis=0)
     edge = int(np.ceil(EDGE * rate))
