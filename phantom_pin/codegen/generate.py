@@ -135,7 +135,8 @@ class _Model:
 
     def rnea(self, theta: list[Any], dtheta: list[Any], ddtheta: list[Any], gravity: bool) -> list[Any]:
         """Joint torques (N m) on theta of the tree with every mimic joint following its
-        primary: Newton-Euler in each link's own frame; no armature."""
+        primary: Newton-Euler in each link's own frame; no armature. One torque per coordinate
+        (a free gimbal's three after the arm's)."""
         zero = sp.zeros(3, 1)
         state = {self.root: (zero, zero, sp.Matrix([0, 0, self.gravity]) if gravity else zero)}
         rotations = {}
@@ -163,7 +164,7 @@ class _Model:
             m, c, inertia = self.links[link]
             force = m * (a + _cross(dw, c) + _cross(w, _cross(w, c)))
             wrench[link] = (force, inertia * dw + _cross(w, inertia * w) + _cross(c, force))
-        tau = [sp.Integer(0)] * 3
+        tau = [sp.Integer(0)] * len(theta)
         for joint in reversed(self.joints):  # inwards: accumulate on the parent, project on the axis
             f, n = wrench[joint.child]
             if joint.axis is not None:
@@ -351,9 +352,46 @@ def _generate(description: Description, progress: Callable[[float], None]) -> di
         "jacobian_transpose_force": _body([(f"tau[{j}]", sum(jacobian[i][j] * f[i] for i in range(3)))
                                            for j in range(3)], [T, ("f", f)]),
     }
+    bodies["friction"] = _friction_body(description)
     if description.config.gimbal is not None:
         bodies["stylus_pose"] = _stylus_body(description)
+        bodies["gravity_stylus"] = _gravity_stylus_body(description)
     return bodies
+
+
+def _gravity_stylus_body(description: Description) -> str:
+    """The arm's gravity torques with the stylus gimbal held at given angles (Phantom.gravity's
+    ``gimbal=``): the Newton-Euler gravity pass over the URDF with the gimbal's joints free, at
+    zero rates, the arm's three torques (the gimbal's own are the hand's)."""
+    model = _Model(description, free=True)
+    theta = list(sp.symbols("q0:3", real=True))
+    gimbal = list(sp.symbols("g0:3", real=True))
+    zero = [sp.Integer(0)] * 6
+    gravity = _leaner(model.rnea(theta + gimbal, zero, zero, True)[:3])
+    return _body([(f"tau[{i}]", gravity[i]) for i in range(3)], [("theta", theta), ("gimbal", gimbal)])
+
+
+#: F of J^T F = tau: F = (J^-1)^T tau, J^-1 = adj(J) / det(J) (J row-major, as tip_jacobian's).
+_SOLVE = """    double J[9], det;
+    {p}_tip_jacobian(theta, J);
+    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    f[0] = (tau[0] * (J[4] * J[8] - J[5] * J[7]) - tau[1] * (J[3] * J[8] - J[5] * J[6])
+            + tau[2] * (J[3] * J[7] - J[4] * J[6])) / det;
+    f[1] = (-tau[0] * (J[1] * J[8] - J[2] * J[7]) + tau[1] * (J[0] * J[8] - J[2] * J[6])
+            - tau[2] * (J[0] * J[7] - J[1] * J[6])) / det;
+    f[2] = (tau[0] * (J[1] * J[5] - J[2] * J[4]) - tau[1] * (J[0] * J[5] - J[2] * J[3])
+            + tau[2] * (J[0] * J[4] - J[1] * J[3])) / det;"""
+
+
+def _friction_body(description: Description) -> str:
+    """The friction law in motion (config.Friction, Device.friction): viscous dtheta + Coulomb
+    sign(dtheta) per joint, sign(0) = 0."""
+    law = description.config.actuation.friction
+    lines = []
+    for i in range(3):
+        lines.append(f"    tau[{i}] = {law.viscous[i]!r} * dtheta[{i}] + {law.coulomb[i]!r} * "
+                     f"((dtheta[{i}] > 0.0) - (dtheta[{i}] < 0.0));")
+    return "\n".join(lines)
 
 
 def _header(description: Description, prefix: str, origin: str, overlay: str,
@@ -364,7 +402,10 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
              "torques in N m on theta. " + _ASSUMES)
     parts = [
         _banner(description, prefix, origin, overlay) +
-        f"#ifndef {guard}\n#define {guard}\n\n#include <math.h>\n\n#ifdef __cplusplus\nextern \"C\" {{\n#endif\n",
+        f"#ifndef {guard}\n#define {guard}\n\n#include <math.h>\n\n"
+        f"/* 1 where the model has a stylus gimbal (HD_CURRENT_GIMBAL_ANGLES), else 0. */\n"
+        f"#define {prefix.upper()}_STYLUS {int(description.config.gimbal is not None)}\n\n"
+        f"#ifdef __cplusplus\nextern \"C\" {{\n#endif\n",
         _function(f"Gravity torques tau = N(theta) (N m) at rest.\n{units}",
                   f"{prefix}_gravity(const double theta[3], double tau[3])", body["gravity"]),
         _function(f"Inverse dynamics tau = M(theta) ddtheta + C(theta, dtheta) dtheta + N(theta) (N m),\n"
@@ -386,7 +427,7 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
                   f"{prefix}_jacobian_transpose_force(const double theta[3], const double f[3], double tau[3])",
                   body["jacobian_transpose_force"]),
         *([] if "stylus_pose" not in body else [_stylus(prefix, body["stylus_pose"])]),
-        _openhaptics(prefix),
+        _openhaptics(prefix, body, description.config.gimbal is not None),
         f"#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {guard} */\n",
     ]
     return "\n".join(parts)
@@ -448,18 +489,69 @@ def _stylus(prefix: str, body: str) -> str:
         f"{prefix}_stylus_pose(const double theta[3], const double gimbal[3], double p[3], double R[9])", body)
 
 
-def _openhaptics(prefix: str) -> str:
+def _openhaptics(prefix: str, body: dict[str, str], has_gimbal: bool) -> str:
     """OpenHaptics' conventions (phantom_pin.drivers): angles theta = (-a1, a2, a3);
-    HD_CURRENT_JOINT_TORQUE (mN m) = 1000 (-tau1, tau2, tau3)."""
-    return "\n".join([
+    HD_CURRENT_JOINT_TORQUE (mN m) = 1000 (-tau1, tau2, tau3); and the compensation in the servo
+    loop's own terms: HD_CURRENT_FORCE (N) or HD_CURRENT_JOINT_TORQUE (mN m) of the angles
+    HD_CURRENT_JOINT_ANGLES and HD_CURRENT_GIMBAL_ANGLES give, optionally with friction."""
+    p = prefix
+    gravity = (f"    {p}_gravity_stylus(theta, gimbal_angles, tau);" if has_gimbal else
+               f"    (void)gimbal_angles;\n    {p}_gravity(theta, tau);")
+    stylus = ("the stylus gimbal at gimbal_angles (HD_CURRENT_GIMBAL_ANGLES, rad)" if has_gimbal else
+              "gimbal_angles ignored (this model has no stylus gimbal: pass NULL)")
+    rates = ("joint_rates: the rates of HD_CURRENT_JOINT_ANGLES (rad/s, the caller's estimate, e.g. filtered\n"
+             "differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).")
+    parts = [
         _function("The report's theta (rad) of OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad): (-a1, a2, a3)\n"
                   "(phantom_pin.drivers.theta_from_openhaptics).",
-                  f"{prefix}_theta_from_openhaptics(const double angles[3], double theta[3])",
+                  f"{p}_theta_from_openhaptics(const double angles[3], double theta[3])",
                   "    theta[0] = -angles[0];\n    theta[1] = angles[1];\n    theta[2] = angles[2];"),
         _function("OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau\n"
-                  "(N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau).\n"
-                  "The sign is inferred from SensAble's CommandJointTorque sample: check it on your device.",
-                  f"{prefix}_openhaptics_torque_from_tau(const double tau[3], double torque[3])",
+                  "(N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau),\n"
+                  "each torque acting on its own OpenHaptics angle (SensAble's CommandJointTorque sample\n"
+                  "renders a restoring joint spring T = k (0 - a), k > 0, on that reading: docs/servo-loop.md).",
+                  f"{p}_openhaptics_torque_from_tau(const double tau[3], double torque[3])",
                   "    torque[0] = -1000.0 * tau[0];\n    torque[1] = 1000.0 * tau[1];\n"
                   "    torque[2] = 1000.0 * tau[2];"),
-    ])
+        _function(f"The friction torques in motion (N m) at joint rates dtheta (rad/s): viscous dtheta +\n"
+                  f"Coulomb sign(dtheta) per joint, 0 for a joint at rest (phantom_pin.Device.friction).\n"
+                  f"{_ASSUMES}",
+                  f"{p}_friction(const double dtheta[3], double tau[3])", body["friction"]),
+        _function("The tip force f (N, frame s = OpenHaptics' axes) whose J^T f is tau (N m): J^-T tau, J the\n"
+                  "tip Jacobian at theta. At a kinematic singularity (det J = 0: the arm stretched, or the tip\n"
+                  "on joint 1's axis) no force gives every torque and the result is not finite.\n"
+                  f"{_ASSUMES}",
+                  f"{p}_force_from_tau(const double theta[3], const double tau[3], double f[3])",
+                  _SOLVE.replace("{p}", p)),
+    ]
+    if has_gimbal:
+        parts.insert(2, _function(
+            "Gravity torques (N m on theta) with the stylus gimbal at gimbal (OpenHaptics' raw gimbal angles,\n"
+            "rad), as phantom_pin.Phantom.gravity(theta, gimbal=gimbal): the arm's, the gimbal's own held by\n"
+            f"the hand. {_ASSUMES}",
+            f"{p}_gravity_stylus(const double theta[3], const double gimbal[3], double tau[3])",
+            body["gravity_stylus"]))
+    for friction in (False, True):
+        suffix, arg = ("_friction", ", const double joint_rates[3]") if friction else ("", "")
+        extra = (f"\n    {{\n        double rates[3], f[3];\n        {p}_theta_from_openhaptics(joint_rates, rates);\n"
+                 f"        {p}_friction(rates, f);\n        tau[0] += f[0];\n        tau[1] += f[1];\n"
+                 "        tau[2] += f[2];\n    }") if friction else ""
+        more = ("\n" + rates) if friction else ""
+        parts.append(_function(
+            f"HD_CURRENT_FORCE (N, OpenHaptics' axes) that compensates the device's gravity at the angles\n"
+            f"joint_angles (HD_CURRENT_JOINT_ANGLES, rad), {stylus}: J^T F = N(theta).{more}\n"
+            f"Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_FORCE, force). Not finite at a\n"
+            f"kinematic singularity ({p}_force_from_tau). {_ASSUMES}",
+            f"{p}_openhaptics_force{suffix}(const double joint_angles[3], const double gimbal_angles[3]{arg}, "
+            f"double force[3])",
+            f"    double theta[3], tau[3];\n    {p}_theta_from_openhaptics(joint_angles, theta);\n{gravity}{extra}\n"
+            f"    {p}_force_from_tau(theta, tau, force);"))
+        parts.append(_function(
+            f"HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates the device's gravity at\n"
+            f"joint_angles (HD_CURRENT_JOINT_ANGLES, rad), {stylus}.{more}\n"
+            f"Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_JOINT_TORQUE, torque). {_ASSUMES}",
+            f"{p}_openhaptics_joint_torque{suffix}(const double joint_angles[3], const double gimbal_angles[3]{arg}, "
+            f"double torque[3])",
+            f"    double theta[3], tau[3];\n    {p}_theta_from_openhaptics(joint_angles, theta);\n{gravity}{extra}\n"
+            f"    {p}_openhaptics_torque_from_tau(tau, torque);"))
+    return "\n".join(parts)

@@ -31,6 +31,7 @@ from phantom_pin.config.types import (
     Limits,
     Motor,
     MujocoSettings,
+    OpenHaptics,
     Scene,
     Stops,
     freeze,
@@ -79,7 +80,21 @@ def motor_problem(motor: Motor) -> str:
     return ""
 
 
+def _openhaptics(r: Reader) -> OpenHaptics | None:
+    """actuation.yaml's ``openhaptics`` section (None without one)."""
+    arg = "actuation_file"
+    if "openhaptics" not in r.documents[arg]:
+        return None
+    return OpenHaptics(r.text(arg, "openhaptics", "model_type"),
+                       r.number(arg, "openhaptics", "nominal_max_force", positive=True),
+                       r.number(arg, "openhaptics", "nominal_max_stiffness", positive=True))
+
+
 def _actuation(r: Reader) -> Actuation:
+    return dataclasses.replace(_drive(r), openhaptics=_openhaptics(r))
+
+
+def _drive(r: Reader) -> Actuation:
     arg = "actuation_file"
 
     def act(*keys: str, **kind: bool) -> float:

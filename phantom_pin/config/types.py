@@ -134,9 +134,22 @@ class Friction:
 
 
 @dataclasses.dataclass(frozen=True)
+class OpenHaptics:
+    """What OpenHaptics reports of the device (actuation.yaml's ``openhaptics``, sourced there):
+    ``model_type`` (HD_DEVICE_MODEL_TYPE), ``max_force`` (N, HD_NOMINAL_MAX_FORCE: the force
+    norm OpenHaptics clamps HD_CURRENT_FORCE to) and ``max_stiffness`` (N/mm,
+    HD_NOMINAL_MAX_STIFFNESS)."""
+
+    model_type: str
+    max_force: float
+    max_stiffness: float
+
+
+@dataclasses.dataclass(frozen=True)
 class Actuation:
     """Transmission ratios (joint angle = motor angle / ratio), motor, encoder, friction, and
-    each joint's torque limit ``effort`` (N m) and speed limit ``velocity`` (rad/s), the URDF's.
+    each joint's torque limit ``effort`` (N m) and speed limit ``velocity`` (rad/s), the URDF's;
+    ``openhaptics``: what OpenHaptics reports of the device (None where the file has no section).
 
     ``ratios``, ``motor`` and ``encoder`` are None where a model's are not public (the Touch):
     actuation.yaml says so with ``null``, and then gives ``joint_torque_limit`` and
@@ -153,6 +166,7 @@ class Actuation:
     velocity: tuple[float, float, float]
     peak: tuple[float, float, float]
     saturation: str = "continuous"
+    openhaptics: OpenHaptics | None = None
 
     def limit(self, policy: str) -> tuple[float, float, float]:
         """Each joint's torque limit (N m) of a saturation ``policy`` (SATURATIONS): "continuous",

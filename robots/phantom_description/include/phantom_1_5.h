@@ -18,6 +18,9 @@
 
 #include <math.h>
 
+/* 1 where the model has a stylus gimbal (HD_CURRENT_GIMBAL_ANGLES), else 0. */
+#define PHANTOM_STYLUS 0
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -349,14 +352,124 @@ static inline void phantom_theta_from_openhaptics(const double angles[3], double
 
 /*
  * OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau
- * (N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau).
- * The sign is inferred from SensAble's CommandJointTorque sample: check it on your device.
+ * (N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau),
+ * each torque acting on its own OpenHaptics angle (SensAble's CommandJointTorque sample
+ * renders a restoring joint spring T = k (0 - a), k > 0, on that reading: docs/servo-loop.md).
  */
 static inline void phantom_openhaptics_torque_from_tau(const double tau[3], double torque[3])
 {
     torque[0] = -1000.0 * tau[0];
     torque[1] = 1000.0 * tau[1];
     torque[2] = 1000.0 * tau[2];
+}
+
+/*
+ * The friction torques in motion (N m) at joint rates dtheta (rad/s): viscous dtheta +
+ * Coulomb sign(dtheta) per joint, 0 for a joint at rest (phantom_pin.Device.friction).
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_friction(const double dtheta[3], double tau[3])
+{
+    tau[0] = 0.0005 * dtheta[0] + 0.01 * ((dtheta[0] > 0.0) - (dtheta[0] < 0.0));
+    tau[1] = 0.0005 * dtheta[1] + 0.01 * ((dtheta[1] > 0.0) - (dtheta[1] < 0.0));
+    tau[2] = 0.0005 * dtheta[2] + 0.01 * ((dtheta[2] > 0.0) - (dtheta[2] < 0.0));
+}
+
+/*
+ * The tip force f (N, frame s = OpenHaptics' axes) whose J^T f is tau (N m): J^-T tau, J the
+ * tip Jacobian at theta. At a kinematic singularity (det J = 0: the arm stretched, or the tip
+ * on joint 1's axis) no force gives every torque and the result is not finite.
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_force_from_tau(const double theta[3], const double tau[3], double f[3])
+{
+    double J[9], det;
+    phantom_tip_jacobian(theta, J);
+    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    f[0] = (tau[0] * (J[4] * J[8] - J[5] * J[7]) - tau[1] * (J[3] * J[8] - J[5] * J[6])
+            + tau[2] * (J[3] * J[7] - J[4] * J[6])) / det;
+    f[1] = (-tau[0] * (J[1] * J[8] - J[2] * J[7]) + tau[1] * (J[0] * J[8] - J[2] * J[6])
+            - tau[2] * (J[0] * J[7] - J[1] * J[6])) / det;
+    f[2] = (tau[0] * (J[1] * J[5] - J[2] * J[4]) - tau[1] * (J[0] * J[5] - J[2] * J[3])
+            + tau[2] * (J[0] * J[4] - J[1] * J[3])) / det;
+}
+
+/*
+ * HD_CURRENT_FORCE (N, OpenHaptics' axes) that compensates the device's gravity at the angles
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), gimbal_angles ignored (this model has no stylus gimbal: pass NULL): J^T F = N(theta).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_FORCE, force). Not finite at a
+ * kinematic singularity (phantom_force_from_tau). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_force(const double joint_angles[3], const double gimbal_angles[3], double force[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    (void)gimbal_angles;
+    phantom_gravity(theta, tau);
+    phantom_force_from_tau(theta, tau, force);
+}
+
+/*
+ * HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates the device's gravity at
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), gimbal_angles ignored (this model has no stylus gimbal: pass NULL).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_JOINT_TORQUE, torque). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_joint_torque(const double joint_angles[3], const double gimbal_angles[3], double torque[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    (void)gimbal_angles;
+    phantom_gravity(theta, tau);
+    phantom_openhaptics_torque_from_tau(tau, torque);
+}
+
+/*
+ * HD_CURRENT_FORCE (N, OpenHaptics' axes) that compensates the device's gravity at the angles
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), gimbal_angles ignored (this model has no stylus gimbal: pass NULL): J^T F = N(theta).
+ * joint_rates: the rates of HD_CURRENT_JOINT_ANGLES (rad/s, the caller's estimate, e.g. filtered
+ * differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_FORCE, force). Not finite at a
+ * kinematic singularity (phantom_force_from_tau). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_force_friction(const double joint_angles[3], const double gimbal_angles[3], const double joint_rates[3], double force[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    (void)gimbal_angles;
+    phantom_gravity(theta, tau);
+    {
+        double rates[3], f[3];
+        phantom_theta_from_openhaptics(joint_rates, rates);
+        phantom_friction(rates, f);
+        tau[0] += f[0];
+        tau[1] += f[1];
+        tau[2] += f[2];
+    }
+    phantom_force_from_tau(theta, tau, force);
+}
+
+/*
+ * HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates the device's gravity at
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), gimbal_angles ignored (this model has no stylus gimbal: pass NULL).
+ * joint_rates: the rates of HD_CURRENT_JOINT_ANGLES (rad/s, the caller's estimate, e.g. filtered
+ * differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_JOINT_TORQUE, torque). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_joint_torque_friction(const double joint_angles[3], const double gimbal_angles[3], const double joint_rates[3], double torque[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    (void)gimbal_angles;
+    phantom_gravity(theta, tau);
+    {
+        double rates[3], f[3];
+        phantom_theta_from_openhaptics(joint_rates, rates);
+        phantom_friction(rates, f);
+        tau[0] += f[0];
+        tau[1] += f[1];
+        tau[2] += f[2];
+    }
+    phantom_openhaptics_torque_from_tau(tau, torque);
 }
 
 #ifdef __cplusplus

@@ -19,6 +19,9 @@
 
 #include <math.h>
 
+/* 1 where the model has a stylus gimbal (HD_CURRENT_GIMBAL_ANGLES), else 0. */
+#define PHANTOM_STYLUS 1
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -447,14 +450,176 @@ static inline void phantom_theta_from_openhaptics(const double angles[3], double
 
 /*
  * OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau
- * (N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau).
- * The sign is inferred from SensAble's CommandJointTorque sample: check it on your device.
+ * (N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau),
+ * each torque acting on its own OpenHaptics angle (SensAble's CommandJointTorque sample
+ * renders a restoring joint spring T = k (0 - a), k > 0, on that reading: docs/servo-loop.md).
  */
 static inline void phantom_openhaptics_torque_from_tau(const double tau[3], double torque[3])
 {
     torque[0] = -1000.0 * tau[0];
     torque[1] = 1000.0 * tau[1];
     torque[2] = 1000.0 * tau[2];
+}
+
+/*
+ * Gravity torques (N m on theta) with the stylus gimbal at gimbal (OpenHaptics' raw gimbal angles,
+ * rad), as phantom_pin.Phantom.gravity(theta, gimbal=gimbal): the arm's, the gimbal's own held by
+ * the hand. Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_gravity_stylus(const double theta[3], const double gimbal[3], double tau[3])
+{
+    const double q1 = theta[1];
+    const double q2 = theta[2];
+    const double g0 = gimbal[0];
+    const double g1 = gimbal[1];
+    const double g2 = gimbal[2];
+    const double x0 = cos(g0);
+    const double x1 = sin(g0);
+    const double x2 = x0*x1;
+    const double x3 = 1.3552527156068805e-20*x2;
+    const double x4 = cos(q2);
+    const double x5 = (x4*x4*x4*x4);
+    const double x6 = (x4*x4);
+    const double x7 = x2*x6;
+    const double x8 = 9.4867690092481638e-20*x7;
+    const double x9 = cos(g1);
+    const double x10 = (x9*x9);
+    const double x11 = cos(q1);
+    const double x12 = (x11*x11*x11*x11);
+    const double x13 = x10*x2;
+    const double x14 = 1.0842021724855044e-19*x7;
+    const double x15 = x13*x5;
+    const double x16 = sin(q2);
+    const double x17 = 2.7105054312137611e-20*x16;
+    const double x18 = (x11*x11);
+    const double x19 = sin(g1);
+    const double x20 = 1.3552527156068805e-20*x16;
+    const double x21 = x1*x19*x20;
+    const double x22 = (x11*x11*x11);
+    const double x23 = 5.4210108624275222e-20*x22;
+    const double x24 = x18*x5;
+    const double x25 = x22*x5;
+    const double x26 = 5.4210108624275222e-20*x25;
+    const double x27 = x12*x5;
+    const double x28 = 1.0842021724855044e-19*x16;
+    const double x29 = (x0*x0);
+    const double x30 = 2.7105054312137611e-20*x29;
+    const double x31 = x11*x6;
+    const double x32 = x22*x6;
+    const double x33 = x30*x32;
+    const double x34 = x10*x26;
+    const double x35 = 5.4210108624275222e-20*x32*((cos(g2))*(cos(g2)));
+    const double x36 = x16*x30;
+    const double x37 = x29*x35;
+    const double x38 = x20*x29;
+    tau[0] = x1*x19*x23*(x4*x4*x4*x4*x4)*x9 - x10*x14*x16*x22 - x10*x3 - x10*x8 - x11*x15*x28 - x11*x17*x2 + 5.4210108624275222e-20*x12*x13 + x12*x14 + 2.1684043449710089e-19*x13*x24 - x13*x25*x28 - 4.3368086899420177e-19*x13*x27 - x14*x18 + 9.4867690092481638e-20*x15 - x16*x2*x26 + x16*x23*x7 + x21*(x4*x4*x4)*x9 + x21*x4*x9 + x3*x5 - x3 + x8;
+    tau[1] = x10*x33 + x10*x37 - x11*x30 + 0.068706257148368481*x11 - x25*x30 - x26 + 1.3552527156068805e-19*x29*x31 + x29*x34 - 5.4210108624275222e-20*x31 + x33 - x34 - x35 + x36*x4*sin(q1) + x37;
+    tau[2] = 1.3552527156068805e-20*x0*x19*x4*x9 + 0.0038061032979948783*x0*x4*x9 + 2.7105054312137611e-20*x10*x12*x16*x29*x6 + 2.7105054312137611e-20*x10*x16*x18*x29*x5 + 5.4210108624275222e-20*x10*x16*x18*x29*x6 - x10*x38 + 2.7105054312137611e-20*x12*x16*x29*x6 - x12*x20 - x12*x38 + 2.7105054312137611e-20*x16*x18*x29*x5 - 0.0038061032979948783*x16*x19 + 1.3552527156068805e-20*x16*x29 + 0.051453952501153081*x16 - x17*x24 - x17*x27 - x18*x36*x6 - x18*x38 - x20*x6 - x27*x36 - x38*x5 - x38*x6;
+}
+
+/*
+ * The friction torques in motion (N m) at joint rates dtheta (rad/s): viscous dtheta +
+ * Coulomb sign(dtheta) per joint, 0 for a joint at rest (phantom_pin.Device.friction).
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_friction(const double dtheta[3], double tau[3])
+{
+    tau[0] = 0.0005 * dtheta[0] + 0.01 * ((dtheta[0] > 0.0) - (dtheta[0] < 0.0));
+    tau[1] = 0.0005 * dtheta[1] + 0.01 * ((dtheta[1] > 0.0) - (dtheta[1] < 0.0));
+    tau[2] = 0.0005 * dtheta[2] + 0.01 * ((dtheta[2] > 0.0) - (dtheta[2] < 0.0));
+}
+
+/*
+ * The tip force f (N, frame s = OpenHaptics' axes) whose J^T f is tau (N m): J^-T tau, J the
+ * tip Jacobian at theta. At a kinematic singularity (det J = 0: the arm stretched, or the tip
+ * on joint 1's axis) no force gives every torque and the result is not finite.
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_force_from_tau(const double theta[3], const double tau[3], double f[3])
+{
+    double J[9], det;
+    phantom_tip_jacobian(theta, J);
+    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    f[0] = (tau[0] * (J[4] * J[8] - J[5] * J[7]) - tau[1] * (J[3] * J[8] - J[5] * J[6])
+            + tau[2] * (J[3] * J[7] - J[4] * J[6])) / det;
+    f[1] = (-tau[0] * (J[1] * J[8] - J[2] * J[7]) + tau[1] * (J[0] * J[8] - J[2] * J[6])
+            - tau[2] * (J[0] * J[7] - J[1] * J[6])) / det;
+    f[2] = (tau[0] * (J[1] * J[5] - J[2] * J[4]) - tau[1] * (J[0] * J[5] - J[2] * J[3])
+            + tau[2] * (J[0] * J[4] - J[1] * J[3])) / det;
+}
+
+/*
+ * HD_CURRENT_FORCE (N, OpenHaptics' axes) that compensates the device's gravity at the angles
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), the stylus gimbal at gimbal_angles (HD_CURRENT_GIMBAL_ANGLES, rad): J^T F = N(theta).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_FORCE, force). Not finite at a
+ * kinematic singularity (phantom_force_from_tau). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_force(const double joint_angles[3], const double gimbal_angles[3], double force[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    phantom_gravity_stylus(theta, gimbal_angles, tau);
+    phantom_force_from_tau(theta, tau, force);
+}
+
+/*
+ * HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates the device's gravity at
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), the stylus gimbal at gimbal_angles (HD_CURRENT_GIMBAL_ANGLES, rad).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_JOINT_TORQUE, torque). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_joint_torque(const double joint_angles[3], const double gimbal_angles[3], double torque[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    phantom_gravity_stylus(theta, gimbal_angles, tau);
+    phantom_openhaptics_torque_from_tau(tau, torque);
+}
+
+/*
+ * HD_CURRENT_FORCE (N, OpenHaptics' axes) that compensates the device's gravity at the angles
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), the stylus gimbal at gimbal_angles (HD_CURRENT_GIMBAL_ANGLES, rad): J^T F = N(theta).
+ * joint_rates: the rates of HD_CURRENT_JOINT_ANGLES (rad/s, the caller's estimate, e.g. filtered
+ * differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_FORCE, force). Not finite at a
+ * kinematic singularity (phantom_force_from_tau). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_force_friction(const double joint_angles[3], const double gimbal_angles[3], const double joint_rates[3], double force[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    phantom_gravity_stylus(theta, gimbal_angles, tau);
+    {
+        double rates[3], f[3];
+        phantom_theta_from_openhaptics(joint_rates, rates);
+        phantom_friction(rates, f);
+        tau[0] += f[0];
+        tau[1] += f[1];
+        tau[2] += f[2];
+    }
+    phantom_force_from_tau(theta, tau, force);
+}
+
+/*
+ * HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates the device's gravity at
+ * joint_angles (HD_CURRENT_JOINT_ANGLES, rad), the stylus gimbal at gimbal_angles (HD_CURRENT_GIMBAL_ANGLES, rad).
+ * joint_rates: the rates of HD_CURRENT_JOINT_ANGLES (rad/s, the caller's estimate, e.g. filtered
+ * differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).
+ * Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_JOINT_TORQUE, torque). Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_joint_torque_friction(const double joint_angles[3], const double gimbal_angles[3], const double joint_rates[3], double torque[3])
+{
+    double theta[3], tau[3];
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    phantom_gravity_stylus(theta, gimbal_angles, tau);
+    {
+        double rates[3], f[3];
+        phantom_theta_from_openhaptics(joint_rates, rates);
+        phantom_friction(rates, f);
+        tau[0] += f[0];
+        tau[1] += f[1];
+        tau[2] += f[2];
+    }
+    phantom_openhaptics_torque_from_tau(tau, torque);
 }
 
 #ifdef __cplusplus
