@@ -11,8 +11,8 @@ from phantom_pin.cli.common import Parser, add_model_options, merge_model_option
 from phantom_pin.exceptions import PhantomPinError
 
 DESCRIPTION = """The PHANToM arms' model: info, check, fk, ik, dynamics, urdf, srdf, mjcf, links, show,
-simulate, excite, identify, codegen, openhaptics-sim, ros2. --model NAME or --config DIR chooses the configuration, --params FILE and
---set KEY=VALUE override its numbers; they go before or after the command."""
+simulate, excite, identify, codegen, openhaptics-sim, ros2. --model NAME or --config DIR chooses the configuration,
+--params FILE and --set KEY=VALUE override its numbers; they go before or after the command."""
 #: The dests of the model options given after the command end with this.
 AFTER = "_after_command"
 

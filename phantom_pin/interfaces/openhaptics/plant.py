@@ -22,8 +22,9 @@ The device (the environment, read once at the start):
 - PHANTOM_PIN_HD_HAND: three numbers, a hand's force on the stylus (N, OpenHaptics' axes, at
   the gimbal centre) from the moment the hold ends (default none; a test's hand: the stand-in's
   phantomPinSimSetHandForce adds its own);
-- PHANTOM_PIN_HD_RECORD: a file to write every tick's state, command and torques to (CSV,
-  RECORD_COLUMNS; protocol.read_record reads it; not overwritten: an existing file is refused).
+- PHANTOM_PIN_HD_RECORD: a file to write every tick's state, command and torques to (binary,
+  protocol.RECORD_HEADER then RECORD_COLUMNS' doubles; protocol.read_record reads it; not
+  overwritten: an existing file is refused).
 
 The plant is simulate()'s (device.plant.Plant: gravity, friction with its stick phase, the
 stops, the motors' saturation), with the gimbal held where the hand holds it. A force command F
@@ -46,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.interfaces.openhaptics.protocol import COMMAND, ENABLED, QUIT, RECORD_COLUMNS, STATE
+from phantom_pin.interfaces.openhaptics.protocol import COMMAND, ENABLED, QUIT, RECORD_COLUMNS, RECORD_HEADER, STATE
 
 #: The servo period the plant's RK4 substeps are chosen for (s): OpenHaptics' 1 kHz.
 PERIOD = 1e-3
@@ -118,8 +119,8 @@ class Server:
             if path.exists():
                 raise InvalidInputError(f"{path} exists (the record is never overwritten)",
                                         argument="PHANTOM_PIN_HD_RECORD")
-            self.record = path.open("w")
-            self.record.write(",".join(RECORD_COLUMNS) + "\n")
+            self.record = path.open("wb")
+            self.record.write(RECORD_HEADER.encode())
 
     def _info(self, config) -> list[float]:
         """INFO_FIELDS' numbers: the nominal maximum force, the continuous one (the least tip force
@@ -170,7 +171,7 @@ class Server:
         if self.record is not None:
             row = (self.tick_count, self.time, float(enabled), *force, *torque, *hand, *self.q, *self.v,
                    *(self.to_theta.T @ theta).tolist(), *self.gimbal, *tau.tolist(), *applied)
-            self.record.write(",".join(repr(float(x)) for x in row) + "\n")
+            self.record.write(struct.pack(f"={len(RECORD_COLUMNS)}d", *row))
         failed = False
         if held:
             self.q, self.v = list(self.theta0), [0.0, 0.0, 0.0]

@@ -37,14 +37,18 @@ RECORD_COLUMNS = ("tick", "t", "enabled", "force1", "force2", "force3", "torque1
                   "gimbal1", "gimbal2", "gimbal3", "tau1", "tau2", "tau3", "applied1", "applied2", "applied3")
 
 
+#: The record's first line (then float64 rows of RECORD_COLUMNS, native byte order).
+RECORD_HEADER = "phantom_pin stand-in record: " + ",".join(RECORD_COLUMNS) + "\n"
+
+
 def read_record(path: str | Path) -> dict[str, np.ndarray]:
     """The stand-in's record (PHANTOM_PIN_HD_RECORD): RECORD_COLUMNS -> (ticks,) arrays."""
     try:
-        table = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except (OSError, ValueError) as error:
-        raise InvalidInputError(f"not a stand-in record: {error}", argument="path") from None
-    if table.shape[1] != len(RECORD_COLUMNS):
-        raise InvalidInputError(f"expected {len(RECORD_COLUMNS)} columns, got {table.shape[1]}", argument="path")
-    return {name: table[:, i] for i, name in enumerate(RECORD_COLUMNS)}
-
-
+        data = Path(path).read_bytes()
+    except OSError as error:
+        raise InvalidInputError(f"cannot read it: {error.strerror}", argument="path") from None
+    header = RECORD_HEADER.encode()
+    if not data.startswith(header) or (len(data) - len(header)) % (8 * len(RECORD_COLUMNS)):
+        raise InvalidInputError("not a stand-in record of this version", argument="path")
+    table = np.frombuffer(data[len(header):], dtype=np.float64).reshape(-1, len(RECORD_COLUMNS))
+    return {name: table[:, i].copy() for i, name in enumerate(RECORD_COLUMNS)}
