@@ -309,3 +309,48 @@ def test_an_overlays_banner_is_wrapped_into_short_comment_lines():
     assert len(overlay) > 1 and max(len(line) for line in overlay) <= 100
     flat = " ".join(line.strip(" *") for line in overlay)
     assert all(f"{key} = {value!r}" in flat for key, value in OVERLAY.items())
+
+
+#: The servo loop's own terms (docs/servo-loop.md, "In your servo loop"): per state a, b = angles.
+SERVO_SHIM = """#include "model.h"
+void servo(int n, const double *a, const double *g, const double *r, double *out) {
+    int k; for (k = 0; k < n; ++k) {
+        phantom_openhaptics_force(a + 3 * k, g + 3 * k, out + 12 * k);
+        phantom_openhaptics_joint_torque(a + 3 * k, g + 3 * k, out + 12 * k + 3);
+        phantom_openhaptics_force_friction(a + 3 * k, g + 3 * k, r + 3 * k, out + 12 * k + 6);
+        phantom_openhaptics_joint_torque_friction(a + 3 * k, g + 3 * k, r + 3 * k, out + 12 * k + 9); } }
+"""
+
+
+@pytest.mark.parametrize("name", models())
+def test_the_servo_loop_functions_compensate_gravity_and_friction(name, tmp_path):
+    """NAME_openhaptics_force and _joint_torque (and their _friction forms), compiled strictly,
+    on 200 seeded states inside the stops (the Touch's gimbal inside its ranges, OpenHaptics'
+    angles a = (-theta1, theta2, theta3)): J^T F and the joint torques on theta equal the
+    gravity of references independent of Phantom (tests/openhaptics_reference.py: the closed
+    form, the CAD's re-derivation, the Touch's six-joint URDF in Pinocchio) to 1e-9 N m, plus the
+    friction law (actuation.yaml's numbers) at the rates given; NAME_STYLUS says whether the
+    model has a gimbal."""
+    from openhaptics_reference import gravity_and_jacobian
+    text = generated(name)
+    library = build(text, tmp_path, SERVO_SHIM)
+    config = describe(name).config
+    n = 200
+    theta = random_states(config.limits, n, seed=61)[0]
+    rng = np.random.default_rng(62)
+    gimbal = np.zeros((n, 3)) if config.gimbal is None else rng.uniform(config.gimbal.lower, config.gimbal.upper, (n, 3))
+    rates = rng.normal(0, 1, (n, 3))
+    sign = np.array([-1.0, 1.0, 1.0])
+    out = np.empty((n, 12))
+    pointer = ctypes.POINTER(ctypes.c_double)
+    arrays = [np.ascontiguousarray(x) for x in (sign * theta, gimbal, rates)]
+    library.servo(ctypes.c_int(n), *(x.ctypes.data_as(pointer) for x in arrays), out.ctypes.data_as(pointer))
+    law = config.actuation.friction
+    for k in range(n):
+        gravity, jacobian = gravity_and_jacobian(name, theta[k], None if config.gimbal is None else gimbal[k])
+        friction = np.array(law.viscous) * sign * rates[k] + np.array(law.coulomb) * np.sign(sign * rates[k])
+        assert np.abs(jacobian.T @ out[k, :3] - gravity).max() <= 1e-9
+        assert np.abs(sign * out[k, 3:6] / 1000 - gravity).max() <= 1e-9
+        assert np.abs(jacobian.T @ out[k, 6:9] - gravity - friction).max() <= 1e-9
+        assert np.abs(sign * out[k, 9:12] / 1000 - gravity - friction).max() <= 1e-9
+    assert f"#define PHANTOM_STYLUS {int(config.gimbal is not None)}" in text
