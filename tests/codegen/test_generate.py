@@ -338,7 +338,8 @@ def test_the_servo_loop_functions_compensate_gravity_and_friction(name, tmp_path
     n = 200
     theta = random_states(config.limits, n, seed=61)[0]
     rng = np.random.default_rng(62)
-    gimbal = np.zeros((n, 3)) if config.gimbal is None else rng.uniform(config.gimbal.lower, config.gimbal.upper, (n, 3))
+    gimbal = np.zeros((n, 3)) if config.gimbal is None else \
+        rng.uniform(config.gimbal.lower, config.gimbal.upper, (n, 3))
     rates = rng.normal(0, 1, (n, 3))
     sign = np.array([-1.0, 1.0, 1.0])
     out = np.empty((n, 12))
