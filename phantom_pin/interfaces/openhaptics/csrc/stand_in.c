@@ -375,23 +375,17 @@ static int capability(HDenum cap)
     return (int)(cap - HD_FORCE_OUTPUT);
 }
 
-HDAPI void HDAPIENTRY hdEnable(HDenum cap)
+static void set_capability(HDenum cap, int value)
 {
     int i;
     pthread_mutex_lock(&g_lock);
     if ((i = capability(cap)) >= 0)
-        g_enabled[i] = 1;
+        g_enabled[i] = value;
     pthread_mutex_unlock(&g_lock);
 }
 
-HDAPI void HDAPIENTRY hdDisable(HDenum cap)
-{
-    int i;
-    pthread_mutex_lock(&g_lock);
-    if ((i = capability(cap)) >= 0)
-        g_enabled[i] = 0;
-    pthread_mutex_unlock(&g_lock);
-}
+HDAPI void HDAPIENTRY hdEnable(HDenum cap) { set_capability(cap, 1); }
+HDAPI void HDAPIENTRY hdDisable(HDenum cap) { set_capability(cap, 0); }
 
 HDAPI HDboolean HDAPIENTRY hdIsEnabled(HDenum cap)
 {
