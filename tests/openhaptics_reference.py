@@ -1,4 +1,5 @@
-"""Independent references for the OpenHaptics tests (tests/interfaces/).
+"""Independent references for the OpenHaptics tests (tests/interfaces/), and their shared helpers
+(falling_posture, tips, framed, residuals).
 
 - HDDEFINES: the values of SensAble's HD/hdDefines.h and hdScheduler.h (OpenHaptics 3.30), read
   at hhmai/PhantomAPI commit e01998c, include/HD/hdDefines.h, and SensAble's hdScheduler.h
@@ -22,6 +23,9 @@ from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
+
+#: N m: |J^T F - gravity| at every tick (both sides exact up to rounding; measured below 1e-13)
+TOLERANCE = 1e-9
 
 HDDEFINES = {
     "HD_SUCCESS": 0x0000, "HD_INVALID_ENUM": 0x0100, "HD_INVALID_VALUE": 0x0101, "HD_INVALID_OPERATION": 0x0102,
@@ -116,3 +120,49 @@ def gravity_and_jacobian(name: str, theta: np.ndarray, gimbal: np.ndarray | None
     jacobian = np.column_stack([(_tip(theta + h * e, k.l1, k.l2) - _tip(theta - h * e, k.l1, k.l2)) / (2 * h)
                                 for e in np.eye(3)])
     return cad_reference.gravity(theta), jacobian
+
+
+def falling_posture(name, seed=49):
+    """A seeded posture inside the stops where gravity beats static friction (some joint's gravity
+    torque at least 3 times its breakaway torque) and the tip Jacobian is far from singular."""
+    from phantom_pin.config import read
+    from phantom_pin.config.sampling import random_states
+
+    config = read(name)
+    for theta in random_states(config.limits, 200, seed=seed)[0]:
+        gravity, jacobian = gravity_and_jacobian(name, theta)
+        if np.max(np.abs(gravity) / np.array(config.actuation.friction.coulomb)) > 3 and \
+                abs(np.linalg.det(jacobian)) > 1e-4:
+            return theta
+    raise AssertionError("no posture")
+
+
+def tips(name, theta):
+    if name == "touch":
+        return np.array([_six().pose(t, np.zeros(3), "tip")[:3, 3] for t in theta])
+    from phantom_pin.config import read
+
+    k = read(name).kinematics
+    return np.array([_tip(t, k.l1, k.l2) for t in theta])
+
+
+def framed(record):
+    """The ticks in which a frame ended: the scheduler ticks without a frame (its command zero)
+    before a callback is scheduled and between the callback's last tick and hdStopScheduler."""
+    keep = record["framed"] == 1
+    ticks = np.flatnonzero(keep)
+    assert len(ticks) and (np.diff(ticks) == 1).all()      # frameless ticks only before and after
+    return {k: v[keep] for k, v in record.items()}
+
+
+def residuals(name, record, shift=0):
+    """|J^T F - gravity| (N m) per tick, the command of tick k against the state of tick k - shift."""
+    theta = np.column_stack([record[f"theta{i}"] for i in (1, 2, 3)])
+    force = np.column_stack([record[f"force{i}"] for i in (1, 2, 3)])
+    torque = np.column_stack([record[f"torque{i}"] for i in (1, 2, 3)])
+    out = []
+    for k in range(shift, len(theta)):
+        gravity, jacobian = gravity_and_jacobian(name, theta[k - shift])
+        applied = jacobian.T @ force[k] + torque[k] * np.array([-1.0, 1.0, 1.0]) / 1000.0
+        out.append(np.abs(applied - gravity).max())
+    return np.array(out)

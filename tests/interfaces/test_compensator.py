@@ -16,14 +16,18 @@ from openhaptics_reference import (
     HDDEFINES,
     PYOPENHAPTICS_DIFFERS,
     PYOPENHAPTICS_SPELLING,
+    TOLERANCE,
+    falling_posture,
+    framed,
     gravity_and_jacobian,
     pyopenhaptics_defines,
+    residuals,
+    tips,
 )
 from phantom_pin.config import models, read
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.interfaces.openhaptics import Compensator, build, read_record
-from test_stand_in import TOLERANCE, falling_posture, residuals, tips
 
 SIGN = np.array([-1.0, 1.0, 1.0])     # theta = SIGN * OpenHaptics' angles (Ubitrack's eq., tests/codegen)
 
@@ -122,7 +126,7 @@ def test_a_pyopenhaptics_callback_floats_the_stylus(name, tmp_path):
     done = subprocess.run([sys.executable, "callback.py", name], cwd=tmp_path, env=env, capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0, done.stderr
-    record = read_record(tmp_path / "record.csv")
+    record = framed(read_record(tmp_path / "record.csv"))
     assert len(record["tick"]) >= 5000
     assert record["enabled"].all()
     theta = np.column_stack([record[f"theta{i}"] for i in (1, 2, 3)])

@@ -14,33 +14,18 @@ import subprocess
 import numpy as np
 import pytest
 
-from openhaptics_reference import HDDEFINES, gravity_and_jacobian
+from openhaptics_reference import HDDEFINES, TOLERANCE, falling_posture, framed, residuals, tips
 from phantom_pin.config import MODELS, models, read
-from phantom_pin.config.sampling import random_states
 from phantom_pin.interfaces.openhaptics import build, read_record
 from phantom_pin.interfaces.openhaptics.stand_in import headers
 
 EXAMPLE = MODELS["premium_1_5"].urdf.parents[3] / "examples" / "openhaptics_gravity.c"
 INCLUDE = MODELS["premium_1_5"].urdf.parents[1] / "include"
-#: N m: |J^T F - gravity| at every tick (both sides exact up to rounding; measured below 1e-13)
-TOLERANCE = 1e-9
 MODES = ("force", "joint_torque")
 
 
 def header_of(name):
     return {"premium_1_5": "phantom_1_5.h", "premium_1_5_cad": "phantom_1_5_cad.h", "touch": "phantom_touch.h"}[name]
-
-
-def falling_posture(name, seed=49):
-    """A seeded posture inside the stops where gravity beats static friction (some joint's gravity
-    torque at least 3 times its breakaway torque) and the tip Jacobian is far from singular."""
-    config = read(name)
-    for theta in random_states(config.limits, 200, seed=seed)[0]:
-        gravity, jacobian = gravity_and_jacobian(name, theta)
-        if np.max(np.abs(gravity) / np.array(config.actuation.friction.coulomb)) > 3 and \
-                abs(np.linalg.det(jacobian)) > 1e-4:
-            return theta
-    raise AssertionError("no posture")
 
 
 @pytest.fixture(scope="module")
@@ -72,28 +57,6 @@ def run(folder, variant, seconds, theta, record, **env):
     return read_record(record), done.stdout
 
 
-def tips(name, theta):
-    from openhaptics_reference import _tip
-    if name == "touch":
-        from openhaptics_reference import _six
-        return np.array([_six().pose(t, np.zeros(3), "tip")[:3, 3] for t in theta])
-    k = read(name).kinematics
-    return np.array([_tip(t, k.l1, k.l2) for t in theta])
-
-
-def residuals(name, record, shift=0):
-    """|J^T F - gravity| (N m) per tick, the command of tick k against the state of tick k - shift."""
-    theta = np.column_stack([record[f"theta{i}"] for i in (1, 2, 3)])
-    force = np.column_stack([record[f"force{i}"] for i in (1, 2, 3)])
-    torque = np.column_stack([record[f"torque{i}"] for i in (1, 2, 3)])
-    out = []
-    for k in range(shift, len(theta)):
-        gravity, jacobian = gravity_and_jacobian(name, theta[k - shift])
-        applied = jacobian.T @ force[k] + torque[k] * np.array([-1.0, 1.0, 1.0]) / 1000.0
-        out.append(np.abs(applied - gravity).max())
-    return np.array(out)
-
-
 @pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("name", models())
 def test_the_example_floats_the_stylus_with_the_three_lines(programs, name, mode, tmp_path):
@@ -102,6 +65,7 @@ def test_the_example_floats_the_stylus_with_the_three_lines(programs, name, mode
     tick's command gives J^T F = gravity (or the joint torques' own) within TOLERANCE."""
     theta0 = falling_posture(name)
     record, _ = run(programs[name], mode, 5, theta0, tmp_path / "record.csv")
+    record = framed(record)
     assert len(record["tick"]) == 5000
     theta = np.column_stack([record[f"theta{i}"] for i in (1, 2, 3)])
     drift = np.linalg.norm(tips(name, theta[::50]) - tips(name, theta0[None])[0], axis=1).max()
@@ -126,6 +90,7 @@ def test_the_compensation_acts_in_the_tick_of_its_state(programs, tmp_path):
     and not at the previous tick's (more than 1e-7 N m off where the arm moves)."""
     theta0 = falling_posture("touch")
     record, _ = run(programs["touch"], "force", 0.5, theta0, tmp_path / "record.csv", PHANTOM_PIN_HD_HAND="0.3 0.2 0")
+    record = framed(record)
     moving = np.abs(np.diff(record["theta2"])).max()
     assert moving > 1e-5
     assert residuals("touch", record).max() <= TOLERANCE

@@ -169,7 +169,7 @@ class Server:
         held = self.time < self.hold
         applied = [0.0, 0.0, 0.0] if held else self.plant.saturate(tau.tolist())
         if self.record is not None:
-            row = (self.tick_count, self.time, float(enabled), *force, *torque, *hand, *self.q, *self.v,
+            row = (self.tick_count, self.time, float(enabled), command[11], *force, *torque, *hand, *self.q, *self.v,
                    *(self.to_theta.T @ theta).tolist(), *self.gimbal, *tau.tolist(), *applied)
             self.record.write(struct.pack(f"={len(RECORD_COLUMNS)}d", *row))
         failed = False

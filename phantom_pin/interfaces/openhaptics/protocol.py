@@ -18,20 +18,21 @@ INFO_FIELDS = ("max_force", "max_continuous_force", "max_stiffness", "peak_torqu
                "workspace_max_x", "workspace_max_y", "workspace_max_z")
 #: A command's doubles by offset: the flag (QUIT, DISABLED: HD_FORCE_OUTPUT off, or ENABLED), the
 #: force (N, OpenHaptics' axes), the joint torques (mN m on OpenHaptics' angles), the period (s)
-#: they are held over, the hand's force (N, OpenHaptics' axes, at the gimbal centre).
-COMMAND_LAYOUT = {"FLAG": 0, "FORCE": 1, "TORQUE": 4, "PERIOD": 7, "HAND": 8}
-COMMAND = 11
+#: they are held over, the hand's force (N, OpenHaptics' axes, at the gimbal centre), and 1 where
+#: a frame ended in the tick (0: no callback ran a frame, and the command is zero).
+COMMAND_LAYOUT = {"FLAG": 0, "FORCE": 1, "TORQUE": 4, "PERIOD": 7, "HAND": 8, "FRAMED": 11}
+COMMAND = 12
 QUIT, DISABLED, ENABLED = -1, 0, 1
 #: A state's doubles by offset: joint angles (rad), gimbal angles (rad), position (mm), velocity
 #: (mm/s), the column-major transform (mm), then 0 or, where the plant failed, 1.
 STATE_LAYOUT = {"JOINT": 0, "GIMBAL": 3, "POSITION": 6, "VELOCITY": 9, "TRANSFORM": 12}
 STATE = 29
 #: The record's columns (one row per tick): the tick, its time (s), whether force output was
-#: on, the force (N) and joint torques (mN m) sent and the hand's force (N), the report's theta
+#: on, whether a frame ended in it, the force (N) and joint torques (mN m) sent and the hand's force (N), the report's theta
 #: (rad) and dtheta (rad/s) served in that tick, OpenHaptics' joint and gimbal angles served
 #: (rad), the torque the command and the hand put on theta (N m, before the motors'
 #: saturation) and the torque applied after it (N m).
-RECORD_COLUMNS = ("tick", "t", "enabled", "force1", "force2", "force3", "torque1", "torque2", "torque3",
+RECORD_COLUMNS = ("tick", "t", "enabled", "framed", "force1", "force2", "force3", "torque1", "torque2", "torque3",
                   "hand1", "hand2", "hand3",
                   "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3", "angle1", "angle2", "angle3",
                   "gimbal1", "gimbal2", "gimbal3", "tau1", "tau2", "tau3", "applied1", "applied2", "applied3")

@@ -65,6 +65,7 @@ static int g_in_frame;
 static double g_frame_force[3], g_frame_torque[3];     /* set in the open frame */
 static double g_tick_force[3], g_tick_torque[3];       /* of the tick's last ended frame */
 static double g_last_force[3], g_last_torque[3];       /* sent at the previous tick */
+static int g_tick_framed;                              /* a frame ended in this tick */
 static HDErrorInfo g_errors[MAX_ERRORS];
 static int g_error_count;
 
@@ -320,6 +321,7 @@ HDAPI void HDAPIENTRY hdEndFrame(HHD hHD)
             g_in_frame = 0;
             memcpy(g_tick_force, g_frame_force, sizeof g_tick_force);
             memcpy(g_tick_torque, g_frame_torque, sizeof g_tick_torque);
+            g_tick_framed = 1;
         }
     }
     pthread_mutex_unlock(&g_lock);
@@ -678,6 +680,8 @@ static int exchange(void)
         command[PP_HAND + i] = g_hand[i];
     }
     command[PP_PERIOD] = 1.0 / (double)g_rate;
+    command[PP_FRAMED] = g_tick_framed;
+    g_tick_framed = 0;
     socket = g_socket;
     pthread_mutex_unlock(&g_lock);
     if (socket < 0 || write_all(socket, command, sizeof command) != 0 || read_all(socket, state, sizeof state) != 0)
