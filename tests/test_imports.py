@@ -66,7 +66,7 @@ def test_the_import_graph_has_no_cycle():
 LAYERS = {"exceptions": 0, "_validation": 0, "_paths": 0, "_integration": 0, "_progress": 0, "inertial": 0,
           "report": 1, "config": 2, "description": 3, "dynamics": 4, "drivers": 4, "profiles": 4,
           "device": 5, "verification": 5, "plots": 5, "identification": 6, "forces": 6, "codegen": 6,
-          "viewer": 6, "robot_descriptions": 6, "ros2": 7, "sim_driver": 7, "cli": 8, "": 9}
+          "viewer": 6, "robot_descriptions": 6, "ros2": 7, "sim_driver": 7, "interfaces": 7, "cli": 8, "": 9}
 
 
 def _layer(name: str) -> int | None:

@@ -22,6 +22,10 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from phantom_pin.codegen.c import ASSUMES as _ASSUMES
+from phantom_pin.codegen.c import body as _body
+from phantom_pin.codegen.c import function as _function
+from phantom_pin.codegen.servo import openhaptics
 from phantom_pin.codegen.tree import ARM_JOINTS as ARM_JOINTS  # (where it lived before)
 from phantom_pin.codegen.tree import Joint, read_tree
 from phantom_pin.config import MODELS
@@ -231,46 +235,6 @@ def _leaner(exprs: list[Any]) -> list[Any]:
     return expanded if cost(expanded) < cost(exprs) else exprs
 
 
-# -- C ---------------------------------------------------------------------------------------
-class _Printer(C99CodePrinter):
-    """SymPy's C99 printer with small integer powers as products (gcc inlines pow(x, 2)
-    alone) and literals with 17 digits."""
-
-    def _print_Pow(self, expr: Any) -> str:
-        if expr.exp.is_Integer and 2 <= expr.exp <= 8:  # libm's pow is a call, not inlined
-            base = self.parenthesize(expr.base, 100)
-            return "(" + "*".join([base] * int(expr.exp)) + ")"
-        return super()._print_Pow(expr)
-
-
-def _body(outputs: list[tuple[str, Any]], inputs: list[tuple[str, list[Any]]]) -> str:
-    """C statements: the used inputs unpacked, the common subexpressions, the outputs."""
-    printer = _Printer({"precision": 17})
-    exprs = [e for _, e in outputs]
-    temps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("x"), order="none")
-    used = set().union(*(e.free_symbols for e in exprs))
-    lines = []
-    for array, symbols in inputs:
-        taken = [(i, s) for i, s in enumerate(symbols) if s in used]
-        if not taken:
-            lines.append(f"    (void){array};")
-        for i, s in taken:
-            lines.append(f"    const double {s} = {array}[{i}];")
-    for symbol, expr in temps:
-        lines.append(f"    const double {symbol} = {printer.doprint(expr)};")
-    for (target, _), expr in zip(outputs, reduced):
-        lines.append(f"    {target} = {printer.doprint(expr)};")
-    return "\n".join(lines)
-
-
-def _function(comment: str, signature: str, body: str) -> str:
-    text = "\n".join(" * " + line if line else " *" for line in comment.strip().splitlines())
-    return f"/*\n{text}\n */\nstatic inline void {signature}\n{{\n{body}\n}}\n"
-
-
-_ASSUMES = "Assumes finite input: no checks, no allocation, no global state."
-
-
 def header(source: str | Path | Description, prefix: str = "phantom",
            overrides: Mapping[str, object] | None = None,
            progress: Callable[[float], None] | None = None, *, argument: str = "source") -> str:
@@ -371,18 +335,6 @@ def _gravity_stylus_body(description: Description) -> str:
     return _body([(f"tau[{i}]", gravity[i]) for i in range(3)], [("theta", theta), ("gimbal", gimbal)])
 
 
-#: F of J^T F = tau: F = (J^-1)^T tau, J^-1 = adj(J) / det(J) (J row-major, as tip_jacobian's).
-_SOLVE = """    double J[9], det;
-    {p}_tip_jacobian(theta, J);
-    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
-    f[0] = (tau[0] * (J[4] * J[8] - J[5] * J[7]) - tau[1] * (J[3] * J[8] - J[5] * J[6])
-            + tau[2] * (J[3] * J[7] - J[4] * J[6])) / det;
-    f[1] = (-tau[0] * (J[1] * J[8] - J[2] * J[7]) + tau[1] * (J[0] * J[8] - J[2] * J[6])
-            - tau[2] * (J[0] * J[7] - J[1] * J[6])) / det;
-    f[2] = (tau[0] * (J[1] * J[5] - J[2] * J[4]) - tau[1] * (J[0] * J[5] - J[2] * J[3])
-            + tau[2] * (J[0] * J[4] - J[1] * J[3])) / det;"""
-
-
 def _friction_body(description: Description) -> str:
     """The friction law in motion (config.Friction, Device.friction): viscous dtheta + Coulomb
     sign(dtheta) per joint, sign(0) = 0."""
@@ -427,7 +379,7 @@ def _header(description: Description, prefix: str, origin: str, overlay: str,
                   f"{prefix}_jacobian_transpose_force(const double theta[3], const double f[3], double tau[3])",
                   body["jacobian_transpose_force"]),
         *([] if "stylus_pose" not in body else [_stylus(prefix, body["stylus_pose"])]),
-        _openhaptics(prefix, body, description.config.gimbal is not None),
+        openhaptics(prefix, body, description.config.gimbal is not None),
         f"#ifdef __cplusplus\n}}\n#endif\n\n#endif /* {guard} */\n",
     ]
     return "\n".join(parts)
@@ -487,71 +439,3 @@ def _stylus(prefix: str, body: str) -> str:
         "(rad); gimbal: OpenHaptics' raw gimbal angles g1..g3 (rad, the URDF's joint4..joint6).\n"
         f"{_ASSUMES}",
         f"{prefix}_stylus_pose(const double theta[3], const double gimbal[3], double p[3], double R[9])", body)
-
-
-def _openhaptics(prefix: str, body: dict[str, str], has_gimbal: bool) -> str:
-    """OpenHaptics' conventions (phantom_pin.drivers): angles theta = (-a1, a2, a3);
-    HD_CURRENT_JOINT_TORQUE (mN m) = 1000 (-tau1, tau2, tau3); and the compensation in the servo
-    loop's own terms: HD_CURRENT_FORCE (N) or HD_CURRENT_JOINT_TORQUE (mN m) of the angles
-    HD_CURRENT_JOINT_ANGLES and HD_CURRENT_GIMBAL_ANGLES give, optionally with friction."""
-    p = prefix
-    gravity = (f"    {p}_gravity_stylus(theta, gimbal_angles, tau);" if has_gimbal else
-               f"    (void)gimbal_angles;\n    {p}_gravity(theta, tau);")
-    stylus = ("the stylus gimbal at gimbal_angles (HD_CURRENT_GIMBAL_ANGLES, rad)" if has_gimbal else
-              "gimbal_angles ignored (this model has no stylus gimbal: pass NULL)")
-    rates = ("joint_rates: the rates of HD_CURRENT_JOINT_ANGLES (rad/s, the caller's estimate, e.g. filtered\n"
-             "differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).")
-    parts = [
-        _function("The report's theta (rad) of OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad): (-a1, a2, a3)\n"
-                  "(phantom_pin.drivers.theta_from_openhaptics).",
-                  f"{p}_theta_from_openhaptics(const double angles[3], double theta[3])",
-                  "    theta[0] = -angles[0];\n    theta[1] = angles[1];\n    theta[2] = angles[2];"),
-        _function("OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau\n"
-                  "(N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau),\n"
-                  "each torque acting on its own OpenHaptics angle (SensAble's CommandJointTorque sample\n"
-                  "renders a restoring joint spring T = k (0 - a), k > 0, on that reading: docs/servo-loop.md).",
-                  f"{p}_openhaptics_torque_from_tau(const double tau[3], double torque[3])",
-                  "    torque[0] = -1000.0 * tau[0];\n    torque[1] = 1000.0 * tau[1];\n"
-                  "    torque[2] = 1000.0 * tau[2];"),
-        _function(f"The friction torques in motion (N m) at joint rates dtheta (rad/s): viscous dtheta +\n"
-                  f"Coulomb sign(dtheta) per joint, 0 for a joint at rest (phantom_pin.Device.friction).\n"
-                  f"{_ASSUMES}",
-                  f"{p}_friction(const double dtheta[3], double tau[3])", body["friction"]),
-        _function("The tip force f (N, frame s = OpenHaptics' axes) whose J^T f is tau (N m): J^-T tau, J the\n"
-                  "tip Jacobian at theta. At a kinematic singularity (det J = 0: the arm stretched, or the tip\n"
-                  "on joint 1's axis) no force gives every torque and the result is not finite.\n"
-                  f"{_ASSUMES}",
-                  f"{p}_force_from_tau(const double theta[3], const double tau[3], double f[3])",
-                  _SOLVE.replace("{p}", p)),
-    ]
-    if has_gimbal:
-        parts.insert(2, _function(
-            "Gravity torques (N m on theta) with the stylus gimbal at gimbal (OpenHaptics' raw gimbal angles,\n"
-            "rad), as phantom_pin.Phantom.gravity(theta, gimbal=gimbal): the arm's, the gimbal's own held by\n"
-            f"the hand. {_ASSUMES}",
-            f"{p}_gravity_stylus(const double theta[3], const double gimbal[3], double tau[3])",
-            body["gravity_stylus"]))
-    for friction in (False, True):
-        suffix, arg = ("_friction", ", const double joint_rates[3]") if friction else ("", "")
-        extra = (f"\n    {{\n        double rates[3], f[3];\n        {p}_theta_from_openhaptics(joint_rates, rates);\n"
-                 f"        {p}_friction(rates, f);\n        tau[0] += f[0];\n        tau[1] += f[1];\n"
-                 "        tau[2] += f[2];\n    }") if friction else ""
-        more = ("\n" + rates) if friction else ""
-        parts.append(_function(
-            f"HD_CURRENT_FORCE (N, OpenHaptics' axes) that compensates the device's gravity at the angles\n"
-            f"joint_angles (HD_CURRENT_JOINT_ANGLES, rad), {stylus}: J^T F = N(theta).{more}\n"
-            f"Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_FORCE, force). Not finite at a\n"
-            f"kinematic singularity ({p}_force_from_tau). {_ASSUMES}",
-            f"{p}_openhaptics_force{suffix}(const double joint_angles[3], const double gimbal_angles[3]{arg}, "
-            f"double force[3])",
-            f"    double theta[3], tau[3];\n    {p}_theta_from_openhaptics(joint_angles, theta);\n{gravity}{extra}\n"
-            f"    {p}_force_from_tau(theta, tau, force);"))
-        parts.append(_function(
-            f"HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates the device's gravity at\n"
-            f"joint_angles (HD_CURRENT_JOINT_ANGLES, rad), {stylus}.{more}\n"
-            f"Between hdBeginFrame and hdEndFrame: hdSetDoublev(HD_CURRENT_JOINT_TORQUE, torque). {_ASSUMES}",
-            f"{p}_openhaptics_joint_torque{suffix}(const double joint_angles[3], const double gimbal_angles[3]{arg}, "
-            f"double torque[3])",
-            f"    double theta[3], tau[3];\n    {p}_theta_from_openhaptics(joint_angles, theta);\n{gravity}{extra}\n"
-            f"    {p}_openhaptics_torque_from_tau(tau, torque);"))
-    return "\n".join(parts)

@@ -28,10 +28,10 @@ QUIT, DISABLED, ENABLED = -1, 0, 1
 STATE_LAYOUT = {"JOINT": 0, "GIMBAL": 3, "POSITION": 6, "VELOCITY": 9, "TRANSFORM": 12}
 STATE = 29
 #: The record's columns (one row per tick): the tick, its time (s), whether force output was
-#: on, whether a frame ended in it, the force (N) and joint torques (mN m) sent and the hand's force (N), the report's theta
-#: (rad) and dtheta (rad/s) served in that tick, OpenHaptics' joint and gimbal angles served
-#: (rad), the torque the command and the hand put on theta (N m, before the motors'
-#: saturation) and the torque applied after it (N m).
+#: on, whether a frame ended in it, the force (N) and joint torques (mN m) sent and the hand's
+#: force (N), the report's theta (rad) and dtheta (rad/s) served in that tick, OpenHaptics'
+#: joint and gimbal angles served (rad), the torque the command and the hand put on theta (N m,
+#: before the motors' saturation) and the torque applied after it (N m).
 RECORD_COLUMNS = ("tick", "t", "enabled", "framed", "force1", "force2", "force3", "torque1", "torque2", "torque3",
                   "hand1", "hand2", "hand3",
                   "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3", "angle1", "angle2", "angle3",
