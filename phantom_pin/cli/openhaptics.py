@@ -21,8 +21,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     """openhaptics-sim."""
     command = sub.add_parser("openhaptics-sim", help="a stand-in for OpenHaptics' libHD that runs HDAPI programs "
                                                      "(C, pyOpenHaptics) against the simulated device")
-    actions = command.add_subparsers(dest="action", required=True)
-    action = actions.add_parser("build", help="write DIR/include/HD/hd.h and DIR/lib/libHD.so (gcc)")
-    action.add_argument("directory", metavar="DIR", help="the folder to write include/ and lib/ into")
-    action.add_argument("--force", "-f", action="store_true", help="overwrite existing files")
-    action.set_defaults(run=build, options={"directory": "DIR"})
+    command.add_argument("action", choices=("build",),
+                         help="build: write DIR/include/HD/hd.h (and the headers it includes) and DIR/lib/libHD.so (gcc)")
+    command.add_argument("directory", metavar="DIR", help="the folder to write include/ and lib/ into")
+    command.add_argument("--force", "-f", action="store_true", help="overwrite existing files")
+    command.set_defaults(run=build, options={"directory": "DIR"})

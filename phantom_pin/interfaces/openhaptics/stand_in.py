@@ -51,7 +51,7 @@ def layout(model: str, python: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def build(directory: str | Path, model: str | Path = "premium_1_5", *, force: bool = False,
+def build(directory: str | Path, model: str | Path, *, force: bool = False,
           python: str | None = None, argument: str = "directory", force_hint: str = "force=True") -> Path:
     """Write the stand-in into ``directory`` (module doc) for ``model`` (a model's name or a
     configuration folder: its default device; PHANTOM_PIN_HD_MODEL chooses another at run
