@@ -22,7 +22,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command = sub.add_parser("openhaptics-sim", help="a stand-in for OpenHaptics' libHD that runs HDAPI programs "
                                                      "(C, pyOpenHaptics) against the simulated device")
     command.add_argument("action", choices=("build",),
-                         help="build: write DIR/include/HD/hd.h (and the headers it includes) and DIR/lib/libHD.so (gcc)")
+                         help="build: write DIR/include/HD/hd.h (and what it includes) and DIR/lib/libHD.so (gcc)")
     command.add_argument("directory", metavar="DIR", help="the folder to write include/ and lib/ into")
     command.add_argument("--force", "-f", action="store_true", help="overwrite existing files")
     command.set_defaults(run=build, options={"directory": "DIR"})
