@@ -223,3 +223,74 @@ def test_the_command_builds_refuses_to_overwrite_and_writes_nothing_on_failure(t
         code, _, err = run_cli(*arguments)
         assert code == 2 and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "missing").exists() and not (tmp_path / "other").exists()
+
+
+SCHEDULER = r"""
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <time.h>
+#include <HD/hd.h>
+#include <HD/phantom_pin_sim.h>
+static char order[64];
+static int n, ticks_a, ticks_b;
+static double last[3], previous[3], mismatch;
+static HDCallbackCode HDCALLBACK low(void *d) { (void)d; if (n < 60) order[n++] = 'L'; ++ticks_b; return HD_CALLBACK_CONTINUE; }
+static HDCallbackCode HDCALLBACK high(void *d)
+{
+    double now[3];
+    (void)d;
+    if (n < 60) order[n++] = 'H';
+    hdBeginFrame(hdGetCurrentDevice());
+    hdGetDoublev(HD_LAST_JOINT_ANGLES, last);
+    hdGetDoublev(HD_CURRENT_JOINT_ANGLES, now);
+    if (ticks_a > 0)   /* HD_LAST_* is the previous tick's HD_CURRENT_* */
+        for (int i = 0; i < 3; ++i) mismatch += (last[i] - previous[i]) * (last[i] - previous[i]);
+    previous[0] = now[0]; previous[1] = now[1]; previous[2] = now[2];
+    hdEndFrame(hdGetCurrentDevice());
+    return ++ticks_a < 300 ? HD_CALLBACK_CONTINUE : HD_CALLBACK_DONE;
+}
+int main(void)
+{
+    struct timespec t0, t1;
+    HDint rate = 0, dof = 0;
+    HHD h = hdInitDevice(HD_DEFAULT_DEVICE);
+    HDSchedulerHandle b = hdScheduleAsynchronous(low, 0, HD_MIN_SCHEDULER_PRIORITY);
+    HDSchedulerHandle a = hdScheduleAsynchronous(high, 0, HD_MAX_SCHEDULER_PRIORITY);
+    hdGetIntegerv(HD_UPDATE_RATE, &rate);
+    hdGetIntegerv(HD_OUTPUT_DOF, &dof);
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    hdStartScheduler();
+    hdWaitForCompletion(a, HD_WAIT_INFINITE);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    printf("done %d %d\n", hdWaitForCompletion(a, HD_WAIT_CHECK_STATUS), hdWaitForCompletion(b, HD_WAIT_CHECK_STATUS));
+    hdUnschedule(b);
+    int before = ticks_b;
+    HDulong t = phantomPinSimTicks();
+    while (phantomPinSimTicks() < t + 5) ;
+    hdStopScheduler();
+    printf("order %.6s\nrate %d dof %d\nunscheduled %d\nmismatch %g\nseconds %f\n", order, rate, dof,
+           ticks_b - before <= 1, mismatch, (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec));
+    hdDisableDevice(h);
+    return 0;
+}
+"""
+
+
+def test_the_scheduler_runs_by_priority_in_real_time(tmp_path):
+    """Callbacks run highest priority first every tick; HD_WAIT_INFINITE returns once the callback
+    is done and HD_WAIT_CHECK_STATUS then says so (the other still scheduled); hdUnschedule stops a
+    callback; HD_LAST_JOINT_ANGLES is the previous tick's HD_CURRENT_JOINT_ANGLES exactly; 300
+    ticks at the default 1000 Hz take at least 0.3 s of the monotonic clock (paced, not faster)."""
+    build(tmp_path / "sim", "touch")
+    (tmp_path / "scheduler.c").write_text(SCHEDULER)
+    subprocess.run(["gcc", "-std=c99", "-Wall", "-Werror", f"-I{tmp_path / 'sim' / 'include'}", "scheduler.c",
+                    f"-L{tmp_path / 'sim' / 'lib'}", "-lHD", "-o", "scheduler"], cwd=tmp_path, check=True,
+                   capture_output=True, text=True)
+    env = {**os.environ, "LD_LIBRARY_PATH": str(tmp_path / "sim" / "lib"), "PHANTOM_PIN_HD_THETA0": "0.2 0.5 0.6"}
+    out = subprocess.run(["./scheduler"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=60,
+                         check=True).stdout
+    values = dict(line.split(" ", 1) for line in out.splitlines())
+    assert values["done"] == "0 1" and values["order"] == "HLHLHL"
+    assert values["rate"] == "1000 dof 3" and values["unscheduled"] == "1"
+    assert float(values["mismatch"]) == 0.0
+    assert float(values["seconds"]) >= 0.299
