@@ -234,7 +234,11 @@ SCHEDULER = r"""
 static char order[64];
 static int n, ticks_a, ticks_b;
 static double last[3], previous[3], mismatch;
-static HDCallbackCode HDCALLBACK low(void *d) { (void)d; if (n < 60) order[n++] = 'L'; ++ticks_b; return HD_CALLBACK_CONTINUE; }
+static HDCallbackCode HDCALLBACK low(void *d)
+{
+    (void)d; if (n < 60) order[n++] = 'L';
+    ++ticks_b; return HD_CALLBACK_CONTINUE;
+}
 static HDCallbackCode HDCALLBACK high(void *d)
 {
     double now[3];
