@@ -52,11 +52,12 @@ def test_forces_and_joint_torques_compensate_gravity(name):
 
 def test_friction_adds_the_law_at_the_callers_rates():
     """With friction, the joint torques gain viscous rate + Coulomb sign(rate) (actuation.yaml's
-    numbers read here) at the rates of the OpenHaptics angles given, on theta; none at rest."""
+    numbers read here) at the rates of the OpenHaptics angles given, on theta; none for a joint
+    within the dead band (the third, at rest)."""
     law = read("touch").actuation.friction
     angles, rates = np.array([0.1, 0.4, 0.3]), np.array([0.5, -0.2, 0.0])
     plain = np.array(Compensator("touch", "joint_torque")(angles))
-    with_friction = np.array(Compensator("touch", "joint_torque", friction=True)(angles, rates=rates))
+    with_friction = np.array(Compensator("touch", "joint_torque", ("gravity", "friction"))(angles, rates=rates))
     theta_rates = SIGN * rates
     expected = np.array(law.viscous) * theta_rates + np.array(law.coulomb) * np.sign(theta_rates)
     assert np.allclose(SIGN * (with_friction - plain) / 1000, expected, rtol=0, atol=1e-15)
@@ -69,7 +70,13 @@ def test_bad_input_names_the_argument():
                            (lambda: Compensator("touch")([0.0, 0.1]), "joints"),
                            (lambda: Compensator("touch")([0.0, 0.1, 0.2], [0, 0, np.inf]), "gimbals"),
                            (lambda: Compensator("premium_1_5")([0.0, 0.1, 0.2], [0, 0, 0]), "gimbals"),
-                           (lambda: Compensator("touch", friction=True)([0.0, 0.1, 0.2]), "rates"),
+                           (lambda: Compensator("touch", compensate="gravity"), "compensate"),
+                           (lambda: Compensator("touch", compensate=("gravity", "wind")), "compensate"),
+                           (lambda: Compensator("touch", compensate=("inertia",)), "kappa"),
+                           (lambda: Compensator("touch", compensate=("inertia",), kappa=1.0), "kappa"),
+                           (lambda: Compensator("touch", kappa=-0.1), "kappa"),
+                           (lambda: Compensator("touch", dead_band=-1.0), "dead_band"),
+                           (lambda: Compensator("touch", cutoff=600.0), "cutoff"),
                            (lambda: Compensator("touch", friction="yes"), "friction")):
         with pytest.raises(InvalidInputError) as error:
             call()
