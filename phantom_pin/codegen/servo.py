@@ -86,4 +86,95 @@ def openhaptics(prefix: str, body: dict[str, str], has_gimbal: bool) -> str:
             f"double torque[3])",
             f"    double theta[3], tau[3];\n    {p}_theta_from_openhaptics(joint_angles, theta);\n{gravity}{extra}\n"
             f"    {p}_openhaptics_torque_from_tau(tau, torque);"))
+    parts.append(_transparent(p))
     return "\n".join(parts)
+
+
+#: The estimator and the compensation beyond gravity (phantom_pin.device.estimator and the
+#: pyOpenHaptics Compensator's terms, in C): {p} is the prefix.
+_TRANSPARENT = """/*
+ * The rates (rad/s) and accelerations (rad/s^2) of OpenHaptics' joint angles estimated from one
+ * sample a tick, as phantom_pin.device.estimator.Estimator: a first-order low-pass (cutoff Hz)
+ * of the backward difference of the angles, then the same of the rate's; zero at the first
+ * sample. The caller owns it: {p}_estimator_init once, {p}_estimator_update every tick.
+ */
+typedef struct {{
+    double previous[3], rate[3], acceleration[3];
+    double alpha, period;
+    int started;
+}} {p}_estimator;
+
+static inline void {p}_estimator_init({p}_estimator *e, double rate_hz, double cutoff_hz)
+{{
+    int i;
+    e->period = 1.0 / rate_hz;
+    e->alpha = 1.0 - exp(-2.0 * 3.14159265358979323846 * cutoff_hz * e->period);
+    e->started = 0;
+    for (i = 0; i < 3; ++i)
+        e->previous[i] = e->rate[i] = e->acceleration[i] = 0.0;
+}}
+
+static inline void {p}_estimator_update({p}_estimator *e, const double angles[3])
+{{
+    int i;
+    for (i = 0; i < 3; ++i) {{
+        if (e->started) {{
+            double rate = e->rate[i] + e->alpha * ((angles[i] - e->previous[i]) / e->period - e->rate[i]);
+            e->acceleration[i] += e->alpha * ((rate - e->rate[i]) / e->period - e->acceleration[i]);
+            e->rate[i] = rate;
+        }}
+        e->previous[i] = angles[i];
+    }}
+    e->started = 1;
+}}
+
+/*
+ * HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates gravity, the friction law
+ * at the estimated rates (0 for a joint slower than dead_band rad/s), and a share kappa (0 <= kappa
+ * < 1) of the inertia, kappa (M(theta) ddtheta + C(theta, dtheta) dtheta), while some joint moves
+ * faster than dead_band, as phantom_pin's Compensator(compensate=("gravity", "friction",
+ * "inertia")). e: updated with this tick's joint_angles first. The inertia uses the arm's M and C
+ * with the stylus at locked_at. Clamp the result to the motors' limits as your loop does.
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void {p}_openhaptics_joint_torque_transparent(const double joint_angles[3], const double gimbal_angles[3],
+                                                           const {p}_estimator *e, double kappa, double dead_band,
+                                                           double torque[3])
+{{
+    double theta[3], rates[3], accelerations[3], tau[3], f[3], inertia[3], c[3], M[9];
+    int i, moving = 0;
+    {p}_theta_from_openhaptics(joint_angles, theta);
+    {p}_theta_from_openhaptics(e->rate, rates);
+    {p}_theta_from_openhaptics(e->acceleration, accelerations);
+    {p}_openhaptics_joint_torque(joint_angles, gimbal_angles, torque);
+    for (i = 0; i < 3; ++i) {{
+        if (fabs(rates[i]) > dead_band)
+            moving = 1;
+        else
+            rates[i] = 0.0;
+    }}
+    {p}_friction(rates, f);
+    for (i = 0; i < 3; ++i)
+        tau[i] = f[i];
+    if (moving && kappa > 0.0) {{
+        {p}_theta_from_openhaptics(e->rate, rates);
+        {p}_mass_matrix(theta, M);
+        {p}_coriolis(theta, rates, c);
+        for (i = 0; i < 3; ++i) {{
+            inertia[i] = M[3 * i] * accelerations[0] + M[3 * i + 1] * accelerations[1] + M[3 * i + 2] * accelerations[2];
+            tau[i] += kappa * (inertia[i] + c[i]);
+        }}
+    }}
+    {{
+        double extra[3];
+        {p}_openhaptics_torque_from_tau(tau, extra);
+        for (i = 0; i < 3; ++i)
+            torque[i] += extra[i];
+    }}
+}}
+"""
+
+
+def _transparent(prefix: str) -> str:
+    """The estimator's type and functions and the transparent joint torque (_TRANSPARENT)."""
+    return _TRANSPARENT.format(p=prefix)

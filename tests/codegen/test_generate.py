@@ -355,3 +355,38 @@ def test_the_servo_loop_functions_compensate_gravity_and_friction(name, tmp_path
         assert np.abs(jacobian.T @ out[k, 6:9] - gravity - friction).max() <= 1e-9
         assert np.abs(sign * out[k, 9:12] / 1000 - gravity - friction).max() <= 1e-9
     assert f"#define PHANTOM_STYLUS {int(config.gimbal is not None)}" in text
+
+
+TRANSPARENT_SHIM = """#include "model.h"
+void transparent(int n, const double *a, double kappa, double dead_band, double *out) {
+    phantom_estimator e; const double g[3] = {0.0, 0.0, 0.0}; int k;
+    phantom_estimator_init(&e, 1000.0, 20.0);
+    for (k = 0; k < n; ++k) {
+        phantom_estimator_update(&e, a + 3 * k);
+        phantom_openhaptics_joint_torque_transparent(a + 3 * k, g, &e, kappa, dead_band, out + 3 * k); } }
+"""
+
+
+@pytest.mark.parametrize("name", models())
+def test_the_transparent_joint_torque_is_the_compensators(name, tmp_path):
+    """The header's estimator and NAME_openhaptics_joint_torque_transparent, over 300 ticks of a
+    seeded smooth motion (OpenHaptics' angles, 1 kHz, with a pause the dead band must see), give
+    the pyOpenHaptics Compensator's joint torques with gravity, friction and kappa = 0.5 of the
+    inertia, tick by tick, to 1e-9 relative: one estimator and one law in two languages (the
+    stylus at locked_at, where the header's M and C hold)."""
+    from phantom_pin.interfaces.openhaptics import Compensator
+    library = build(generated(name), tmp_path, TRANSPARENT_SHIM)
+    t = np.arange(300) / 1000.0
+    rng = np.random.default_rng(71)
+    base, amplitude = np.array([0.1, 0.4, 0.5]), rng.uniform(0.05, 0.2, 3)
+    angles = base + amplitude * np.sin(2 * np.pi * 1.5 * np.minimum(t, 0.15)[:, None] + rng.uniform(0, 1, 3))
+    out = np.empty((len(t), 3))
+    pointer = ctypes.POINTER(ctypes.c_double)
+    a = np.ascontiguousarray(angles)
+    library.transparent(ctypes.c_int(len(t)), a.ctypes.data_as(pointer), ctypes.c_double(0.5), ctypes.c_double(0.01),
+                        out.ctypes.data_as(pointer))
+    compensate = Compensator(name, "joint_torque", ("gravity", "friction", "inertia"), kappa=0.5)
+    gimbal = None if describe(name).config.gimbal is None else [0.0, 0.0, 0.0]
+    python = np.array([compensate.torque(x, gimbal) for x in angles]) * np.array([-1.0, 1.0, 1.0]) * 1000.0
+    assert np.abs(out - python).max() <= 1e-9 * np.abs(python).max()
+    assert np.abs(out[200:] - out[-1]).max() < np.abs(out[100:150] - out[-1]).max()   # the pause: inertia off

@@ -622,6 +622,87 @@ static inline void phantom_openhaptics_joint_torque_friction(const double joint_
     phantom_openhaptics_torque_from_tau(tau, torque);
 }
 
+/*
+ * The rates (rad/s) and accelerations (rad/s^2) of OpenHaptics' joint angles estimated from one
+ * sample a tick, as phantom_pin.device.estimator.Estimator: a first-order low-pass (cutoff Hz)
+ * of the backward difference of the angles, then the same of the rate's; zero at the first
+ * sample. The caller owns it: phantom_estimator_init once, phantom_estimator_update every tick.
+ */
+typedef struct {
+    double previous[3], rate[3], acceleration[3];
+    double alpha, period;
+    int started;
+} phantom_estimator;
+
+static inline void phantom_estimator_init(phantom_estimator *e, double rate_hz, double cutoff_hz)
+{
+    int i;
+    e->period = 1.0 / rate_hz;
+    e->alpha = 1.0 - exp(-2.0 * 3.14159265358979323846 * cutoff_hz * e->period);
+    e->started = 0;
+    for (i = 0; i < 3; ++i)
+        e->previous[i] = e->rate[i] = e->acceleration[i] = 0.0;
+}
+
+static inline void phantom_estimator_update(phantom_estimator *e, const double angles[3])
+{
+    int i;
+    for (i = 0; i < 3; ++i) {
+        if (e->started) {
+            double rate = e->rate[i] + e->alpha * ((angles[i] - e->previous[i]) / e->period - e->rate[i]);
+            e->acceleration[i] += e->alpha * ((rate - e->rate[i]) / e->period - e->acceleration[i]);
+            e->rate[i] = rate;
+        }
+        e->previous[i] = angles[i];
+    }
+    e->started = 1;
+}
+
+/*
+ * HD_CURRENT_JOINT_TORQUE (mN m on OpenHaptics' angles) that compensates gravity, the friction law
+ * at the estimated rates (0 for a joint slower than dead_band rad/s), and a share kappa (0 <= kappa
+ * < 1) of the inertia, kappa (M(theta) ddtheta + C(theta, dtheta) dtheta), while some joint moves
+ * faster than dead_band, as phantom_pin's Compensator(compensate=("gravity", "friction",
+ * "inertia")). e: updated with this tick's joint_angles first. The inertia uses the arm's M and C
+ * with the stylus at locked_at. Clamp the result to the motors' limits as your loop does.
+ * Assumes finite input: no checks, no allocation, no global state.
+ */
+static inline void phantom_openhaptics_joint_torque_transparent(const double joint_angles[3], const double gimbal_angles[3],
+                                                           const phantom_estimator *e, double kappa, double dead_band,
+                                                           double torque[3])
+{
+    double theta[3], rates[3], accelerations[3], tau[3], f[3], inertia[3], c[3], M[9];
+    int i, moving = 0;
+    phantom_theta_from_openhaptics(joint_angles, theta);
+    phantom_theta_from_openhaptics(e->rate, rates);
+    phantom_theta_from_openhaptics(e->acceleration, accelerations);
+    phantom_openhaptics_joint_torque(joint_angles, gimbal_angles, torque);
+    for (i = 0; i < 3; ++i) {
+        if (fabs(rates[i]) > dead_band)
+            moving = 1;
+        else
+            rates[i] = 0.0;
+    }
+    phantom_friction(rates, f);
+    for (i = 0; i < 3; ++i)
+        tau[i] = f[i];
+    if (moving && kappa > 0.0) {
+        phantom_theta_from_openhaptics(e->rate, rates);
+        phantom_mass_matrix(theta, M);
+        phantom_coriolis(theta, rates, c);
+        for (i = 0; i < 3; ++i) {
+            inertia[i] = M[3 * i] * accelerations[0] + M[3 * i + 1] * accelerations[1] + M[3 * i + 2] * accelerations[2];
+            tau[i] += kappa * (inertia[i] + c[i]);
+        }
+    }
+    {
+        double extra[3];
+        phantom_openhaptics_torque_from_tau(tau, extra);
+        for (i = 0; i < 3; ++i)
+            torque[i] += extra[i];
+    }
+}
+
 #ifdef __cplusplus
 }
 #endif
