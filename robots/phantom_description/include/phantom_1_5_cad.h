@@ -573,7 +573,8 @@ static inline void phantom_openhaptics_joint_torque_transparent(const double joi
         phantom_mass_matrix(theta, M);
         phantom_coriolis(theta, rates, c);
         for (i = 0; i < 3; ++i) {
-            inertia[i] = M[3 * i] * accelerations[0] + M[3 * i + 1] * accelerations[1] + M[3 * i + 2] * accelerations[2];
+            inertia[i] = M[3 * i] * accelerations[0] + M[3 * i + 1] * accelerations[1]
+                         + M[3 * i + 2] * accelerations[2];
             tau[i] += kappa * (inertia[i] + c[i]);
         }
     }
