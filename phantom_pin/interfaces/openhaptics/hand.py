@@ -13,6 +13,7 @@ gimbal centre) through J_p^T F_hand. Three experiments:
 - ``backdrive``: the hand drags the tip along u at a constant speed through a stiff coupling
   (a spring-damper to a target moving at ``speed``); the mean coupling force along u over the
   steady part is the backdrive force (N).
+- ``rest_drift``: no hand, from rest: how far the tip wanders (m).
 - ``wall``: a virtual wall F = -K (n . x - w) n (plus a damping B) rendered in the loop where
   the tip is beyond the plane, the hand pressing into it with a constant force: the wall is
   stable at K if the tip's oscillation about its rest, in the last half of the run, stays below
@@ -41,10 +42,12 @@ class Run:
     hand: np.ndarray
 
 
-def _loop(compensator, theta0, duration, hand, friction=True, wall=None):
+def _loop(compensator, theta0, duration, hand, friction=True, wall=None, noise=0.0):
     """Run the device for ``duration`` s from rest at ``theta0`` (rad) with ``compensator``
     (None: no compensation) and the hand ``hand(t, tip, tip_velocity) -> F`` (N, frame s);
-    ``wall`` (n, w, K, B) adds the virtual wall's force to the command. Returns a Run."""
+    ``wall`` (n, w, K, B) adds the virtual wall's force to the command; ``noise`` (rad) is the
+    standard deviation of a seeded Gaussian noise on the angles before their rounding to counts
+    (an encoder's transitions flicker). Returns a Run."""
     from phantom_pin.device.plant import MAX_STEP, Plant, contact_substeps
 
     device = compensator.device if compensator is not None else None
@@ -56,11 +59,13 @@ def _loop(compensator, theta0, duration, hand, friction=True, wall=None):
     quantized = device.config.actuation.encoder is not None
     sign = compensator._sign
     q, v = list(map(float, theta0)), [0.0, 0.0, 0.0]
+    rng = np.random.default_rng(0)
     count = int(round(duration / PERIOD))
     t, tips, hands = np.arange(count) * PERIOD, np.empty((count, 3)), np.empty((count, 3))
     for k in range(count):
         theta = np.array(q)
-        seen = device.encoder_theta(device.encoder_counts(theta)) if quantized else theta
+        seen = theta + (rng.normal(0.0, noise, 3) if noise else 0.0)
+        seen = device.encoder_theta(device.encoder_counts(seen)) if quantized else seen
         jacobian = device.tip_jacobian(theta)
         tip = device.phantom.forward_kinematics(theta)[:3, 3]
         force = hand(t[k], tip, jacobian @ np.array(v))
@@ -103,6 +108,14 @@ def backdrive(compensator, theta0, direction, speed=0.02, duration=0.5, stiffnes
     run = _loop(compensator, theta0, duration, hand)
     steady = run.t >= duration / 2
     return float((run.hand[steady] @ u).mean())
+
+
+def rest_drift(compensator, theta0, duration=2.0, noise=2e-4) -> float:
+    """How far (m) the tip wanders in ``duration`` s from rest at ``theta0`` with no hand, the
+    angles seen with ``noise`` (rad): what a compensation that pushes a resting joint on noise
+    does (the dead band's purpose)."""
+    run = _loop(compensator, theta0, duration, lambda t, x, dx: np.zeros(3), noise=noise)
+    return float(np.linalg.norm(run.tip - run.tip[0], axis=1).max())
 
 
 def wall_is_stable(compensator, theta0, normal, stiffness, damping=0.0, push=0.5, duration=1.0,

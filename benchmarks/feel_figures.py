@@ -1,0 +1,91 @@
+"""The numbers of docs/feel.md's "Compensation beyond gravity": what the hand feels through the
+OpenHaptics servo loop on the simulated device (phantom_pin.interfaces.openhaptics.hand, 1 kHz,
+the encoder's counts where the model has public encoder data), per model at the posture given:
+
+- the mass felt pushing the tip from rest along OpenHaptics' x, y, z (g), against Lambda along
+  the same axis, without and with a share kappa of the inertia compensated;
+- the backdrive force dragging the tip at 20 mm/s along each axis (mN), with gravity
+  compensated alone and with friction too, for each dead band of --dead-bands;
+- how far the tip wanders at rest in 2 s with friction compensated, for each dead band (mm);
+- the stiffest wall (N/m, normal along z) that holds the hand's 0.5 N push still, with gravity
+  compensated, with friction too, and with friction and a virtual damper B, against Colgate and
+  Brown's passivity bound K <= 2 (b - |B|) / T for the device's own viscous damping b along the
+  wall's normal (b = n^T J^-T D J^-1 n, D the joints' viscous coefficients; J. E. Colgate and
+  J. M. Brown, "Factors affecting the Z-Width of a haptic display", IEEE ICRA 1994).
+
+    python benchmarks/feel_figures.py [--theta T1 T2 T3] [--kappa 0.6] [--damping 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from phantom_pin import Device
+from phantom_pin.config import models
+from phantom_pin.interfaces.openhaptics import Compensator, hand
+
+AXES = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+
+def along(name: str, theta: np.ndarray, u: np.ndarray) -> tuple[float, float]:
+    """(1 / (u^T Lambda^-1 u) kg, the device's viscous damping along u, N s/m)."""
+    device = Device.from_model(name)
+    jacobian = device.tip_jacobian(theta)
+    inverse = jacobian @ np.linalg.solve(device.phantom.mass_matrix(theta), jacobian.T)
+    back = np.linalg.inv(jacobian)                                  # tip velocity -> joint rates
+    damping = back.T @ np.diag(device.config.actuation.friction.viscous) @ back
+    return 1.0 / (u @ inverse @ u), float(u @ damping @ u)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--theta", type=float, nargs=3, default=[0.0, 0.3, 0.4], metavar=("T1", "T2", "T3"))
+    parser.add_argument("--kappa", type=float, default=0.6)
+    parser.add_argument("--damping", type=float, default=3.0, help="the wall's virtual damper B (N s/m)")
+    parser.add_argument("--dead-bands", type=float, nargs="+", default=[0.0, 0.01, 0.05])
+    args = parser.parse_args()
+    theta = np.array(args.theta)
+    print(f"# posture theta = {args.theta} rad; kappa = {args.kappa}; 1 kHz")
+    print("\n| model | axis | Lambda (g) | felt (g) | felt, inertia compensated (g) | ratio |")
+    print("|---|---|---|---|---|---|")
+    for name in models():
+        for axis, u in AXES.items():
+            reference = along(name, theta, u)[0]
+            plain = hand.apparent_mass(Compensator(name, "joint_torque"), theta, u)
+            less = hand.apparent_mass(Compensator(name, "joint_torque", ("gravity", "inertia"), kappa=args.kappa),
+                                      theta, u)
+            print(f"| {name} | {axis} | {reference * 1e3:.1f} | {plain * 1e3:.1f} | {less * 1e3:.1f} | "
+                  f"{plain / less:.2f} |")
+    print("\n| model | axis | backdrive (mN) | " + " | ".join(f"friction compensated, dead band {d:g} rad/s (mN)"
+                                                       for d in args.dead_bands) + " |")
+    print("|---|---|---|" + "---|" * len(args.dead_bands))
+    for name in models():
+        for axis, u in AXES.items():
+            plain = hand.backdrive(Compensator(name, "joint_torque"), theta, u)
+            cells = [hand.backdrive(Compensator(name, "joint_torque", ("gravity", "friction"), dead_band=d), theta, u)
+                     for d in args.dead_bands]
+            print(f"| {name} | {axis} | {plain * 1e3:.1f} | " + " | ".join(f"{c * 1e3:.2f}" for c in cells) + " |")
+    print("\n| model | " + " | ".join(f"drift at rest in 2 s, dead band {d:g} rad/s (mm)" for d in args.dead_bands)
+          + " |")
+    print("|---|" + "---|" * len(args.dead_bands))
+    for name in models():
+        cells = [hand.rest_drift(Compensator(name, "joint_torque", ("gravity", "friction"), dead_band=d), theta)
+                 for d in args.dead_bands]
+        print(f"| {name} | " + " | ".join(f"{c * 1e3:.3f}" for c in cells) + " |")
+    zero, normal = np.zeros(3), AXES["z"]
+    print("\n| model | b along z (N s/m) | Colgate-Brown 2 b / T (N/m) | gravity | + friction | "
+          f"+ friction, B = {args.damping:g} N s/m |")
+    print("|---|---|---|---|---|---|")
+    for name in models():
+        b = along(name, zero, normal)[1]
+        cells = [hand.stiffest_wall(lambda terms=terms: Compensator(name, "joint_torque", terms), zero, normal,
+                                    damping=damping)
+                 for terms, damping in ((("gravity",), 0.0), (("gravity", "friction"), 0.0),
+                                        (("gravity", "friction"), args.damping))]
+        print(f"| {name} | {b:.4f} | {2 * b / 1e-3:.0f} | " + " | ".join(f"{c:.0f}" for c in cells) + " |")
+
+
+if __name__ == "__main__":
+    main()
