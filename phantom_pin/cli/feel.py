@@ -28,8 +28,8 @@ def _forces(values: np.ndarray) -> str:
 
 def text(m: Feel) -> str:
     """The measures as lines with their units and definitions."""
-    where = ("the SRDF's zero posture: upper arm horizontal, forearm vertical, the spec sheets' nominal "
-             "(orthogonal arms) position" if m.posture == "zero" else "as given")
+    where = ("the SRDF's zero posture, the nominal one: upper arm horizontal, forearm vertical (orthogonal arms)"
+             if m.posture == "zero" else "as given")
     directions = " ".join(vector(d, "{:+.3f}") for d in m.directions.T)
     tip = np.where(abs(m.tip) < 5e-3, 0.0, m.tip)          # no "-0.00"
     lines = [
@@ -122,8 +122,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                                           "largest tip forces and the workspace (phantom_pin.device.feel)")
     command.set_defaults(run=feel_command, options=OPTIONS, output=None)
     command.add_argument("--theta", metavar="T", nargs=3, type=float,
-                         help="posture (rad, the report's theta; inside the stops; default the SRDF's zero, the spec "
-                              "sheets' nominal orthogonal-arms position)")
+                         help="posture (rad, the report's theta; inside the stops; default the SRDF's zero, the "
+                              "nominal orthogonal-arms posture)")
     command.add_argument("--speed", type=float, default=DEFAULT_SPEED,
                          help=f"tip speed of the sliding backdrive force (m/s, default {DEFAULT_SPEED:g})")
     command.add_argument("--json", action="store_true", help="print JSON")

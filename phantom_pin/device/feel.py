@@ -119,9 +119,9 @@ def _none_for_nan(value: Any) -> Any:
 
 def nominal_posture(device: Device) -> tuple[np.ndarray, str]:
     """(theta, name) of the nominal posture: the SRDF's "zero", theta = (0, 0, 0) rad, where the
-    upper arm is horizontal and the forearm vertical. The spec sheets of SensAble/3D Systems quote
-    the maximum exertable force "at nominal (orthogonal arms) position", and OpenHaptics' origin
-    is near it (the tip sits at frame s's origin there)."""
+    upper arm is horizontal and the forearm vertical (the arms orthogonal) and the tip sits at frame
+    s's origin, near the middle of the workspace: the "nominal position" at which the maximum force
+    of a PHANToM is quoted (issue 52; the spec sheets' own definition was not reached, docs/feel.md)."""
     postures = device.config.limits.postures
     return np.array(postures.get("zero", (0.0, 0.0, 0.0)), dtype=float), "zero"
 
@@ -138,7 +138,7 @@ def _posture(device: Device, theta: object) -> tuple[np.ndarray, str]:
 
 def feel(device: Device | None = None, theta: object = None, speed: float = DEFAULT_SPEED) -> Feel:
     """The measures of what the hand feels at posture ``theta`` (rad, the report's; default the
-    nominal posture, nominal_posture: theta = 0, the spec sheets' "orthogonal arms"), with the
+    nominal posture, nominal_posture: theta = 0, the arms orthogonal), with the
     sliding backdrive force at tip speed ``speed`` (m/s, > 0): a Feel (its doc gives each measure's
     definition, frame and unit). ``device``: a Device (default Device()).
 
