@@ -13,7 +13,7 @@ from importlib.metadata import PackageNotFoundError, version
 from phantom_pin import drivers
 from phantom_pin.config import Config, models
 from phantom_pin.description.build import Description, describe
-from phantom_pin.device import Device, SimulationResult, simulate
+from phantom_pin.device import Device, Feel, SimulationResult, feel, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.dynamics.loader import PhantomLoader, load, load_files
 from phantom_pin.dynamics.model import Phantom
@@ -34,7 +34,8 @@ try:
 except PackageNotFoundError:  # a source tree on sys.path, not installed
     __version__ = "unknown"
 
-__all__ = ["__version__", "Phantom", "Device", "simulate", "simulate_mujoco", "SimulationResult", "load", "load_files",
-           "PhantomLoader", "Description", "describe", "check", "models", "Config", "ReportParameters", "closed_form",
+__all__ = ["__version__", "Phantom", "Device", "simulate", "feel", "Feel", "simulate_mujoco", "SimulationResult",
+           "load", "load_files", "PhantomLoader", "Description", "describe", "check", "models", "Config",
+           "ReportParameters", "closed_form",
            "drivers", "PhantomPinError", "InvalidInputError", "ParameterFileError", "UnreachableTargetError",
            "MissingDataError", "MissingDependencyError"]

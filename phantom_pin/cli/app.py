@@ -6,13 +6,13 @@ import argparse
 import os
 import sys
 
-from phantom_pin.cli import codegen, device, identification, model, openhaptics, ros2
+from phantom_pin.cli import codegen, device, feel, identification, model, openhaptics, ros2
 from phantom_pin.cli.common import Parser, add_model_options, merge_model_options
 from phantom_pin.exceptions import PhantomPinError
 
 DESCRIPTION = """The PHANToM arms' model: info, check, fk, ik, dynamics, urdf, srdf, mjcf, links, show,
-simulate, excite, identify, codegen, openhaptics-sim, ros2. --model NAME or --config DIR chooses the configuration,
---params FILE and --set KEY=VALUE override its numbers; they go before or after the command."""
+simulate, feel, excite, identify, codegen, openhaptics-sim, ros2. --model NAME or --config DIR chooses the
+configuration, --params FILE and --set KEY=VALUE override its numbers; they go before or after the command."""
 #: The dests of the model options given after the command end with this.
 AFTER = "_after_command"
 
@@ -24,7 +24,7 @@ def parser() -> argparse.ArgumentParser:
     top.add_argument("--quiet", "-q", action="store_true",
                      help="no progress bar on stderr (shown on a terminal when work takes over 2 s)")
     sub = top.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for concern in (model, device, identification, codegen, openhaptics, ros2):
+    for concern in (model, device, feel, identification, codegen, openhaptics, ros2):
         concern.add_parsers(sub)
     for command in sub.choices.values():  # the model options and --quiet after the command too
         add_model_options(command, AFTER)
