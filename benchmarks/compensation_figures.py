@@ -1,6 +1,7 @@
 """The numbers of docs/feel.md's "Compensation beyond gravity": what the hand feels through the
 OpenHaptics servo loop on the simulated device (phantom_pin.interfaces.openhaptics.hand, 1 kHz,
-the encoder's counts where the model has public encoder data), per model at the posture given:
+the encoder's counts where the model has public encoder data), per model at the posture given
+(default the nominal one of docs/feel.md, theta = 0):
 
 - the mass felt pushing the tip from rest along OpenHaptics' x, y, z (g), against Lambda along
   the same axis, without and with a share kappa of the inertia compensated;
@@ -13,7 +14,7 @@ the encoder's counts where the model has public encoder data), per model at the 
   wall's normal (b = n^T J^-T D J^-1 n, D the joints' viscous coefficients; J. E. Colgate and
   J. M. Brown, "Factors affecting the Z-Width of a haptic display", IEEE ICRA 1994).
 
-    python benchmarks/feel_figures.py [--theta T1 T2 T3] [--kappa 0.6] [--damping 3]
+    python benchmarks/compensation_figures.py [--theta T1 T2 T3] [--kappa 0.6] [--damping 3]
 """
 
 from __future__ import annotations
@@ -41,7 +42,8 @@ def along(name: str, theta: np.ndarray, u: np.ndarray) -> tuple[float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--theta", type=float, nargs=3, default=[0.0, 0.3, 0.4], metavar=("T1", "T2", "T3"))
+    parser.add_argument("--theta", type=float, nargs=3, default=[0.0, 0.0, 0.0], metavar=("T1", "T2", "T3"),
+                        help="the posture (rad; default the nominal one, device.feel.nominal_posture's)")
     parser.add_argument("--kappa", type=float, default=0.6)
     parser.add_argument("--damping", type=float, default=3.0, help="the wall's virtual damper B (N s/m)")
     parser.add_argument("--dead-bands", type=float, nargs="+", default=[0.0, 0.01, 0.05])
@@ -75,13 +77,14 @@ def main() -> None:
                  for d in args.dead_bands]
         print(f"| {name} | " + " | ".join(f"{c * 1e3:.3f}" for c in cells) + " |")
     zero, normal = np.zeros(3), AXES["z"]
-    print("\n| model | b along z (N s/m) | Colgate-Brown 2 b / T (N/m) | gravity | + friction | "
+    print("\n| model | b along z (N s/m) | Colgate-Brown 2 b / T (N/m) | stiffest wall, gravity compensated (N/m) | "
+          "+ friction (N/m) | "
           f"+ friction, B = {args.damping:g} N s/m |")
     print("|---|---|---|---|---|---|")
     for name in models():
         b = along(name, zero, normal)[1]
-        cells = [hand.stiffest_wall(lambda terms=terms: Compensator(name, "joint_torque", terms), zero, normal,
-                                    damping=damping)
+        cells = [hand.stiffest_wall(lambda terms=terms, name=name: Compensator(name, "joint_torque", terms),
+                                    zero, normal, damping=damping)
                  for terms, damping in ((("gravity",), 0.0), (("gravity", "friction"), 0.0),
                                         (("gravity", "friction"), args.damping))]
         print(f"| {name} | {b:.4f} | {2 * b / 1e-3:.0f} | " + " | ".join(f"{c:.0f}" for c in cells) + " |")
