@@ -26,6 +26,7 @@ from openhaptics_reference import (
 )
 from phantom_pin.config import models, read
 from phantom_pin.config.sampling import random_states
+from phantom_pin.config.types import Friction
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.interfaces.openhaptics import Compensator, build, read_record
 
@@ -77,7 +78,9 @@ def test_bad_input_names_the_argument():
                            (lambda: Compensator("touch", kappa=-0.1), "kappa"),
                            (lambda: Compensator("touch", dead_band=-1.0), "dead_band"),
                            (lambda: Compensator("touch", cutoff=600.0), "cutoff"),
-                           (lambda: Compensator("touch", friction="yes"), "friction")):
+                           (lambda: Compensator("touch", friction="yes"), "friction"),
+                           (lambda: Compensator("touch", compensate=("gravity", "friction"),
+                                                friction=Friction((0.0,) * 3, (0.0,) * 3)), "compensate")):
         with pytest.raises(InvalidInputError) as error:
             call()
         assert error.value.argument == argument

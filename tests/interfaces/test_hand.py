@@ -61,3 +61,12 @@ def test_compensating_friction_removes_the_walls_dissipation():
     assert hand.wall_is_stable(Compensator("premium_1_5", "joint_torque", ("gravity", "friction")), zero, normal,
                                1000.0, damping=3.0)
     assert not hand.wall_is_stable(Compensator("premium_1_5", "joint_torque"), zero, normal, 20000.0)
+
+
+def test_a_wall_that_is_not_finite_or_negative_is_refused():
+    from phantom_pin.exceptions import InvalidInputError
+    for stiffness, damping, argument in ((float("inf"), 0.0, "stiffness"), (-1.0, 0.0, "stiffness"),
+                                         (100.0, float("nan"), "damping")):
+        with pytest.raises(InvalidInputError) as error:
+            hand.wall_is_stable(Compensator("touch", "joint_torque"), [0.0] * 3, [0, 0, 1.0], stiffness, damping)
+        assert error.value.argument == argument

@@ -107,6 +107,10 @@ class Compensator:
         #: da/dtheta, diagonal (OpenHaptics' angles are linear in theta): theta = S a, tau_a = S tau
         self._sign = np.diag(openhaptics_from_theta(np.eye(3)))
         self.law = friction if friction is not None else self.phantom.config.actuation.friction
+        if "friction" in self.terms and not any(self.law.viscous) and not any(self.law.coulomb):
+            raise InvalidInputError(f"the model {self.phantom.config.name!r} has no friction data (every viscous and "
+                                    "Coulomb coefficient 0): give friction= (an identified overlay's)",
+                                    argument="compensate")
         openhaptics = self.phantom.config.actuation.openhaptics
         self.max_force = math.inf if openhaptics is None else openhaptics.max_force       # N, the norm
         self.peak = np.array(self.phantom.config.actuation.peak) * 1000.0                # mN m per joint

@@ -124,6 +124,9 @@ def wall_is_stable(compensator, theta0, normal, stiffness, damping=0.0, push=0.5
     normal ``normal`` (frame s, the wall's inside beyond it), holds the hand's ``push`` N still:
     the tip's depth varies by less than ``amplitude`` m (peak to peak) over the last quarter of
     ``duration`` s (an oscillation that has not died out by then is sustained)."""
+    for name, value in (("stiffness", stiffness), ("damping", damping)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < math.inf:
+            raise InvalidInputError(f"expected a finite number >= 0, got {value!r}", argument=name)
     n = np.asarray(normal, float) / np.linalg.norm(normal)
     offset = float(n @ compensator.device.phantom.forward_kinematics(np.asarray(theta0, float))[:3, 3])
     run = _loop(compensator, theta0, duration, lambda t, x, dx: push * n, wall=(n, offset, stiffness, damping))
