@@ -30,8 +30,8 @@ def kernel_sensitive() -> dict:
     iterations on 60 points: the paths parted at the second), then the friction speed threshold
     chosen on a 10 s log along it (the Touch's inverse dynamics with Coulomb friction on joint 3
     near its torque RMS, seeded 2 mN m noise); 200 seeded links' standard parameters (what a
-    model's URDF and a simulated device's counts are made of); and the kernels threadpoolctl
-    says run."""
+    model's URDF and a simulated device's counts are made of); the general structure's base
+    parameters in words (its pivots and their order); and the kernels threadpoolctl says run."""
     from threadpoolctl import threadpool_info
 
     from phantom_pin import Phantom, describe
@@ -51,7 +51,7 @@ def kernel_sensitive() -> dict:
     rng = np.random.default_rng(4)
     tensor = (1e-4, 1e-6, 2e-6, 2e-4, 3e-6, 3e-4)
     links = [Inertial(0.1, tuple(rng.uniform(-0.05, 0.05, 3)), tensor).dynamic_parameters() for _ in range(200)]
-    return {"links": [link.tolist() for link in links],
+    return {"links": [link.tolist() for link in links], "base": General(device).base.describe(),
             "kernels": sorted({i["architecture"] for i in threadpool_info() if i["internal_api"] == "openblas"}),
             "q0": design.trajectory.q0.tolist(), "a": design.trajectory.a.tolist(),
             "b": design.trajectory.b.tolist(), "theta": theta[::1000].tolist(), "condition": design.condition,
@@ -77,13 +77,15 @@ def _other_kernel(here: str) -> str:
 @pytest.mark.skipif(not _blas.reference_can_run(), reason="needs an x86-64 CPU with AVX2 and FMA (the reference)")
 def test_excite_and_the_threshold_are_the_same_on_two_kernels():
     """This process's kernel against another's, in a child with two threads (this one has
-    conftest's one). The links' parameters bit for bit (Python floats); the Fourier
+    conftest's one). The links' parameters bit for bit (Python floats), the base parameters'
+    words alike (pivots and ties in a fixed order); the Fourier
     coefficients bit for bit (the optimisation runs on the reference kernel
     wherever it is called); the trajectory at the log's times within 1e-12 rad and the
     condition numbers within 1e-9 relative (evaluated on each child's own kernel); the same
-    threshold, its scores within 1e-9 relative (held-out least squares on each kernel: 1e-13
-    apart)."""
-    (here, _), = set(_blas.kernels())               # this process: one kernel (NumPy's and SciPy's alike)
+    threshold, its scores within 1e-5 relative (held-out least squares on each kernel: up to
+    4e-6 apart, Sandybridge against Haswell; 1e-13 SkylakeX against Haswell; selection's ties
+    are 1 % and more)."""
+    here, = {kernel for kernel, _ in _blas.kernels()}   # this process: one kernel (NumPy's and SciPy's alike)
     other = _other_kernel(here)
     env = {**os.environ, "OPENBLAS_CORETYPE": other, "OPENBLAS_NUM_THREADS": "2"}
     child = subprocess.Popen([sys.executable, "-c", CHILD], cwd=ROOT, env=env, text=True,
@@ -93,10 +95,10 @@ def test_excite_and_the_threshold_are_the_same_on_two_kernels():
     assert child.returncode == 0, err
     second = json.loads(out)
     assert first["kernels"] == [here] and second["kernels"] == [other], (here, second["kernels"])
-    for key in ("q0", "a", "b", "links"):
+    for key in ("q0", "a", "b", "links", "base"):
         assert first[key] == second[key], key
     np.testing.assert_allclose(first["theta"], second["theta"], rtol=0, atol=1e-12)
     for key in ("condition", "report"):
         assert first[key] == pytest.approx(second[key], rel=1e-9), key
     assert first["chosen"] == second["chosen"]
-    np.testing.assert_allclose(first["scores"], second["scores"], rtol=1e-9)
+    np.testing.assert_allclose(first["scores"], second["scores"], rtol=1e-5)
