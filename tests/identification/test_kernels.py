@@ -30,8 +30,9 @@ def kernel_sensitive() -> dict:
     iterations on 60 points: the paths parted at the second), then the friction speed threshold
     chosen on a 10 s log along it (the Touch's inverse dynamics with Coulomb friction on joint 3
     near its torque RMS, seeded 2 mN m noise); 200 seeded links' standard parameters (what a
-    model's URDF and a simulated device's counts are made of); the general structure's base
-    parameters in words (its pivots and their order); and the kernels threadpoolctl says run."""
+    model's URDF and a simulated device's counts are made of); the Premium 1.5's general
+    structure's base parameters in words (its pivots and their order: Sandybridge's pivoted QR
+    chose others); and the kernels threadpoolctl says run."""
     from threadpoolctl import threadpool_info
 
     from phantom_pin import Phantom, describe
@@ -51,7 +52,8 @@ def kernel_sensitive() -> dict:
     rng = np.random.default_rng(4)
     tensor = (1e-4, 1e-6, 2e-6, 2e-4, 3e-6, 3e-4)
     links = [Inertial(0.1, tuple(rng.uniform(-0.05, 0.05, 3)), tensor).dynamic_parameters() for _ in range(200)]
-    return {"links": [link.tolist() for link in links], "base": General(device).base.describe(),
+    base = General(Phantom.from_model("premium_1_5")).base.describe()
+    return {"links": [link.tolist() for link in links], "base": base,
             "kernels": sorted({i["architecture"] for i in threadpool_info() if i["internal_api"] == "openblas"}),
             "q0": design.trajectory.q0.tolist(), "a": design.trajectory.a.tolist(),
             "b": design.trajectory.b.tolist(), "theta": theta[::1000].tolist(), "condition": design.condition,
