@@ -11,12 +11,14 @@ identify BAG against the same log's CSV (issue 39; each described at the end). M
 shared 2-core machine (x86_64, Python 3.11): the main table (105 rows) in 3 min 48 s of wall time;
 --quick (5 rows) in 13-24 s; ``--parts touch`` in 7 s, ``--parts rest`` (3 setups x 4 seeds) in
 3 s, ``--parts bags`` in 13 s (the Touch's excite trajectory and log included). One BLAS thread
-(OPENBLAS_NUM_THREADS=1, set here unless given, as the tests set it): OpenBLAS's threads change
-excite's trajectory in its last digits, and so the table (at --min-speed 0.01, the Touch's excite
-row with a Stribeck peak: 0.58 % with one thread, 0.22 % with two), and took 3.8 times the time
-(12 min 48 s for 81 rows). A row that names neither the torque timing nor --min-speed runs
-identify's defaults: both chosen from the log. Not run in CI: its --quick clean row and
-``--parts rest`` on the CAD are checked by tests/integration/test_identification_figures.py.
+(OPENBLAS_NUM_THREADS=1, set here unless given, as the tests set it): OpenBLAS's threads took
+3.8 times the time (12 min 48 s for 81 rows), and changed excite's trajectory, and so the table
+(at --min-speed 0.01, the Touch's excite row with a Stribeck peak: 0.58 % with one thread, 0.22 %
+with two), until excite's optimisation ran on one kernel and thread wherever called
+(phantom_pin._blas): the table is the same on every OpenBLAS kernel (DEVELOPERS.md). A row that
+names neither the torque timing nor --min-speed runs identify's defaults: both chosen from the
+log. Not run in CI: its --quick clean row and ``--parts rest`` on the CAD are checked by
+tests/integration/test_identification_figures.py.
 
 Setups (the device, and the configuration it is identified on, the prior):
 - ``cad``: the Premium 1.5 built from independent CAD mass properties (``premium_1_5_cad``: full

@@ -66,7 +66,7 @@ class Inertial:
         """The 10 standard parameters in Pinocchio's order [m, m c, I_origin (xx, xy, yy, xz,
         yz, zz)]: the inertia about the link frame's origin (kg, kg m, kg m^2)."""
         m, c = float(self.mass), np.array(self.com, dtype=float)
-        origin = self.tensor + m * (c @ c * np.eye(3) - np.outer(c, c))
+        origin = self.tensor + _point(m, c)
         return np.array([m, *(m * c), origin[0, 0], origin[0, 1], origin[1, 1], origin[0, 2],
                          origin[1, 2], origin[2, 2]])
 
@@ -75,15 +75,18 @@ class Inertial:
         """The inverse of dynamic_parameters (the mass must be positive)."""
         m, hx, hy, hz, ixx, ixy, iyy, ixz, iyz, izz = (float(v) for v in pi)
         c = np.array([hx, hy, hz]) / m
-        at_com = (np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-                  - m * (c @ c * np.eye(3) - np.outer(c, c)))
+        at_com = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]) - _point(m, c)
         return cls(m, vector3(float(v) for v in c),
                    tensor6(float(at_com[i, j]) for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))))
 
 
 def _point(m: float, c: np.ndarray) -> np.ndarray:
-    """The inertia of a point mass ``m`` at ``c`` about the origin: m (|c|^2 1 - c c^T)."""
-    return m * (c @ c * np.eye(3) - np.outer(c, c))
+    """The inertia of a point mass ``m`` at ``c`` about the origin: m (|c|^2 1 - c c^T). |c|^2 in
+    Python floats, not BLAS's dot: OpenBLAS's kernels round it differently (SkylakeX against
+    Haswell: a link's iyy written to the URDF 1e-16 apart, and a simulated device's encoder
+    counts with it; DEVELOPERS.md)."""
+    x, y, z = c.tolist()
+    return m * ((x * x + y * y + z * z) * np.eye(3) - np.outer(c, c))
 
 
 def without_point_mass(body: Inertial, mass: float, point: tuple[float, float, float]) -> Inertial:

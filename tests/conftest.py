@@ -14,8 +14,8 @@ import pytest
 # OpenBLAS: the identification's SVDs and least squares on tall (3N, P) matrices took 3 to 5
 # times the CPU with OpenBLAS's threads on a 2-core machine (an `identify` of a 20 s log: 5.8 s
 # of CPU against 1.1 s), and with the xdist workers filling the cores a script's threads could
-# take minutes (`check -n 2e7` took 64 s to answer Ctrl-C). The xdist workers inherit it; the
-# docs quote examples/identify_simulated.py's figures as printed with it.
+# take minutes (`check -n 2e7` took 64 s to answer Ctrl-C). The xdist workers inherit it. (excite
+# limits its own optimisation to one thread on one kernel wherever it runs: phantom_pin._blas.)
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # SymPy's cache unbounded, set before SymPy loads (its default keeps 1000 results): the C headers'
 # generation (codegen) takes 18 % less CPU (8.2 s against 6.7 s for the three models), the same bytes.

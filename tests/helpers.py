@@ -138,6 +138,30 @@ def recorded_trajectory(path, record=None, model="touch"):
     return path
 
 
+#: The Fourier series `phantom-pin [--model touch] excite --restarts 1` optimised once (its "command").
+EXCITATIONS = Path(__file__).parent / "data" / "excitations.json"
+
+
+def excitation_file(path, model="touch"):
+    """The file `phantom-pin --model MODEL excite -o PATH --restarts 1` writes (its defaults: 20 s
+    at 1 kHz), from the series EXCITATIONS recorded (model "touch" or "premium_1_5"): the same
+    rows to the last bits of the evaluation's products, on any machine and for any future
+    optimiser, so that a test of a method's property keeps its case (issue 50, 2)."""
+    from phantom_pin.cli.common import csv_text
+    from phantom_pin.identification.excitation import Fourier
+    from phantom_pin.identification.io import TRAJECTORY_COLUMNS
+
+    series = json.loads(EXCITATIONS.read_text())[model]
+    trajectory = Fourier(*(np.array(series[key]) for key in ("q0", "a", "b")), series["period"])
+    phantom = Phantom.from_model(model)
+    t = np.arange(20001) / 1000
+    theta, dtheta, ddtheta = trajectory(t)
+    tau = phantom.inverse_dynamics(theta, dtheta, ddtheta) + phantom.config.actuation.friction.torque(dtheta)
+    path.write_text(csv_text(list(TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
+                             phantom.config.name, "report"))
+    return path
+
+
 WIDTH, HEIGHT, FOV = 800, 600, 75.0
 RESTING, RAISED = np.array([0.0, -0.25, -0.35]), np.array([-1.0, 1.0, 1.1])
 #: Pixels around a projected point searched for its colour (the projection is exact;

@@ -20,6 +20,7 @@ import dataclasses
 
 import numpy as np
 
+from phantom_pin import _blas
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.identification.regressor import Regressor
 
@@ -49,11 +50,18 @@ class BaseParameters:
         return [f"beta{k + 1:<2} = {self.words(k)}" for k in range(self.rank)]
 
 
+#: The digits (of the largest coefficient) to which words() compares coefficients.
+WORD_DIGITS = 9
+
+
 def words(row: np.ndarray, names: tuple[str, ...] | list[str], first: int | None = None) -> str:
-    """A linear combination as a sum, largest coefficients first (``first`` leading)."""
-    keys = -np.abs(row) - (np.arange(len(row)) == first) * 1e300
+    """A linear combination as a sum, largest coefficients first (``first`` leading), those equal
+    to WORD_DIGITS digits in the order of ``names`` (a fixed rule: coefficients of 1 come out of
+    the QR as 1 +- 1e-16, in an order the BLAS kernel decided; DEVELOPERS.md)."""
+    size = np.round(np.abs(row) / max(float(np.abs(row).max()), 1e-300), WORD_DIGITS)
+    keys = -size - (np.arange(len(row)) == first) * 1e300
     terms = []
-    for j in np.argsort(keys):
+    for j in np.argsort(keys, kind="stable"):
         if abs(row[j]) > _ZERO * np.abs(row).max():
             coefficient = "" if np.isclose(abs(row[j]), 1.0, rtol=1e-9) else f"{abs(row[j]):.6g} "
             terms.append(f"{'-' if row[j] < 0 else ''}{coefficient}{names[j]}")
@@ -61,12 +69,22 @@ def words(row: np.ndarray, names: tuple[str, ...] | list[str], first: int | None
 
 
 def base_parameters(stacked: np.ndarray, names: tuple[str, ...] | list[str],
-                    scale: np.ndarray | None = None) -> BaseParameters:
-    """The base parameters of a stacked regressor (3N, P) whose columns are ``names``.
+                    scale: np.ndarray | None = None, affine: np.ndarray | None = None) -> BaseParameters:
+    """The base parameters of a stacked regressor (3N, P) whose columns are ``names``; of
+    ``stacked @ affine`` where ``affine`` is given (the regressor in other parameters).
 
     ``scale`` (P,), the typical size of each parameter, equilibrates the columns before
-    pivoting, so that the pivots are the parameters that matter most.
+    pivoting, so that the pivots are the parameters that matter most. On one BLAS kernel and
+    thread (phantom_pin._blas): columns of equal norm (a symmetry's) tie for a pivot, and the
+    kernel's rounding chose which (Sandybridge against Haswell: another basis; DEVELOPERS.md).
     """
+    return _blas.run(_base_parameters, np.asarray(stacked, float), tuple(names), scale, affine)
+
+
+def _base_parameters(stacked: np.ndarray, names: tuple[str, ...], scale: np.ndarray | None,
+                     affine: np.ndarray | None, _progress: object) -> BaseParameters:
+    if affine is not None:
+        stacked = stacked @ affine
     scale = np.ones(stacked.shape[1]) if scale is None else np.asarray(scale, float)
     import scipy.linalg  # here: 0.17 s that every command line start paid
 

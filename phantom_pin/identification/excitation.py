@@ -13,6 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from phantom_pin import _blas
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
@@ -22,6 +23,9 @@ from phantom_pin.identification.structures import General, Report, friction_bloc
 #: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
 #: would stall SLSQP's finite differences); the result is checked with the law itself.
 SMOOTH_SPEED = 0.05
+#: A restart replaces the best one only where its cost (a log: relative in the condition number
+#: and the sizes) is lower by more than this: within it, the earlier start is kept.
+RESTART_TIE = 1e-9
 
 
 @dataclasses.dataclass(frozen=True)
@@ -121,11 +125,18 @@ def optimise(phantom: Phantom, period: float = 5.0, harmonics: int = 5,
         raise InvalidInputError(f"expected a phantom_pin.Phantom (Phantom(description) for a Description), got a "
                                 f"{type(phantom).__name__}", argument="phantom")
     problem = _Problem(phantom, period, harmonics, samples, margin, torque_share, amplitude_weight, times)
+    # on one BLAS kernel and one thread: SLSQP's path hinges on the last bits (phantom_pin._blas)
+    return _blas.run(_optimised, problem, restarts, iterations, seed, progress=progress)
+
+
+def _optimised(problem: _Problem, restarts: int, iterations: int, seed: int,
+               progress: Callable[[float], None] | None) -> Excitation:
+    """optimise's result on ``problem`` (its search, then the checks at ``problem.checked``)."""
     best = _search(problem, restarts, iterations, seed, progress)
-    trajectory = Fourier.from_free(best, harmonics, period)
+    trajectory = Fourier.from_free(best, problem.harmonics, problem.period)
     states, phi, torque = problem.evaluate(best, problem.checked, exact=True)
     report = None
-    if phantom.description.config.report is not None:
+    if problem.general.phantom.description.config.report is not None:
         report = condition_number(Report(problem.general.phantom).regressor_of(*states)[0].reshape(-1, 14))
     return Excitation(trajectory, condition_number(phi), report, np.abs(torque).max(axis=0),
                       float(problem.limits.slack(states[0]).min()))
@@ -139,6 +150,7 @@ class _Problem:
     def __init__(self, phantom: Phantom, period: float, harmonics: int, samples: int, margin: float,
                  torque_share: float, amplitude_weight: float, times: np.ndarray | None) -> None:
         description = phantom.description
+        self._arguments = (description, period, harmonics, samples, margin, torque_share, amplitude_weight, times)
         self.period, self.harmonics, self.margin = period, harmonics, margin
         self.torque_share, self.amplitude_weight = torque_share, amplitude_weight
         self.limits = description.config.limits
@@ -149,6 +161,10 @@ class _Problem:
         self.t = np.linspace(0.0, period, samples, endpoint=False)
         self.checked = self.t if times is None else np.unique(np.mod(np.asarray(times, float), period))
         self._memo: dict[bytes, tuple] = {}
+
+    def __reduce__(self) -> tuple:
+        """Pickled as its arguments (a child process on the reference BLAS builds it again)."""
+        return (_problem, self._arguments)
 
     def evaluate(self, free: np.ndarray, at: np.ndarray | None = None, exact: bool = False) -> tuple:
         """(states, Phi stacked (3N, P), torque (N, 3)) at the times ``at`` (default ``t``): for the
@@ -201,6 +217,10 @@ class _Problem:
                     and (self.torque_share * self.effort - np.abs(torque)).min() >= -1e-12)
 
 
+def _problem(description: Description, *arguments: object) -> _Problem:
+    return _Problem(Phantom(description), *arguments)  # type: ignore[arg-type]
+
+
 def _search(problem: _Problem, restarts: int, iterations: int, seed: int,
             progress: Callable[[float], None] | None) -> np.ndarray:
     """The best feasible coefficients of SLSQP from ``restarts`` seeded random starts, each result
@@ -228,7 +248,7 @@ def _search(problem: _Problem, restarts: int, iterations: int, seed: int,
         for alpha in (1.0, 0.95, 0.9, 0.8, 0.6, 0.4, 0.2, 0.0):
             candidate = free0 + alpha * (result.x - free0)
             if problem.feasible(candidate):
-                if problem.cost(candidate) < best_cost:
+                if problem.cost(candidate) < best_cost - RESTART_TIE:     # the earliest start of a tie
                     best, best_cost = candidate, problem.cost(candidate)
                 break
     if best is None:

@@ -180,7 +180,7 @@ class General(Structure):
         self.scale = np.concatenate([*(_body_scale(self.bodies[name]) for name in BODIES),
                                      [config.actuation.rotor[0]] if self.motor else [], self.friction_scale])
         base = cached(description, ("general base", prefix),   # the base of Y A: combinations of x only
-                      lambda: base_parameters(regressor.stacked(*sample(regressor)) @ a, self.names, self.scale))
+                      lambda: base_parameters(regressor.stacked(*sample(regressor)), self.names, self.scale, a))
         order = np.argsort(base.independent)            # pivots in x's order: friction last
         self.base = dataclasses.replace(base, independent=tuple(base.independent[k] for k in order),
                                         matrix=base.matrix[order])

@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from helpers import CONFIG, run_cli
+from helpers import CONFIG, excitation_file, run_cli
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
@@ -65,9 +65,9 @@ def rms(error, reference) -> float:
 @pytest.fixture(scope="module")
 def run(tmp_path_factory):
     folder = tmp_path_factory.mktemp("general")
-    # excite's defaults' file, byte for byte: of its two starts the first is the better one here
-    # (and on the Touch), so --restarts 1 writes it at 2/3 of the CPU (measured 2026-11-27)
-    assert cli("excite", "-o", folder / "traj.csv", "--restarts", "1")[0] == 0
+    # `phantom-pin excite -o traj.csv --restarts 1`'s file (the defaults' too: of their two starts
+    # the first is the better one here), from its recorded series (helpers.EXCITATIONS)
+    excitation_file(folder / "traj.csv", "premium_1_5")
     assert cli("excite", "-o", folder / "held_out.csv", "--seed", "5", "--iterations", "5")[0] == 0
     t, theta, dtheta, _, tau = io.read_trajectory(folder / "traj.csv")
     log = simulation.track(DEVICE, t, theta, dtheta, tau, torque_noise=NOISE, seed=1)

@@ -6,6 +6,7 @@ simulated device's own numbers (its --set) and its own inverse dynamics, not the
 import numpy as np
 import pytest
 
+from helpers import excitation_file
 from phantom_pin import Phantom, describe
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
@@ -19,9 +20,9 @@ def touch_log(tmp_path_factory):
 
     folder = tmp_path_factory.mktemp("touch")
     sets = [a for key, value in DEVICE.items() for a in ("--set", f"{key}={value!r}")]
-    # the defaults' file, byte for byte: their first start is the better one on the Touch
-    # (test_general_structure's fixture), so --restarts 1 writes it at 2/3 of the CPU
-    assert main(["-q", "--model", "touch", "excite", "-o", str(folder / "t.csv"), "--restarts", "1"]) == 0
+    # `phantom-pin --model touch excite -o t.csv --restarts 1`'s file (the defaults' too: their
+    # first start is the better one on the Touch), from its recorded series (helpers.EXCITATIONS)
+    excitation_file(folder / "t.csv", "touch")
     assert main(["-q", "--model", "touch", "simulate", "--trajectory", str(folder / "t.csv"), *sets,
                  "-o", str(folder / "log.csv")]) == 0
     return folder
@@ -56,10 +57,10 @@ def test_the_threshold_is_chosen_and_the_touch_comes_back_exact(touch_log, cli):
 
 def test_the_old_default_threshold_was_confidently_wrong_on_this_log(touch_log, cli):
     """The same log at the old default, --min-speed 0.01 given: viscous friction off by more
-    than 3 % on a joint (4.7 % on joint 3 here; the issue measured 6.7 % and 9.6 % on the command
-    line's excitation, which differs from this one in-process: OpenBLAS's thread count changes
-    SLSQP's path, DEVELOPERS.md) where the chosen threshold's is within 0.5 %, so the choice
-    above is what fixed it."""
+    than 3 % on a joint (4.7 % on joint 3 here; the issue measured 6.7 % and 9.6 % on another
+    excitation) where the chosen threshold's is within 0.5 %, so the choice above is what fixed
+    it. The log's trajectory is the recorded one (the fixture: `phantom-pin --model touch excite
+    -o t.csv --restarts 1` run once, tests/data/excitations.json), not what excite writes today."""
     out, _, _ = _identified(cli, touch_log, "--min-speed", "0.01")
     assert "friction speed threshold: 0.01 rad/s (given" in out
     line = next(line for line in out.splitlines() if line.startswith("friction.viscous estimated per joint"))

@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_identify_simulated_example(tmp_path):
-    result = run("identify_simulated.py", tmp_path)   # one BLAS thread (conftest), as the docs' figures were made
+    result = run("identify_simulated.py", tmp_path)   # on any BLAS kernel: excite's on one (phantom_pin._blas)
     assert result.returncode == 0, result.stderr
     figure(tmp_path / "identify_simulated.png")
     general = number(r"identified \(general\) (\S+) %", result.stdout)
