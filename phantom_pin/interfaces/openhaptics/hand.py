@@ -42,7 +42,7 @@ class Run:
     hand: np.ndarray
 
 
-def _loop(compensator, theta0, duration, hand, friction=True, wall=None, noise=0.0):
+def run(compensator, theta0, duration, hand, friction=True, wall=None, noise=0.0) -> Run:
     """Run the device for ``duration`` s from rest at ``theta0`` (rad) with ``compensator``
     (None: no compensation) and the hand ``hand(t, tip, tip_velocity) -> F`` (N, frame s);
     ``wall`` (n, w, K, B) adds the virtual wall's force to the command; ``noise`` (rad) is the
@@ -86,10 +86,10 @@ def apparent_mass(compensator, theta0, direction, force=0.02, window=(0.04, 0.1)
     """The mass (kg) the hand feels along ``direction`` (frame s) pushing with ``force`` N from
     rest at ``theta0``, friction off in the plant (module doc)."""
     u = np.asarray(direction, float) / np.linalg.norm(direction)
-    run = _loop(compensator, theta0, window[1], lambda t, x, dx: force * u, friction=False)
-    keep = run.t >= window[0]
-    along = (run.tip[keep] - run.tip[0]) @ u
-    a = 2.0 * np.polyfit(run.t[keep], along, 2)[0]
+    samples = run(compensator, theta0, window[1], lambda t, x, dx: force * u, friction=False)
+    keep = samples.t >= window[0]
+    along = (samples.tip[keep] - samples.tip[0]) @ u
+    a = 2.0 * np.polyfit(samples.t[keep], along, 2)[0]
     return force / a
 
 
@@ -105,17 +105,17 @@ def backdrive(compensator, theta0, direction, speed=0.02, duration=0.5, stiffnes
         target = start + speed * t * u
         return stiffness * (target - tip) + damping * (speed * u - velocity)
 
-    run = _loop(compensator, theta0, duration, hand)
-    steady = run.t >= duration / 2
-    return float((run.hand[steady] @ u).mean())
+    samples = run(compensator, theta0, duration, hand)
+    steady = samples.t >= duration / 2
+    return float((samples.hand[steady] @ u).mean())
 
 
 def rest_drift(compensator, theta0, duration=2.0, noise=2e-4) -> float:
     """How far (m) the tip wanders in ``duration`` s from rest at ``theta0`` with no hand, the
     angles seen with ``noise`` (rad): what a compensation that pushes a resting joint on noise
     does (the dead band's purpose)."""
-    run = _loop(compensator, theta0, duration, lambda t, x, dx: np.zeros(3), noise=noise)
-    return float(np.linalg.norm(run.tip - run.tip[0], axis=1).max())
+    samples = run(compensator, theta0, duration, lambda t, x, dx: np.zeros(3), noise=noise)
+    return float(np.linalg.norm(samples.tip - samples.tip[0], axis=1).max())
 
 
 def wall_is_stable(compensator, theta0, normal, stiffness, damping=0.0, push=0.5, duration=1.0,
@@ -129,8 +129,8 @@ def wall_is_stable(compensator, theta0, normal, stiffness, damping=0.0, push=0.5
             raise InvalidInputError(f"expected a finite number >= 0, got {value!r}", argument=name)
     n = np.asarray(normal, float) / np.linalg.norm(normal)
     offset = float(n @ compensator.device.phantom.forward_kinematics(np.asarray(theta0, float))[:3, 3])
-    run = _loop(compensator, theta0, duration, lambda t, x, dx: push * n, wall=(n, offset, stiffness, damping))
-    depth = run.tip[run.t >= 0.75 * duration] @ n
+    samples = run(compensator, theta0, duration, lambda t, x, dx: push * n, wall=(n, offset, stiffness, damping))
+    depth = samples.tip[samples.t >= 0.75 * duration] @ n
     return bool(np.isfinite(depth).all() and depth.max() - depth.min() < amplitude)
 
 
