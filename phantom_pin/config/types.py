@@ -54,7 +54,9 @@ class Kinematics:
 @dataclasses.dataclass(frozen=True)
 class Motor:
     """At the motor shaft: rotor inertia (kg m^2), max. continuous and stall torque (N m)
-    and current (A), torque constant (N m/A), terminal resistance (Ohm), no-load speed (rad/s)."""
+    and current (A), torque constant (N m/A), terminal resistance (Ohm), no-load speed (rad/s),
+    the winding's thermal time constant (s: how long the stall torque may last before the
+    continuous rating binds, device.thermal)."""
 
     rotor_inertia: float
     max_continuous_torque: float
@@ -64,6 +66,7 @@ class Motor:
     torque_constant: float
     terminal_resistance: float
     max_speed: float
+    thermal_time_constant: float
 
 
 @dataclasses.dataclass(frozen=True)

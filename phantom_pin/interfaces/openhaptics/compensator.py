@@ -28,9 +28,11 @@ angles), tau the sum of the terms of ``compensate`` (TERMS):
 
 The rates and accelerations are estimated from the successive calls at ``rate`` Hz
 (device.estimator.Estimator, ``cutoff`` Hz), or taken from ``rates`` where the caller gives them
-(friction only). The total is bounded as OpenHaptics bounds it: a force to the device's
-HD_NOMINAL_MAX_FORCE (its norm, direction kept; actuation.yaml's openhaptics), a joint torque to
-the motors' peak torque per joint; the result is never non-finite. The cost is measured by
+(friction only). The total is bounded as OpenHaptics and the motors bound it: a force to the device's
+HD_NOMINAL_MAX_FORCE (its norm, direction kept; actuation.yaml's openhaptics), and the joint
+torques to the motors' peak for short forces and their continuous rating on average
+(device.thermal.TorqueBudget, one call a servo period: a force scaled, its direction kept; joint
+torques clipped per joint); the result is never non-finite. The cost is measured by
 benchmarks/bench_openhaptics.py.
 """
 
@@ -89,6 +91,7 @@ class Compensator:
         from phantom_pin.description.build import description_of
         from phantom_pin.device.device import Device
         from phantom_pin.device.estimator import CUTOFF, Estimator
+        from phantom_pin.device.thermal import TorqueBudget
         from phantom_pin.drivers import openhaptics_from_theta
         from phantom_pin.dynamics.model import Phantom
 
@@ -113,7 +116,7 @@ class Compensator:
                                     argument="compensate")
         openhaptics = self.phantom.config.actuation.openhaptics
         self.max_force = math.inf if openhaptics is None else openhaptics.max_force       # N, the norm
-        self.peak = np.array(self.phantom.config.actuation.peak) * 1000.0                # mN m per joint
+        self.budget = TorqueBudget(self.device, 1.0 / rate)                               # the motors' limits in time
 
     def _gimbal(self, gimbals: Sequence[float] | None) -> np.ndarray | None:
         locked = self.phantom.config.gimbal
@@ -149,7 +152,7 @@ class Compensator:
         """HD_CURRENT_FORCE (N) or HD_CURRENT_JOINT_TORQUE (mN m), bounded, as a list of three floats."""
         tau = self.torque(joints, gimbals, rates)
         if self.mode == "joint_torque":
-            return np.clip(tau * self._sign * 1000.0, -self.peak, self.peak).tolist()
+            return (self.budget.clip(tau) * self._sign * 1000.0).tolist()
         theta = _three(joints, "joints") * self._sign
         jacobian = self.device.tip_jacobian(theta)
         if abs(np.linalg.det(jacobian)) < 1e-12:
@@ -157,4 +160,5 @@ class Compensator:
                                     "torques; use mode 'joint_torque'", argument="joints")
         force = np.linalg.solve(jacobian.T, tau)
         norm = float(np.linalg.norm(force))
-        return (force * (self.max_force / norm) if norm > self.max_force else force).tolist()
+        force = force * (self.max_force / norm) if norm > self.max_force else force
+        return (force * self.budget.scale(jacobian.T @ force)).tolist()
