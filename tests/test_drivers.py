@@ -415,3 +415,26 @@ def test_a_bad_joint_convention_is_refused_naming_its_field(arguments, argument)
     with pytest.raises(InvalidInputError) as error:
         drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], convention="kinisi")
     assert error.value.argument == "convention"
+
+
+def test_the_origin_puts_the_shoulder_where_the_arm_turns_about_it_with_unequal_links():
+    """Mutant 31. A Touch whose links differ (l1 = 0.20 m, l2 = 0.11 m; the Touch's equal links
+    hide a swap): frame s's origin in OpenHaptics' coordinates is openhaptics_shoulder less the
+    shoulder in frame s, and the shoulder is the point whose distance to the gimbal centre
+    depends on the elbow's angle alone, |p - S|^2 = l1^2 + l2^2 + 2 l1 l2 sin(theta3 - theta2)
+    (the law of cosines), p Ubitrack's position formula with those lengths (the gimbal centre in
+    frame s, PhantomForwardKinematics.h lines 101-103): 1e-12 m^2 over 50 seeded postures."""
+    import dataclasses
+
+    config = read("touch")
+    l1, l2 = 0.20, 0.11
+    config = dataclasses.replace(config, kinematics=dataclasses.replace(config.kinematics, l1=l1, l2=l2))
+    shoulder = np.array(config.gimbal.openhaptics_shoulder) - drivers.openhaptics_origin(config)   # frame s
+    theta = sample_postures(config.limits, 50, np.random.default_rng(23), draws=200)
+    a = theta * [-1.0, 1.0, 1.0]                        # OpenHaptics' angles (Ubitrack's)
+    s1, c1, s2, c2, s3, c3 = np.sin(a[:, 0]), np.cos(a[:, 0]), np.sin(a[:, 1]), np.cos(a[:, 1]), \
+        np.sin(a[:, 2]), np.cos(a[:, 2])
+    p = np.stack([-(l1 * c2 + l2 * s3) * s1, l1 * s2 - l2 * c3 + l2, -l1 + (l1 * c2 + l2 * s3) * c1], axis=-1)
+    distance = ((p - shoulder) ** 2).sum(axis=1)
+    np.testing.assert_allclose(distance, l1**2 + l2**2 + 2 * l1 * l2 * np.sin(theta[:, 2] - theta[:, 1]),
+                               rtol=0, atol=1e-12)
