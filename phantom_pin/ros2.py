@@ -480,6 +480,8 @@ def run(make: Callable[[], Any], ready: str, loop: Callable[[Any, threading.Even
                 pass
         finally:
             stop.set()
+            if loop is not None:   # it returns once stop is set: let it finish before the executor goes (a
+                worker.join(timeout=5.0)   # shutdown inside its spin_once raised InvalidHandle there, under load)
             executor.shutdown(timeout_sec=5.0)
             worker.join(timeout=5.0)
             node.destroy_node()
