@@ -20,22 +20,43 @@ OpenHaptics (``openhaptics_*``), sources:
   inferred from that sample, not stated by any public document: check it on your device
   (docs/touch.md). So tau (N m) = (-torque1, torque2, torque3) / 1000.
 
-ROS ``joint_states`` (``joint_state_*``): the drivers publish waist = -angle1 = theta1,
-shoulder = angle2 = theta2, elbow = angle3 - angle2 = theta3 - theta2 (fsuarez6/phantom_omni
-omni_common/src/omni_state.cpp lines 182-193 and 296-300; jhu-saw/sawSensablePhantom
-core/components/code/mtsSensableHD.cpp lines 417-419, ``q[0] = -q[0]; q[2] -= q[1]``;
-bgromov/sensable_phantom src/phantom_node.cpp lines 319-320), names optionally prefixed. The
-gimbal's yaw, pitch, roll are OpenHaptics' raw HD_CURRENT_GIMBAL_ANGLES g1..g3 (rad) in the
-Touch-era drivers (GIMBAL_CONVENTIONS["raw"]: jhu-saw/sawSensablePhantom since commit 69776dd,
-"Removing strange offsets on gimbal joints added to compensate for issues with old Omni";
-kinisi-robotics/phantom_touch_ros2 2bf5b20; CalaW/touch_ros2_control e1e181e), which are the
-model's joint4..joint6 (Phantom.stylus_pose). The fsuarez6/phantom_omni lineage (and its
-forks) publishes yaw = pi - g1, pitch = -g2 - 3 pi / 4, roll = -g3 - pi (omni_state.cpp lines
-188-193), tuned for the old FireWire Omni: GIMBAL_CONVENTIONS["omni_firewire"], a per-device
-convention to choose, not the default. The maps are affine, so joint velocities convert as
-positions do, without the offsets (``rates=True``). The drivers' efforts follow no common rule
+ROS ``joint_states`` (``joint_state_*``, JointConvention): every driver publishes OpenHaptics'
+raw angles a (HD_CURRENT_JOINT_ANGLES) and g (HD_CURRENT_GIMBAL_ANGLES) through a fixed linear
+(for the gimbal affine) map, its JointConvention: ``published = arm_signs * (a1, a2, a3 - a2)``
+(elbow "relative") or ``arm_signs * a`` ("absolute"), gimbal ``gimbal_signs * g + offsets``. The
+drivers differ in the waist's sign (read at each driver's source; docs/drivers.md has the
+table):
+
+- waist = -a1 = theta1: the older drivers, the fsuarez6/phantom_omni lineage (fsuarez6/phantom_omni
+  omni_common/src/omni_state.cpp; bharatm11/Geomagic_Touch_ROS_Drivers 34e9fac omni_state.cpp
+  line 183 with 236 and 296-298; its ROS 2 ports IvoD1998/Geomagic_Touch_ROS2 cd0cdba and
+  stevens-armlab/Geomagic_Touch_ROS2 2e4b1f5 omni_state.cpp line 228 with 286 and 343-347),
+  WPI-AIM/ros_geomagic 441542c geomagic_control/src/device_node.cpp line 200 with 260 and 301-303,
+  and jhu-saw/sawSensablePhantom 7ddd575 core/components/code/mtsSensableHD.cpp lines 312-313 and
+  418-419 (``q[0] = -q[0]; q[2] -= q[1]``). Their convention, FIXED_CONVENTION, is the one
+  urdf/phantom_touch_driver.urdf, the ``ros2`` node without ``--driver`` and the
+  ``joint_state_*`` functions here read.
+- waist = +a1 = -theta1: kinisi-robotics/phantom_touch_ros2 2bf5b20
+  phantom_touch_control/src/hd++.cpp lines 257-268 (no sign, ``angles[2] -= angles[1]``),
+  published as they are by phantom_touch_control_node.cpp line 314; CalaW/touch_ros2_control
+  e1e181e touch_hardware/src/touch_driver_node.cpp line 169 and
+  touch_hardware/include/touch_hardware/device_transforms.hpp lines 77-87 (no sign); and
+  RViMLab/geomagic_touch_x_ros2 57da5c9 src/device.cpp line 54, src/geomagic_touch_x_component.cpp
+  lines 161 and 177 (raw, elbow absolute). Read these through their profiles
+  (phantom_pin.profiles: Profile.joint_states.convention; ``ros2 --driver``): FIXED_CONVENTION
+  would mirror them about joint 1.
+
+The gimbal's yaw, pitch, roll are OpenHaptics' raw g1..g3 (rad) in the Touch-era drivers
+(GIMBAL_CONVENTIONS["raw"]: jhu-saw/sawSensablePhantom since commit 69776dd, "Removing strange
+offsets on gimbal joints added to compensate for issues with old Omni"; kinisi-robotics/
+phantom_touch_ros2 2bf5b20; CalaW/touch_ros2_control e1e181e), which are the model's
+joint4..joint6 (Phantom.stylus_pose). The fsuarez6/phantom_omni lineage (and its forks)
+publishes yaw = pi - g1, pitch = -g2 - 3 pi / 4, roll = -g3 - pi (omni_state.cpp lines 188-193),
+tuned for the old FireWire Omni: GIMBAL_CONVENTIONS["omni_firewire"], a per-device convention to
+choose, not the default. The maps are affine, so joint velocities convert as positions do,
+without the offsets (``rates=True``). The drivers' efforts follow no common rule
 (sawSensablePhantom publishes OpenHaptics' raw joint torques): convert those with
-``openhaptics_torque_to_tau``.
+``tau_from_openhaptics_torque``.
 
 HD_CURRENT_TRANSFORM (``pose_from_openhaptics_transform``): the 16 numbers of the stylus's
 column-major 4x4 transform, translation in mm, in OpenHaptics' axes, which are frame s's. Its
@@ -55,6 +76,7 @@ Arrays: one vector (3,) or a batch (..., 3), as the rest of phantom_pin.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 
@@ -76,10 +98,92 @@ GIMBAL_CONVENTIONS = {
 }
 #: m per mm (HD_CURRENT_TRANSFORM's and HD_CURRENT_POSITION's unit).
 METRE_PER_MM = 1e-3
-#: OpenHaptics' angle i = SIGN[i] * theta_i; its joint torque (mN m) = SIGN[i] * tau_i * 1000.
-_SIGN = np.array([-1.0, 1.0, 1.0])
+#: OpenHaptics' angle i = OPENHAPTICS_SIGN[i] * theta_i; its joint torque (mN m) =
+#: OPENHAPTICS_SIGN[i] * tau_i * 1000 (the module's doc gives the sources). The one statement
+#: of the law: phantom_pin.profiles reads it from here.
+OPENHAPTICS_SIGN = (-1.0, 1.0, 1.0)
+_SIGN = np.array(OPENHAPTICS_SIGN)
 #: mN m per N m (HD_CURRENT_JOINT_TORQUE's unit).
 MILLI = 1000.0
+
+
+#: How a driver publishes the elbow: "relative" (a3 - a2, the Touch-era drivers) or "absolute" (a3).
+ELBOWS = ("relative", "absolute")
+
+
+def _signs(value: object, argument: str) -> tuple[float, float, float]:
+    if (not isinstance(value, (tuple, list)) or len(value) != 3
+            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and v in (-1, 1) for v in value)):
+        raise InvalidInputError(f"expected three signs, each 1 or -1, got {value!r}", argument=argument)
+    return float(value[0]), float(value[1]), float(value[2])
+
+
+@dataclasses.dataclass(frozen=True)
+class JointConvention:
+    """How a driver publishes OpenHaptics' raw angles as joint_states (rad; the module's doc):
+    the arm ``published = arm_signs * (a1, a2, a3 - a2)`` (``elbow`` "relative") or ``arm_signs
+    * (a1, a2, a3)`` ("absolute"), the gimbal ``published = gimbal_signs * g + gimbal_offsets``.
+    The one reader of every driver's joint states: each profile's (Profile.joint_states.convention)
+    and FIXED_CONVENTION (urdf/phantom_touch_driver.urdf, the ``ros2`` node without a driver).
+    InvalidInputError naming the field for a sign other than 1 or -1, an unknown elbow or an
+    offset that is not finite. Each method takes (3,) or (..., 3) and is exact (signs, one sum)."""
+
+    arm_signs: tuple[float, float, float]
+    elbow: str = "relative"
+    gimbal_signs: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    gimbal_offsets: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "arm_signs", _signs(self.arm_signs, "arm_signs"))
+        object.__setattr__(self, "gimbal_signs", _signs(self.gimbal_signs, "gimbal_signs"))
+        if not isinstance(self.elbow, str) or self.elbow not in ELBOWS:
+            raise InvalidInputError(f"expected one of {', '.join(ELBOWS)}, got {self.elbow!r}", argument="elbow")
+        offsets, _ = as_states(self.gimbal_offsets, "gimbal_offsets")
+        if offsets.shape != (3,):
+            raise InvalidInputError(f"expected three offsets (rad), got {self.gimbal_offsets!r}",
+                                    argument="gimbal_offsets")
+        object.__setattr__(self, "gimbal_offsets", tuple(offsets.tolist()))
+
+    def theta(self, published: object) -> np.ndarray:
+        """The report's theta (rad; rad/s of rates: the map is linear) of the three published arm
+        angles, (3,) or (..., 3)."""
+        a = np.asarray(published, dtype=float) * self.arm_signs   # signs are +-1: their own inverse
+        if self.elbow == "relative":
+            a[..., 2] += a[..., 1]
+        return a * _SIGN
+
+    def published(self, theta: object) -> np.ndarray:
+        """The three published arm angles (rad; or rates) of the report's theta, (3,) or (..., 3)."""
+        a = np.asarray(theta, dtype=float) * _SIGN
+        if self.elbow == "relative":
+            a[..., 2] -= a[..., 1]
+        return a * self.arm_signs
+
+    def effort(self, tau: object) -> np.ndarray:
+        """The torques (N m) conjugate to the published arm angles of the report's joint torques
+        ``tau`` (N m), (3,) or (..., 3): the same power, effort . d(published) = tau . d(theta)."""
+        t = np.asarray(tau, dtype=float) * _SIGN
+        if self.elbow == "relative":
+            t[..., 1] += t[..., 2]
+        return t * self.arm_signs
+
+    def gimbal(self, published: object, rates: bool = False) -> np.ndarray:
+        """OpenHaptics' raw gimbal angles g (rad) of the three published ones; ``rates``: rad/s,
+        without the offsets."""
+        p = np.asarray(published, dtype=float)
+        return (p if rates else p - self.gimbal_offsets) * self.gimbal_signs
+
+    def published_gimbal(self, gimbal: object, rates: bool = False) -> np.ndarray:
+        """The three published gimbal angles (rad) of OpenHaptics' raw ones; ``rates``: rad/s,
+        without the offsets."""
+        p = np.asarray(gimbal, dtype=float) * self.gimbal_signs
+        return p if rates else p + self.gimbal_offsets
+
+
+#: The older drivers' fixed convention (the module's doc): waist = -a1 = theta1, shoulder = a2,
+#: elbow = a3 - a2, the gimbal raw (sawSensablePhantom's; the fsuarez6 lineage's gimbal is
+#: GIMBAL_CONVENTIONS["omni_firewire"]). urdf/phantom_touch_driver.urdf is jointed in it.
+FIXED_CONVENTION = JointConvention((-1.0, 1.0, 1.0), "relative", *GIMBAL_CONVENTIONS["raw"])
 
 
 def theta_from_openhaptics(angles: object) -> np.ndarray:
@@ -129,12 +233,13 @@ def _names(names: object, wanted: list[str]) -> list[str]:
     return given
 
 
-def _convention(convention: object) -> tuple[np.ndarray, np.ndarray]:
+def _convention(convention: object) -> JointConvention:
+    """FIXED_CONVENTION's arm with the gimbal of GIMBAL_CONVENTIONS[``convention``]."""
     if not isinstance(convention, str) or convention not in GIMBAL_CONVENTIONS:
         raise InvalidInputError(f"expected one of {', '.join(GIMBAL_CONVENTIONS)}, got {convention!r}",
                                 argument="convention")
-    signs, offsets = GIMBAL_CONVENTIONS[convention]
-    return np.array(signs), np.array(offsets)
+    return dataclasses.replace(FIXED_CONVENTION, gimbal_signs=GIMBAL_CONVENTIONS[convention][0],
+                               gimbal_offsets=GIMBAL_CONVENTIONS[convention][1])
 
 
 def gimbal_from_joint_state(names: object, position: object, prefix: str = "", convention: str = "raw",
@@ -144,12 +249,12 @@ def gimbal_from_joint_state(names: object, position: object, prefix: str = "", c
     (rad) as theta_from_joint_state's; ``convention``: GIMBAL_CONVENTIONS' name of the driver's
     (default "raw", the Touch-era drivers'). ``rates``: convert velocities (rad/s), without
     the offsets."""
-    signs, offsets = _convention(convention)
+    reader = _convention(convention)
     given = _names(names, [_prefix(prefix) + name for name in GIMBAL_STATE_NAMES])
     values, _ = as_states(position, "position", width=len(given))
     published = np.stack([values[..., given.index(prefix + name)] for name in GIMBAL_STATE_NAMES], axis=-1)
     with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result, naming position
-        return finite_result((published - (0 if rates else offsets)) * signs, "position")
+        return finite_result(reader.gimbal(published, rates), "position")
 
 
 def joint_state_from_gimbal(gimbal: object, prefix: str = "", convention: str = "raw",
@@ -157,11 +262,11 @@ def joint_state_from_gimbal(gimbal: object, prefix: str = "", convention: str = 
     """(names, position) of the drivers' gimbal joint_states (GIMBAL_STATE_NAMES with
     ``prefix``) for OpenHaptics' raw gimbal angles ``gimbal`` (rad), (3,) or (..., 3), in the
     driver's ``convention``; ``rates``: velocities (rad/s), without the offsets."""
-    signs, offsets = _convention(convention)
+    reader = _convention(convention)
     g, _ = as_states(gimbal, "gimbal")
     names = [_prefix(prefix) + name for name in GIMBAL_STATE_NAMES]
     with np.errstate(over="ignore", invalid="ignore"):
-        return names, finite_result(signs * g + (0 if rates else offsets), "gimbal")
+        return names, finite_result(reader.published_gimbal(g, rates), "gimbal")
 
 
 def _rigid(pose: np.ndarray, argument: str) -> None:
@@ -242,39 +347,52 @@ def openhaptics_transform_from_pose(pose: object, origin: object = None) -> np.n
     return finite_result(np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,)), "pose")
 
 
+def _reader(convention: object) -> JointConvention:
+    if not isinstance(convention, JointConvention):
+        raise InvalidInputError(f"expected a phantom_pin.drivers.JointConvention (FIXED_CONVENTION, or a profile's "
+                                f"joint_states.convention), got {convention!r}", argument="convention")
+    return convention
+
+
 def theta_from_driver(waist: float | np.ndarray, shoulder: float | np.ndarray,
                       elbow: float | np.ndarray) -> np.ndarray:
-    """The report's theta (rad) of the Touch-era drivers' coordinates (rad, floats or arrays of
-    one shape; the elbow relative to the shoulder): (waist, shoulder, shoulder + elbow), unchecked
-    (theta_from_joint_state checks and names its input)."""
-    return np.stack([waist, shoulder, shoulder + elbow], axis=-1)
+    """The report's theta (rad) of the older drivers' coordinates (FIXED_CONVENTION; rad, floats
+    or arrays of one shape; the elbow relative to the shoulder): (waist, shoulder, shoulder +
+    elbow), unchecked (theta_from_joint_state checks and names its input)."""
+    return FIXED_CONVENTION.theta(np.stack([waist, shoulder, elbow], axis=-1))
 
 
 def effort_from_tau(tau: np.ndarray) -> np.ndarray:
-    """The torques (N m) conjugate to the drivers' coordinates (waist, shoulder, elbow) of the
-    report's tau (N m, (3,) or (..., 3)): (tau1, tau2 + tau3, tau3), the effort of their
-    joint_states."""
-    return np.stack([tau[..., 0], tau[..., 1] + tau[..., 2], tau[..., 2]], axis=-1)
+    """The torques (N m) conjugate to the older drivers' coordinates (waist, shoulder, elbow;
+    FIXED_CONVENTION) of the report's tau (N m, (3,) or (..., 3)): (tau1, tau2 + tau3, tau3),
+    the effort of their joint_states."""
+    return FIXED_CONVENTION.effort(tau)
 
 
-def theta_from_joint_state(names: object, position: object, prefix: str = "") -> np.ndarray:
+def theta_from_joint_state(names: object, position: object, prefix: str = "",
+                           convention: JointConvention = FIXED_CONVENTION) -> np.ndarray:
     """The report's theta (rad) of a driver's joint_states: ``names`` (sequence of str, as in
     sensor_msgs/JointState, each joint of JOINT_STATE_NAMES with ``prefix`` exactly once;
     others, such as the gimbal's (gimbal_from_joint_state), are ignored) and ``position`` (rad,
-    one value per name, or (N, len(names)) for a batch): theta = (waist, shoulder, shoulder +
-    elbow). Velocities (rad/s) convert the same way."""
+    one value per name, or (N, len(names)) for a batch), read in ``convention`` (default
+    FIXED_CONVENTION: theta = (waist, shoulder, shoulder + elbow); for kinisi's or CalaW's driver
+    pass its profile's joint_states.convention). Velocities (rad/s) convert the same way."""
+    reader = _reader(convention)
     wanted = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
     given = _names(names, wanted)
     values, _ = as_states(position, "position", width=len(given))
-    waist, shoulder, elbow = (values[..., given.index(name)] for name in wanted)
+    published = np.stack([values[..., given.index(name)] for name in wanted], axis=-1)
     with np.errstate(over="ignore"):  # reported by finite_result, naming position
-        return finite_result(theta_from_driver(waist, shoulder, elbow), "position")
+        return finite_result(reader.theta(published), "position")
 
 
-def joint_state_from_theta(theta: object, prefix: str = "") -> tuple[list[str], np.ndarray]:
-    """(names, position) of the drivers' joint_states for the report's theta (rad):
-    ([prefix + waist, shoulder, elbow], (theta1, theta2, theta3 - theta2)), (3,) or (..., 3)."""
+def joint_state_from_theta(theta: object, prefix: str = "",
+                           convention: JointConvention = FIXED_CONVENTION) -> tuple[list[str], np.ndarray]:
+    """(names, position) of the drivers' joint_states for the report's theta (rad), (3,) or
+    (..., 3), in ``convention`` (default FIXED_CONVENTION: [prefix + waist, shoulder, elbow],
+    (theta1, theta2, theta3 - theta2))."""
+    reader = _reader(convention)
     t, _ = as_states(theta, "theta")
     names = [_prefix(prefix) + name for name in JOINT_STATE_NAMES]
     with np.errstate(over="ignore"):  # reported by finite_result, naming theta
-        return names, finite_result(np.stack([t[..., 0], t[..., 1], t[..., 2] - t[..., 1]], axis=-1), "theta")
+        return names, finite_result(reader.published(t), "theta")

@@ -13,10 +13,12 @@ HD_CURRENT_FORCE); OpenHaptics renders it at the gimbal centre (the tool frame t
 the joint torques are J_p(theta)^T F, J_p the tip's position Jacobian in frame s
 (Device.tip_jacobian). See docs/drivers.md.
 
-Joint states: ``published = sign * a`` for OpenHaptics' raw arm angles a
-(HD_CURRENT_JOINT_ANGLES, rad), the elbow ``relative`` (sign3 * (a3 - a2)) or ``absolute``
-(sign3 * a3); the gimbal ``published = sign * g + offset`` (HD_CURRENT_GIMBAL_ANGLES, rad).
-The report's theta is (-a1, a2, a3) (phantom_pin.drivers).
+Joint states: each profile's phantom_pin.drivers.JointConvention (``published = sign * a`` for
+OpenHaptics' raw arm angles a (HD_CURRENT_JOINT_ANGLES, rad), the elbow ``relative`` (sign3 *
+(a3 - a2)) or ``absolute`` (sign3 * a3); the gimbal ``published = sign * g + offset``
+(HD_CURRENT_GIMBAL_ANGLES, rad)), the one reader that the ``ros2`` node without a driver and
+urdf/phantom_touch_driver.urdf use too (drivers.FIXED_CONVENTION). The report's theta is (-a1,
+a2, a3) (phantom_pin.drivers).
 """
 
 from __future__ import annotations
@@ -30,14 +32,13 @@ import numpy as np
 
 from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config.files import read_yaml
+from phantom_pin.drivers import JointConvention
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 
 __all__ = ["Profile", "JointStates", "ForceCommand", "StateTopic", "Qos", "load", "names", "relayed"]
 
 #: Where the profiles live: one YAML file per driver, named after its repository.
 PROFILES_DIR = DESCRIPTION_DIR / "config" / "drivers"
-#: OpenHaptics' angle i = _SIGN[i] * theta_i (phantom_pin.drivers).
-_SIGN = (-1.0, 1.0, 1.0)
 #: The force message types a driver takes (the fields read; omni_msgs is built in a ROS workspace).
 FORCE_TYPES = ("geometry_msgs/msg/Vector3", "geometry_msgs/msg/Wrench", "geometry_msgs/msg/WrenchStamped",
                "omni_msgs/msg/OmniFeedback")
@@ -54,16 +55,13 @@ class Qos:
 @dataclasses.dataclass(frozen=True)
 class JointStates:
     """What a driver publishes as sensor_msgs/JointState: ``topic``, ``names`` (the six, in
-    order: three of the arm, three of the gimbal), ``arm_signs`` and ``elbow`` ("relative" or
-    "absolute") of the arm's angles, ``gimbal_signs`` and ``gimbal_offsets`` (rad), ``effort_unit``
-    ("mN m" where it publishes OpenHaptics' joint torques, else None), ``qos``, ``rate`` (Hz)."""
+    order: three of the arm, three of the gimbal), ``convention`` (drivers.JointConvention: the
+    arm's signs and elbow, the gimbal's signs and offsets), ``effort_unit`` ("mN m" where it
+    publishes OpenHaptics' joint torques, else None), ``qos``, ``rate`` (Hz)."""
 
     topic: str
     names: tuple[str, ...]
-    arm_signs: tuple[float, float, float]
-    elbow: str
-    gimbal_signs: tuple[float, float, float]
-    gimbal_offsets: tuple[float, float, float]
+    convention: JointConvention
     effort_unit: str | None
     qos: Qos
     rate: float
@@ -123,26 +121,19 @@ class Profile:
     # -- joint states ------------------------------------------------------------------
     def arm_from_state(self, published: Sequence[float]) -> np.ndarray:
         """The report's theta (rad) of the driver's three published arm angles (rad)."""
-        s = self.joint_states.arm_signs
-        a1, a2, a3 = (p / si for p, si in zip(published, s))
-        if self.joint_states.elbow == "relative":
-            a3 += a2
-        return np.array([_SIGN[0] * a1, a2, a3])
+        return self.joint_states.convention.theta(published)
 
     def state_from_arm(self, theta: Sequence[float]) -> np.ndarray:
         """The driver's three published arm angles (rad) of the report's theta (rad)."""
-        a1, a2, a3 = _SIGN[0] * theta[0], theta[1], theta[2]
-        if self.joint_states.elbow == "relative":
-            a3 -= a2
-        return np.array([a1, a2, a3]) * np.array(self.joint_states.arm_signs)
+        return self.joint_states.convention.published(theta)
 
     def gimbal_from_state(self, published: Sequence[float]) -> np.ndarray:
         """OpenHaptics' raw gimbal angles (rad) of the driver's three published ones (rad)."""
-        return (np.asarray(published, dtype=float) - self.joint_states.gimbal_offsets) / self.joint_states.gimbal_signs
+        return self.joint_states.convention.gimbal(published)
 
     def state_from_gimbal(self, gimbal: Sequence[float]) -> np.ndarray:
         """The driver's three published gimbal angles (rad) of OpenHaptics' raw ones (rad)."""
-        return np.asarray(gimbal, dtype=float) * self.joint_states.gimbal_signs + self.joint_states.gimbal_offsets
+        return self.joint_states.convention.published_gimbal(gimbal)
 
     # -- forces ------------------------------------------------------------------------
     def message_from_openhaptics(self, force: np.ndarray) -> np.ndarray:
@@ -207,8 +198,9 @@ def _joint_states(node: dict, where: str) -> JointStates:
     rate = node["rate"]
     if not isinstance(rate, (int, float)) or not rate > 0:
         raise ParameterFileError(f"{where}.rate: expected a rate in Hz, got {rate!r}")
-    return JointStates(str(node["topic"]), tuple(map(str, names_)), signs[:3], arm["elbow"], signs[3:],
-                       _three(gimbal["offsets"], f"{where}.gimbal.offsets"), unit,
+    offsets = _three(gimbal["offsets"], f"{where}.gimbal.offsets")
+    convention = JointConvention(signs[:3], arm["elbow"], signs[3:], offsets)
+    return JointStates(str(node["topic"]), tuple(map(str, names_)), convention, unit,
                        _qos(node["qos"], f"{where}.qos"), float(rate))
 
 

@@ -12,9 +12,10 @@ scene: floor, light, table), XACRO_PATH (the top-level xacro, one for every mode
 XACRO_ARGS (the xacro arguments that select the model: ``xacro XACRO_PATH *XACRO_ARGS``) and
 CONFIG_PATH (its YAML). The
 Touch, whose ROS drivers publish joint_states in their own convention, also has
-DRIVER_URDF_PATH (urdf/phantom_touch_driver.urdf: the same arm jointed as the drivers' waist,
-shoulder, elbow, yaw, pitch, roll, for robot_state_publisher; phantom-pin urdf --convention
-driver).
+DRIVER_URDF_PATH (urdf/phantom_touch_driver.urdf: the same arm jointed as the older drivers' waist,
+shoulder, elbow, yaw, pitch, roll, phantom_pin.drivers.FIXED_CONVENTION, for
+robot_state_publisher; phantom-pin urdf --convention driver; kinisi's and CalaW's drivers publish
+the waist with the other sign: docs/ros2.md).
 
 Build a Pinocchio model from URDF_PATH with ``mimic=True`` (or use phantom_pin.load): without
 it, as robot_descriptions' and example-robot-data's Pinocchio loaders build, the four passive

@@ -2,9 +2,11 @@
 poses out, per message, with the message's stamp (the ``ros2`` extra: rclpy and the message
 packages from PyPI).
 
-Input, ``joint_states`` (sensor_msgs/JointState): the Touch-era drivers' names (``waist,
-shoulder, elbow`` with the elbow relative to the shoulder, and, for a model with a stylus
-gimbal, ``yaw, pitch, roll``, OpenHaptics' raw gimbal angles; phantom_pin.drivers), or the
+Input, ``joint_states`` (sensor_msgs/JointState): the older drivers' names and fixed convention
+(drivers.FIXED_CONVENTION, the one urdf/phantom_touch_driver.urdf is jointed in: ``waist,
+shoulder, elbow`` = theta1, theta2, theta3 - theta2, and, for a model with a stylus gimbal,
+``yaw, pitch, roll``, OpenHaptics' raw gimbal angles; sawSensablePhantom publishes it; kinisi's,
+CalaW's and RViMLab's drivers do not: read them with ``--driver``, DriverBridge), or the
 model's own (``joint1..joint3``, ``joint4..joint6``), each with the node's prefix; the gimbal's
 under either set of names, whichever names the arm. Other names are ignored; without the
 gimbal's names the gimbal is taken at its ``locked_at``.
@@ -13,7 +15,7 @@ Output, every message carrying the input's header stamp:
 
 - ``gravity_torque`` (sensor_msgs/JointState): the joint torques that hold the arm (N m), as
   effort on the input's own joint names: for the drivers' names the torques conjugate to
-  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3) (drivers.effort_from_tau), tau the report's
+  their coordinates (waist, shoulder, elbow): (tau1, tau2 + tau3, tau3) (FIXED_CONVENTION.effort), tau the report's
   (Phantom.gravity); for the model's names tau itself. Position and velocity are empty.
 - ``gravity_torque_openhaptics`` (sensor_msgs/JointState): the same torques as
   HD_CURRENT_JOINT_TORQUE takes them (mN m, on OpenHaptics' angles and signs:
@@ -63,6 +65,8 @@ __all__ = ["Bridge", "DriverBridge", "Output", "make_node", "spin", "run", "mess
 TOPICS = {"joint_states": "joint_states", "wrench": "wrench", "gravity_torque": "gravity_torque",
           "gravity_torque_openhaptics": "gravity_torque_openhaptics", "tip_pose": "tip_pose",
           "stylus_pose": "stylus_pose", "model_joint_states": "model_joint_states"}
+#: The joint_states convention read without a driver (the older drivers'; drivers' module doc).
+FIXED = drivers.FIXED_CONVENTION
 #: OpenHaptics' names of its three joints (its reference guide: "Turet Left +, Thigh Up +, Shin Up +").
 OPENHAPTICS_NAMES = ("turret", "thigh", "shin")
 #: A message is dropped when an angle lies more than this beyond its stop (rad): a turn.
@@ -219,14 +223,14 @@ class Bridge:
         if missing:
             raise InvalidInputError(f"missing {', '.join(missing)}: give the gimbal's three angles or none "
                                     f"(none: its locked_at), in {list(values)}", argument="name")
-        return np.array([values[n] for n in named[0]])  # raw angles (the Touch-era drivers')
+        return FIXED.gimbal([values[n] for n in named[0]])  # raw angles (the older drivers' and the model's)
 
     def __call__(self, names: Sequence[str], positions: Sequence[float], velocity: Sequence[float] = ()) -> Output:
         """Output of one joint_states message; ``velocity`` (its velocity field) is checked only:
         empty or one value per name."""
         values, driver = self._values(names, positions, velocity)
         arm = [values[n] for n in (self.driver_names if driver else self.model_arm)]
-        theta = drivers.theta_from_driver(*arm) if driver else np.array(arm)
+        theta = FIXED.theta(arm) if driver else np.array(arm)
         gimbal = self._gimbal(values)
         state = np.concatenate([theta, gimbal if gimbal is not None else
                                 (self.gimbal.locked_at if self.gimbal else [])])
@@ -239,7 +243,7 @@ class Bridge:
                                     argument="position")
         phantom = self.phantom
         tau = phantom.gravity(theta) if gimbal is None else phantom.gravity(theta, gimbal)
-        effort = drivers.effort_from_tau(tau) if driver else tau
+        effort = FIXED.effort(tau) if driver else tau
         tip = self.base_from_s @ phantom.forward_kinematics(theta)
         stylus = None if gimbal is None else self.base_from_s @ phantom.stylus_tip_pose(theta, gimbal)
         return Output(tuple(self.driver_names if driver else self.model_arm), effort,
@@ -476,6 +480,8 @@ def run(make: Callable[[], Any], ready: str, loop: Callable[[Any, threading.Even
                 pass
         finally:
             stop.set()
+            if loop is not None:   # it returns once stop is set: let it finish before the executor goes (a
+                worker.join(timeout=5.0)   # shutdown inside its spin_once raised InvalidHandle there, under load)
             executor.shutdown(timeout_sec=5.0)
             worker.join(timeout=5.0)
             node.destroy_node()

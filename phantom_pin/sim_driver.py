@@ -41,6 +41,8 @@ __all__ = ["DriverSimulation", "make_node", "loop", "spin"]
 
 #: The servo loop's period (s): OpenHaptics' 1 kHz.
 PERIOD = 1e-3
+#: What the node logs when the first force command reaches it (the loopback tests wait for it).
+FIRST_COMMAND = "first force command received"
 #: The most servo ticks one pass of the real-time loop catches up (a machine too busy to keep
 #: up drops the rest: the simulated time then lags the clock, said once in the log).
 CATCH_UP = 20
@@ -191,6 +193,8 @@ def make_node(simulation: DriverSimulation, gimbal: Sequence[float], prefix: str
             # when it arrived (the middleware's time, on the system clock), not when this callback ran: the
             # driver's ROS thread takes each message then, whatever the servo loop here is doing
             simulation.command((vector.x, vector.y, vector.z), at=info["received_timestamp"] * 1e-9 - self.offset)
+            if not self.received:   # a test lets the stylus go only once the driver has a command
+                self.get_logger().info(FIRST_COMMAND)
             self.received += 1
 
         def publish_state(self) -> None:

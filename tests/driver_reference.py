@@ -64,18 +64,36 @@ FORCE = {"geomagic_touch_ros2": geomagic_touch_ros2, "sawsensablephantom": sawse
 
 
 # -- each driver's joint_states of OpenHaptics' raw angles a (arm) and g (gimbal), rad ------------
+# The waist's sign, read at each driver's source (the commit each profile cites is its default
+# branch's newest, checked 2026-12-03): -a1 in the fsuarez6 lineage and sawSensablePhantom, +a1
+# in kinisi's, CalaW's and RViMLab's drivers.
 def published(profile: str, a: np.ndarray, g: np.ndarray) -> tuple[list[str], list[float]]:
     """(names, positions) as each driver publishes them (sources in the comments)."""
     six = ["waist", "shoulder", "elbow", "yaw", "pitch", "roll"]
-    if profile == "geomagic_touch_ros2":   # omni_state.cpp 222-239, 286-288, 343-347
+    if profile == "geomagic_touch_ros2":
+        # IvoD1998/Geomagic_Touch_ROS2@cd0cdba (stevens-armlab@2e4b1f5 the same lines) omni_state.cpp:
+        # 286 and 288 read HD_CURRENT_JOINT_ANGLES and HD_CURRENT_GIMBAL_ANGLES, 343-347 store
+        # thetas = (0, a1, a2, a3 - a2, g1, g2, g3), 228-238 publish -thetas[1], thetas[2],
+        # thetas[3], -thetas[4] + pi, -thetas[5] - 3 pi / 4, -thetas[6] - pi (bharatm11@34e9fac: 236,
+        # 296-300, 183-193)
         return six, [-a[0], a[1], a[2] - a[1], -g[0] + PI, -g[1] - 3 * PI / 4, -g[2] - PI]
-    if profile == "sawsensablephantom":    # mtsSensableHD.cpp 417-423 (q[0] = -q[0]; q[2] -= q[1]); gimbal raw
+    if profile == "sawsensablephantom":
+        # jhu-saw/sawSensablePhantom@7ddd575 core/components/code/mtsSensableHD.cpp 312-315 read the
+        # angles, 418-419 q[0] = -q[0]; q[2] -= q[1]; 421-423 the gimbal as read
         return six, [-a[0], a[1], a[2] - a[1], *g]
-    if profile in ("phantom_touch_ros2", "touch_ros2_control"):   # hd++.cpp 257-268; device_transforms.hpp 77-87
+    if profile in ("phantom_touch_ros2", "touch_ros2_control"):
+        # kinisi-robotics/phantom_touch_ros2@2bf5b20 phantom_touch_control/src/hd++.cpp 257-268 (the
+        # angles as read, angles[2] -= angles[1]), published as they are by
+        # phantom_touch_control_node.cpp 215 and 314; CalaW/touch_ros2_control@e1e181e
+        # touch_hardware/src/touch_driver_node.cpp 169 reads them, device_transforms.hpp 77-87
+        # (a1, a2, a3 - a2, g1, g2, g3), touch_driver_node.cpp 377-378 publish them
         return six, [a[0], a[1], a[2] - a[1], *g]
-    if profile == "geomagic_touch_x_ros2":  # geomagic_touch_x_component.cpp 98-105, 157-165: raw, absolute
+    if profile == "geomagic_touch_x_ros2":
+        # RViMLab/geomagic_touch_x_ros2@57da5c9 src/device.cpp 54-55 read, geomagic_touch_x_component.cpp
+        # 103 names, 161-162 and 177 publish the angles as read: raw, elbow absolute
         return [f"joint_angle_{k}" for k in (1, 2, 3)] + [f"gimbal_angle_{k}" for k in (1, 2, 3)], [*a, *g]
     raise KeyError(profile)
+
 
 
 # -- the Touch: the tip's position Jacobian in frame s and the gravity torques ------------------------

@@ -16,7 +16,8 @@ import math
 import numpy as np
 import pytest
 
-from phantom_pin import Phantom, closed_form, drivers
+import driver_reference
+from phantom_pin import Phantom, closed_form, drivers, profiles
 from phantom_pin.config import read
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.exceptions import InvalidInputError
@@ -334,3 +335,106 @@ def test_the_origin_is_gimbal_yamls_shoulder_less_the_shoulder_in_frame_s():
     with pytest.raises(InvalidInputError) as error:
         drivers.pose_from_openhaptics_transform(np.eye(4).ravel(), origin=[[0, 0, 0]])
     assert error.value.argument == "origin"
+
+
+# -- one reader of joint_states per driver (drivers.JointConvention) ---------------------------------
+WAIST_NAMED = ("geomagic_touch_ros2", "sawsensablephantom", "phantom_touch_ros2", "touch_ros2_control")
+
+
+def _waist_sign(name: str) -> float:
+    """a1's coefficient in the waist each driver publishes (driver_reference.published, its source lines)."""
+    return driver_reference.published(name, np.array([1.0, 0.0, 0.0]), np.zeros(3))[1][0]
+
+
+@pytest.mark.parametrize("name", profiles.names())
+def test_each_profiles_convention_reads_its_drivers_published_angles_back(name):
+    """The profile's JointConvention, batched, on the driver's own formulas of 200 seeded
+    OpenHaptics angles inside the stops: theta = (-a1, a2, a3) and g raw, 1e-15 rad (one sum
+    a3 - a2 + a2 rounds); the inverse gives the driver's numbers back, 1e-15 rad."""
+    convention = profiles.load(name).joint_states.convention
+    theta, g = driver_reference.states(200, seed=21)
+    a = theta * [-1.0, 1.0, 1.0]
+    published = np.array([driver_reference.published(name, x, y)[1] for x, y in zip(a, g)])
+    np.testing.assert_allclose(convention.theta(published[:, :3]), theta, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(convention.gimbal(published[:, 3:]), g, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(convention.published(theta), published[:, :3], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(convention.published_gimbal(g), published[:, 3:], rtol=0, atol=1e-15)
+
+
+def test_the_waist_signs_found_at_the_drivers_sources():
+    """-a1 (= theta1) in the fsuarez6 lineage and sawSensablePhantom, +a1 (= -theta1) in kinisi's,
+    CalaW's and RViMLab's drivers (driver_reference.published's source lines); the fixed
+    convention, the plain node's and the driver URDF's, is the older drivers': sawSensablePhantom's
+    profile exactly."""
+    assert {name: _waist_sign(name) for name in profiles.names()} == {
+        "geomagic_touch_ros2": -1.0, "sawsensablephantom": -1.0, "phantom_touch_ros2": 1.0,
+        "touch_ros2_control": 1.0, "geomagic_touch_x_ros2": 1.0}
+    assert profiles.load("sawsensablephantom").joint_states.convention == drivers.FIXED_CONVENTION
+    assert drivers.FIXED_CONVENTION.arm_signs[0] == _waist_sign("sawsensablephantom")
+
+
+@pytest.mark.parametrize("name", WAIST_NAMED)
+def test_the_plain_node_puts_the_tip_where_ubitrack_does_for_the_older_drivers_and_mirrored_for_the_others(name):
+    """ros2.Bridge (no --driver) on each driver's own joint_states, arm names only: its tip in
+    base_link (REP-103 axes, origin at the shoulder) is Ubitrack's position of the OpenHaptics
+    angles, 1e-12 m,
+    for the drivers whose waist is -a1; for kinisi's and CalaW's (+a1) it is that position
+    mirrored about joint 1's plane (x of frame s negated), the mirror the docs warn of, while
+    their profiles (DriverBridge, theta_from_joint_state with the profile's convention) read
+    theta right."""
+    from phantom_pin.ros2 import Bridge, DriverBridge
+
+    touch = Phantom.from_model("touch")
+    plain, profile = Bridge(touch), profiles.load(name)
+    mirror = np.diag([_waist_sign(name) * -1.0, 1.0, 1.0])   # identity where the waist is -a1
+    theta, g = driver_reference.states(20, seed=22)
+    for t, gg in zip(theta, g):
+        a = t * [-1.0, 1.0, 1.0]
+        names, positions = driver_reference.published(name, a, gg)
+        tip = plain(names[:3], positions[:3]).tip[:3, 3]
+        position = ubitrack(np.array([a]))[0]   # frame s, whose origin is (0, l2, -l1) from the shoulder's
+        expected = driver_reference.BASE_FROM_S @ (mirror @ position - [0.0, driver_reference.L2, -driver_reference.L1])
+        np.testing.assert_allclose(tip, expected, rtol=0, atol=1e-12)
+        theta_read = drivers.theta_from_joint_state(names, positions, convention=profile.joint_states.convention)
+        np.testing.assert_allclose(theta_read, t, rtol=0, atol=1e-15)
+        np.testing.assert_allclose(DriverBridge(touch, profile).state(names, positions)[0], t, rtol=0, atol=1e-15)
+    assert np.abs(position[0]) > 1e-3   # x matters: the mirror is seen
+
+
+@pytest.mark.parametrize("arguments, argument", [
+    (((-1.0, 2.0, 1.0), "relative"), "arm_signs"),
+    (((-1.0, 1.0, 1.0), "relativ"), "elbow"),
+    (((-1.0, 1.0, 1.0), "relative", (1.0, 1.0, 0.0)), "gimbal_signs"),
+    (((-1.0, 1.0, 1.0), "relative", (1.0, 1.0, 1.0), (0.0, float("nan"), 0.0)), "gimbal_offsets"),
+    (((True, 1.0, 1.0), "relative"), "arm_signs"),
+])
+def test_a_bad_joint_convention_is_refused_naming_its_field(arguments, argument):
+    with pytest.raises(InvalidInputError) as error:
+        drivers.JointConvention(*arguments)
+    assert isinstance(error.value, ValueError) and error.value.argument == argument
+    with pytest.raises(InvalidInputError) as error:
+        drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], convention="kinisi")
+    assert error.value.argument == "convention"
+
+
+def test_the_origin_puts_the_shoulder_where_the_arm_turns_about_it_with_unequal_links():
+    """Mutant 31. A Touch whose links differ (l1 = 0.20 m, l2 = 0.11 m; the Touch's equal links
+    hide a swap): frame s's origin in OpenHaptics' coordinates is openhaptics_shoulder less the
+    shoulder in frame s, and the shoulder is the point whose distance to the gimbal centre
+    depends on the elbow's angle alone, |p - S|^2 = l1^2 + l2^2 + 2 l1 l2 sin(theta3 - theta2)
+    (the law of cosines), p Ubitrack's position formula with those lengths (the gimbal centre in
+    frame s, PhantomForwardKinematics.h lines 101-103): 1e-12 m^2 over 50 seeded postures."""
+    import dataclasses
+
+    config = read("touch")
+    l1, l2 = 0.20, 0.11
+    config = dataclasses.replace(config, kinematics=dataclasses.replace(config.kinematics, l1=l1, l2=l2))
+    shoulder = np.array(config.gimbal.openhaptics_shoulder) - drivers.openhaptics_origin(config)   # frame s
+    theta = sample_postures(config.limits, 50, np.random.default_rng(23), draws=200)
+    a = theta * [-1.0, 1.0, 1.0]                        # OpenHaptics' angles (Ubitrack's)
+    s1, c1, s2, c2, s3, c3 = np.sin(a[:, 0]), np.cos(a[:, 0]), np.sin(a[:, 1]), np.cos(a[:, 1]), \
+        np.sin(a[:, 2]), np.cos(a[:, 2])
+    p = np.stack([-(l1 * c2 + l2 * s3) * s1, l1 * s2 - l2 * c3 + l2, -l1 + (l1 * c2 + l2 * s3) * c1], axis=-1)
+    distance = ((p - shoulder) ** 2).sum(axis=1)
+    np.testing.assert_allclose(distance, l1**2 + l2**2 + 2 * l1 * l2 * np.sin(theta[:, 2] - theta[:, 1]),
+                               rtol=0, atol=1e-12)

@@ -205,3 +205,92 @@ def test_every_profile_cites_its_sources_for_the_joint_states_and_the_force():
             sources = node[section]["sources"]
             cited = r"[\w.-]+/[\w.-]+@[0-9a-f]{7}\b.*(:\d| p\.\d)"
             assert sources and all(re.match(cited, s) for s in sources.values()), (name, section, sources)
+
+
+# -- what the mutation survivors of ../shared/data/mutants6.md got past (each against a reference) --
+def test_a_profile_whose_frame_map_mirrors_an_axis_is_refused(tmp_path, monkeypatch):
+    """Mutant 05. A frame change between right-handed frames is a rotation, det +1; a hand-written
+    map with one axis negated (det -1, numpy's determinant) renders every force mirrored: the
+    profile is refused with a ParameterFileError (a ValueError) naming to_openhaptics; the same
+    file with the driver's own map loads."""
+    import yaml
+
+    from phantom_pin.exceptions import ParameterFileError
+
+    node = yaml.safe_load((profiles.PROFILES_DIR / "phantom_touch_ros2.yaml").read_text())
+    mirrored = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]
+    assert round(np.linalg.det(np.array(mirrored, dtype=float))) == -1
+    monkeypatch.setattr(profiles, "PROFILES_DIR", tmp_path)
+    (tmp_path / "phantom_touch_ros2.yaml").write_text(yaml.safe_dump(node))
+    profiles.load.cache_clear()
+    try:
+        assert profiles.load("phantom_touch_ros2").force.to_openhaptics.tolist() == np.eye(3).tolist()
+        node["force"]["to_openhaptics"] = mirrored
+        (tmp_path / "phantom_touch_ros2.yaml").write_text(yaml.safe_dump(node))
+        profiles.load.cache_clear()
+        with pytest.raises(ParameterFileError) as error:
+            profiles.load("phantom_touch_ros2")
+        assert isinstance(error.value, ValueError) and "to_openhaptics" in str(error.value)
+    finally:
+        profiles.load.cache_clear()
+
+
+@pytest.mark.parametrize("name", PROFILES)
+def test_the_relay_of_every_driver_fills_a_bare_vector3_with_a_stamp_given(touch, name):
+    """Mutant 06. --relay sends geometry_msgs/Vector3, which has no header, whatever the driver's
+    own type: filled with the state's stamp given (as the node does), the bare Vector3 (x, y, z
+    only) takes the three numbers, and the driver's own formula of them (driver_reference.FORCE,
+    the relay copying them into its message) gives the direct path's HD_CURRENT_FORCE, exactly."""
+    profile = profiles.load(name)
+    relayed = profiles.relayed(profile)
+    theta, g = ref.states(3, seed=15)
+    for t, gg in zip(theta, g):
+        direct, relay = Renderer(touch, profile)(t, gg), Renderer(touch, relayed)(t, gg)
+        vector = SimpleNamespace(x=0.0, y=0.0, z=0.0)
+        fill_force(vector, relayed, relay.message, stamp=SimpleNamespace(sec=1, nanosec=2))
+        own = message(profile)
+        target = own if profile.force.field is None else own.force if profile.force.field == "force" \
+            else own.wrench.force
+        target.x, target.y, target.z = vector.x, vector.y, vector.z
+        assert set(vars(vector)) == {"x", "y", "z"}
+        assert np.array_equal(ref.FORCE[name](own), direct.openhaptics)
+
+
+def test_the_inverse_is_exact_wherever_the_jacobian_is_well_conditioned(touch):
+    """Mutant 07. Postures whose smallest singular value of the tip's Jacobian (complex steps of
+    Ubitrack's kinematics, numpy's SVD) lies between 3 and 15 mm/rad, above SINGULAR's 2 mm/rad
+    (a lever of 1.5 % of the arm: nothing is near singular there): J^T F equals the closed form's
+        gravity within 1e-9 N m, undamped. 10 seeded postures inside the stops with the tip 4-14 mm
+    from joint 1's axis (the arm folded up near joint 2's and the coupled stop: the Touch's only
+    postures that near it) whose singular value lies in that band."""
+    rng = np.random.default_rng(16)
+    _, g = ref.states(10, seed=16)
+    kept = []
+    while len(kept) < 10:    # the tip r from joint 1's axis: l1 cos(theta2) + l2 sin(theta3) = r
+        theta2, r = rng.uniform(1.74, 1.75), rng.uniform(0.004, 0.014)
+        theta3 = np.pi - np.arcsin((r - ref.L1 * np.cos(theta2)) / ref.L2)
+        t = np.array([rng.uniform(-0.9, 0.9), theta2, theta3])
+        inside = (t[2] <= ref.LIMITS["joint3"]["upper"] and t[1] <= ref.LIMITS["joint2"]["upper"]
+                  and t[2] - t[1] <= ref.LIMITS["theta3_minus_theta2_max"])
+        if inside and 0.003 < np.linalg.svd(ref.tip_jacobian(t), compute_uv=False)[-1] < 0.015:
+            kept.append((t, g[len(kept)]))
+    renderer = Renderer(touch, profiles.load("geomagic_touch_x_ros2"))
+    for t, gg in kept:
+        rendered = renderer(t, gg)
+        want = ref.gravity(t, gg, touch.config.report)
+        assert np.abs(ref.tip_jacobian(t).T @ rendered.openhaptics - want).max() < 1e-9
+
+
+def test_a_joint_resting_with_encoder_jitter_gets_no_coulomb_push(touch):
+    """Mutant 10. A resting arm whose angles jitter by +-1e-6 rad sample to sample (1 kHz: raw
+    rates of 2e-3 rad/s, below forces.REST) is at rest: pushing it with the Coulomb torque (0.01
+    N m, config/touch/actuation.yaml) would start it moving. J^T F is gravity (closed form) plus
+    the viscous term of the filtered rate only (5e-4 N m s/rad x at most 2e-3 rad/s = 1e-6 N m),
+    within 2e-6 N m, far below the 0.01 N m a Coulomb term adds."""
+    renderer = Renderer(touch, profiles.load("geomagic_touch_x_ros2"), compensate=("gravity", "friction"))
+    start = np.array([0.1, 0.4, 0.5])
+    for k in range(200):
+        t = start + (1e-6 if k % 2 else 0.0)
+        rendered = renderer(t, None, time=k * 1e-3)
+        want = ref.gravity(t, np.zeros(3), touch.config.report)
+        assert np.abs(ref.tip_jacobian(t).T @ rendered.openhaptics - want).max() < 2e-6

@@ -415,3 +415,118 @@ def test_the_openhaptics_topic_names_its_torques_turret_thigh_shin(touch):
     assert list(torques) == ["left_turret", "left_thigh", "left_shin"]
     assert [torques["left_turret"], torques["left_thigh"], torques["left_shin"]] == pytest.approx(
         reference, abs=1e-9)
+
+
+# -- the force path's message handling without a network (mutation survivors of mutants6.md) -------
+class _Node:
+    """What _on_wrench and _send_force use of the node: its user force, a force publisher that
+    keeps what it is given, a logger."""
+
+    def __init__(self) -> None:
+        import types
+
+        self.user = ("", (0.0, 0.0, 0.0))
+        self.sent: list = []
+        self.force = types.SimpleNamespace(publish=self.sent.append)
+        self.warned: set[str] = set()
+        logger = types.SimpleNamespace(warning=lambda *a, **k: None)
+        self.get_logger = lambda: logger
+
+
+def _stamp(seconds: float):
+    from builtin_interfaces.msg import Time
+
+    return Time(sec=int(seconds), nanosec=int(round((seconds - int(seconds)) * 1e9)))
+
+
+@pytest.mark.parametrize("name", ["sawsensablephantom", "touch_ros2_control", "phantom_touch_ros2"])
+def test_a_users_wrench_in_base_link_reaches_the_driver_as_the_same_force_and_the_command_its_stamp(touch, name):
+    """Mutants 24 and 26. A user's WrenchStamped (0.1, -0.2, 0.3) N in base_link through
+    ros2._on_wrench, then the force command of a state through ros2._send_force: the driver's own
+    formula of the message it gets (driver_reference.FORCE) gives J^T F = G + J^T (R F_user),
+    R base_link's axes in frame s (driver_reference.BASE_FROM_S, the macro's frame), J and G the
+    references' (1e-9 N m); a stamped type carries the state's stamp (a driver that checks
+    stamps needs it), exactly."""
+    from geometry_msgs.msg import WrenchStamped
+
+    import driver_reference as ref
+    from phantom_pin import profiles
+
+    profile = profiles.load(name)
+    driver = ros2.DriverBridge(touch, profile)
+    node, kind = _Node(), ros2.message_type(profile.force.type)
+    wrench = WrenchStamped()
+    wrench.header.frame_id = "base_link"
+    wrench.wrench.force.x, wrench.wrench.force.y, wrench.wrench.force.z = 0.1, -0.2, 0.3
+    ros2._on_wrench(node, driver, wrench)
+    theta, g = ref.states(5, seed=31)
+    for k, (t, gg) in enumerate(zip(theta, g)):
+        stamp = _stamp(1000.0 + 0.25 * k)
+        ros2._send_force(node, driver, kind, t, gg, stamp)
+        command = node.sent[-1]
+        got = ref.FORCE[name](command)
+        f_s = ref.BASE_FROM_S.T @ np.array([0.1, -0.2, 0.3])
+        want = ref.gravity(t, gg, touch.config.report) + ref.tip_jacobian(t).T @ f_s
+        assert np.abs(ref.tip_jacobian(t).T @ got - want).max() < 1e-9
+        if profile.force.header:
+            assert (command.header.stamp.sec, command.header.stamp.nanosec) == (stamp.sec, stamp.nanosec)
+
+
+def test_friction_compensation_runs_on_the_states_stamps_when_they_arrive_in_a_burst(touch):
+    """Mutant 21. 400 states of a joint path at a constant rate w (rad/s), stamped 1 ms apart but
+    handed to ros2._send_force at once (a burst, as a busy executor delivers them): the rate is
+    the stamps' (the wall clock's would be microseconds apart), so after them J^T F = G +
+    viscous w + Coulomb sign(w) (config/touch/actuation.yaml: 5e-4 N m s/rad, 0.01 N m; the
+    references' J and G), 1e-9 N m."""
+    import driver_reference as ref
+    from phantom_pin import profiles
+
+    profile = profiles.load("geomagic_touch_x_ros2")
+    driver = ros2.DriverBridge(touch, profile, compensate=("gravity", "friction"))
+    node, kind = _Node(), ros2.message_type(profile.force.type)
+    rate, start, gimbal = np.array([0.4, -0.3, 0.2]), np.array([0.0, 0.4, 0.5]), np.zeros(3)
+    for k in range(401):
+        t = start + rate * k * 1e-3
+        ros2._send_force(node, driver, kind, t, gimbal, _stamp(2000.0 + k * 1e-3))
+    got = ref.FORCE["geomagic_touch_x_ros2"](node.sent[-1])
+    want = ref.gravity(t, gimbal, touch.config.report) + 5e-4 * rate + 0.01 * np.sign(rate)
+    assert np.abs(ref.tip_jacobian(t).T @ got - want).max() < 1e-9
+
+
+def test_with_a_driver_the_outputs_follow_at_a_hundred_hertz(touch, monkeypatch):
+    """Mutant 25. A 1 kHz driver's states for 1 s of the node's monotonic clock (a fake clock, 1 ms a
+    state; no network: the node is built, not spun, and its outputs counted as listened to):
+    the gravity torques, poses and model joint states follow at most at 100 Hz (ros2.OUTPUTS_RATE,
+    docs/ros2.md) and no less than at 90 Hz: 10 or 11 ms apart (the next due time, 10 ms after the
+    last, falls between two states of the millisecond grid or on one, by the clock's rounding;
+    95 here), and every state gets its force."""
+    import types
+
+    import rclpy
+
+    from phantom_pin import profiles
+
+    in_process(_environment())
+    clock = types.SimpleNamespace(now=0.0)
+    monkeypatch.setattr(ros2, "time", types.SimpleNamespace(monotonic=lambda: clock.now, time=time.time))
+    context_was_up = rclpy.ok()
+    if not context_was_up:
+        rclpy.init()
+    try:
+        driver = ros2.DriverBridge(touch, profiles.load("geomagic_touch_x_ros2"))
+        node = ros2.make_node(touch, driver=driver)
+        sent: list = []
+        node.force = types.SimpleNamespace(publish=sent.append)
+        node.outputs = {role: types.SimpleNamespace(get_subscription_count=lambda: 1) for role in node.outputs}
+        theta, gimbal = np.array([0.1, 0.4, 0.5]), np.zeros(3)
+        answered = []
+        for k in range(1000):
+            clock.now = 100.0 + k * 1e-3
+            if node.serve((theta, gimbal), _stamp(5.0 + k * 1e-3)) is not None:
+                answered.append(k)
+        node.destroy_node()
+    finally:
+        if not context_was_up:
+            rclpy.shutdown()
+    assert len(sent) == 1000
+    assert 90 <= len(answered) <= 100 and set(np.diff(answered)) <= {10, 11}, answered[:5]

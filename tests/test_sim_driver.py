@@ -210,3 +210,25 @@ def test_the_state_topics_are_each_drivers_own_of_the_stylus_pose_and_velocity(d
                 seen.add(spec.topic)
     assert seen == set(ref.STATE)
     assert min(traces) <= 0 < max(traces), traces
+
+
+@pytest.mark.parametrize("name", [n for n in PROFILES if profiles.load(n).joint_states.effort_unit == "mN m"])
+def test_the_published_efforts_are_openhaptics_joint_torques_in_mN_m(device, name):
+    """Mutant 18. The drivers that publish HD_CURRENT_JOINT_TORQUE or HD_LAST_JOINT_TORQUE
+    (sawSensablePhantom, CalaW's, RViMLab's) publish OpenHaptics' unit, mN m, on its own angles
+    a = (-theta1, theta2, theta3): by the power, T . da = tau . dtheta, T = 1000 (-tau1, tau2,
+    tau3) for the joint torques tau = J^T F (N m) of the force the tick rendered (the driver's own
+    formula of the command, the reference's J by complex steps; at rest at its start-up posture:
+    no spring, no damping), the gimbal's 0; 1e-9 mN m."""
+    theta0 = np.array([0.1, 0.5, 0.6])
+    profile = profiles.load(name)
+    simulation = DriverSimulation(device, profile, theta0)
+    command = np.array([0.3, -0.2, 0.1])
+    sent = message(profile)
+    fill_force(sent, profile, command)
+    simulation.command(command)
+    simulation.tick()
+    tau = ref.tip_jacobian(theta0).T @ ref.FORCE[name](sent)
+    _, _, efforts = simulation.joint_state(np.zeros(3))
+    np.testing.assert_allclose(efforts, [*(1000.0 * np.array([-tau[0], tau[1], tau[2]])), 0, 0, 0], rtol=0, atol=1e-9)
+    assert np.abs(efforts[:3]).max() > 10.0   # tens of mN m: a unit off by 1000 cannot hide

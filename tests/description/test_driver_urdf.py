@@ -1,5 +1,5 @@
-"""The Touch's URDF in the ROS drivers' convention (urdf/phantom_touch_driver.urdf): the
-drivers' six joint_states drive it unchanged. Its link poses, in Pinocchio (mimic) and yourdfpy,
+"""The Touch's URDF in the older ROS drivers' fixed convention (urdf/phantom_touch_driver.urdf,
+drivers.FIXED_CONVENTION): their six joint_states drive it unchanged. Its link poses, in Pinocchio (mimic) and yourdfpy,
 from joint_states written by the drivers' published formulas (waist = -angle1, shoulder =
 angle2, elbow = angle3 - angle2, raw gimbal angles), equal ours in the report's convention
 from the OpenHaptics angles they came from."""
@@ -16,6 +16,7 @@ import pinocchio as pin
 import yaml
 import yourdfpy
 
+import driver_reference
 from phantom_pin.config import MODELS
 from phantom_pin.description.build import driver_urdf
 
@@ -40,9 +41,11 @@ def openhaptics_states(n: int, seed: int) -> np.ndarray:
 
 
 def driver_joint_states(o: np.ndarray) -> dict[str, float]:
-    """What the Touch-era drivers publish for OpenHaptics' angles ``o`` (omni_state.cpp line 183
-    and lines 296-298, mtsSensableHD.cpp lines 417-419; the gimbal raw)."""
-    return dict(zip(DRIVER_JOINTS, (-o[0], o[1], o[2] - o[1], o[3], o[4], o[5])))
+    """What the older drivers publish for OpenHaptics' angles ``o``: sawSensablePhantom's formula
+    (driver_reference.published, its source lines; the fsuarez6 lineage's arm is the same)."""
+    names, positions = driver_reference.published("sawsensablephantom", o[:3], o[3:])
+    assert names == list(DRIVER_JOINTS)
+    return dict(zip(names, positions))
 
 
 def report_state(o: np.ndarray) -> dict[str, float]:

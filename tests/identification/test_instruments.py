@@ -158,3 +158,15 @@ def test_identify_reference_on_the_command_line(tmp_path, capsys):
         err = capsys.readouterr().err
         assert code == 2 and err.count("\n") == 1 and "--reference" in err, err
         assert not (tmp_path / "no.yaml").exists()
+
+
+def test_with_the_reference_given_no_warning_asks_for_it(fits):
+    """Mutant 52. The lead warning tells the user to give --reference (instrumental variables);
+    with it given (the instrumented fit: its delay estimated on the instruments, which the loop's
+    noise does not drive), no delay it finds, even a 4 ms lead, prints that warning, nor any
+    warning naming --reference."""
+    _, iv = fits
+    assert iv.closed_loop and iv.delay_estimated
+    leading = dataclasses.replace(iv, delay=-4e-3)
+    assert result.lead_warning(leading) is None
+    assert not [w for w in result.fit_warnings(leading) if "--reference" in w]

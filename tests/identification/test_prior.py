@@ -314,3 +314,17 @@ def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_
                 f"phantom-pin: error: --prior-spread: {float(spread)!r} is beyond 1e+06, where the prior no "
                 "longer counts; give inf for no prior\n")
             assert not (tmp_path / "id.yaml").exists()
+
+
+def test_a_tight_wrong_prior_does_not_make_a_good_log_look_unrelated_to_its_motion(lab):
+    """Mutant 51. Whether the torques follow the motion is the log's: the narrow log's torques are
+    its simulated device's (the repo's plant, 1 % noise), so the log alone's fit leaves under 15 %
+    (checks.MAX_RESIDUAL_SHARE) of the torque RMS on every joint; a prior 10-30 % off the device
+    held tight (spread 1e-6) pulls the written fit to leave more than that, which says nothing of
+    the log. No "do not follow the motion" among the problems."""
+    from phantom_pin.identification import checks
+
+    fit = estimation.estimate(lab[3]["narrow"], PRIOR, prior_spread=1e-6)
+    assert (fit.log_rms / fit.torque_rms).max() < checks.MAX_RESIDUAL_SHARE
+    assert (fit.rms / fit.torque_rms).max() > checks.MAX_RESIDUAL_SHARE      # the case: the prior pulls it off
+    assert not [p for p in fit.problems if "do not follow the motion" in p], fit.problems

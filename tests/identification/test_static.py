@@ -125,3 +125,36 @@ def test_bad_rest_arguments_are_refused_naming_them():
     with pytest.raises(InvalidInputError) as error:
         static.estimate_gravity(static.Rest(theta, PRIOR.gravity(theta)), PRIOR, prior_spread=float("inf"))
     assert error.value.argument == "prior_spread"
+
+
+def _held_log():
+    """6 s at 1 kHz of the report's arm (its gravity by the closed form, independent of the fit):
+    held still at A (0-1.5 s), moved to B (1.5-2 s, a cosine blend: at rest at both ends), held at B
+    with the servo's settling in the torque for the first 80 ms (a 50 Hz ringing of 0.05 N m,
+    dying linearly to exactly 0), creeping at 0.05 rad/s on joint 2 (3.5-4.5 s: a slow motion,
+    its torque 0.02 N m of sliding friction off gravity), held at C (4.5-6 s)."""
+    from phantom_pin import closed_form
+
+    report = PRIOR.config.report
+    t = np.arange(6001) / 1000.0
+    a, b = np.array([0.1, 0.5, 0.6]), np.array([-0.2, 0.7, 0.4])
+    blend = np.clip((t - 1.5) / 0.5, 0, 1)
+    theta = a + (b - a) * ((1 - np.cos(np.pi * blend)) / 2)[:, None]
+    theta[:, 1] += 0.05 * np.clip(t - 3.5, 0, 1.0)
+    tau = closed_form.gravity(theta, report)
+    settling = (t >= 2.0) & (t < 2.08)
+    tau[settling] += (0.05 * np.cos(2 * np.pi * 50 * (t[settling] - 2.0)) * (1 - (t[settling] - 2.0) / 0.08))[:, None]
+    tau[(t > 3.5) & (t < 4.5), 1] += 0.02
+    return io.Log(t, theta, tau), closed_form.gravity(np.array([a, b, theta[-1]]), report), np.array([a, b, theta[-1]])
+
+
+def test_rest_is_the_still_stretches_less_their_settling_and_never_a_slow_motion():
+    """Mutants 36 and 37. static.rest_of on _held_log: the three holds and nothing else (a 0.05 rad/s
+    creep is motion: its friction is no holding torque), each at its posture (1e-12 rad) with its
+    holding torque the closed form's gravity there (1e-12 N m): the settling's torques, where the
+    arm has just stopped, are left out."""
+    log, gravity, postures = _held_log()
+    rest = static.rest_of(log)
+    assert rest.theta.shape == (3, 3), rest.theta
+    np.testing.assert_allclose(rest.theta, postures, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(rest.tau, gravity, rtol=0, atol=1e-12)

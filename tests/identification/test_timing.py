@@ -18,7 +18,7 @@ from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import estimation, filtering, io, result, simulation
+from phantom_pin.identification import estimation, filtering, io, result, simulation, timing
 from test_end_to_end import COULOMB, VISCOUS, truth_overrides
 from test_prior import PRIOR, error, sum_of_sines, truth_log
 
@@ -268,3 +268,26 @@ def test_the_delay_line_says_where_the_angles_noise_stays_above_its_aim(estimate
     assert "-1.010 ms, has the torques logged before" in result.lead_warning(dataclasses.replace(fit, delay=-1.01e-3))
     assert result.lead_warning(dataclasses.replace(fit, delay=-4e-3, delay_estimated=False)) is None
 
+
+
+def test_the_delay_criterion_weighs_each_joint_by_its_mean_not_its_count():
+    """Mutant 45. timing.criterion is the sum over the joints of the residual's mean square over
+    each joint's own moving equations, as a share of its torque's mean square: a joint with ten
+    times the equations must not weigh ten times as much (else the delay is the busiest joint's).
+    A case whose answer is known: each joint's torques its own columns' (block-diagonal phi, 1000
+    samples; joints 1, 2, 3 moving in 1000, 100 and 400 of them) plus a residual e_j made
+    orthogonal to those columns over its moving samples (numpy's lstsq): the fit leaves e_j, so the
+    criterion is sum_j mean(e_j^2) / rms_j^2, 1e-12 relative."""
+    rng = np.random.default_rng(45)
+    n, counts, rms = 1000, (1000, 100, 400), np.array([1.0, 2.0, 0.5])
+    phi, y, moving, expected = np.zeros((n, 3, 6)), np.zeros((n, 3)), np.zeros((n, 3), dtype=bool), 0.0
+    for j, count in enumerate(counts):
+        moving[:count, j] = True
+        columns = rng.normal(size=(count, 2))
+        e = rng.normal(scale=0.1 * (j + 1), size=count)
+        e -= columns @ np.linalg.lstsq(columns, e, rcond=None)[0]
+        phi[:count, j, 2 * j:2 * j + 2] = columns
+        y[:count, j] = columns @ rng.normal(size=2) + e
+        expected += np.mean(e**2) / rms[j] ** 2
+    got = timing.criterion(phi, moving, rms)(y)
+    assert got == pytest.approx(expected, rel=1e-12)
