@@ -31,6 +31,8 @@ import pinocchio as pin
 
 from phantom_pin.config.types import Friction
 from phantom_pin.device.device import Device
+from phantom_pin.device.estimator import Estimator
+from phantom_pin.device.thermal import TorqueBudget
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.profiles import Profile
@@ -42,8 +44,8 @@ Vector = Sequence[float] | np.ndarray
 #: The smallest singular value of J_p (m/rad) below which the inverse is damped: 2 mm/rad, a
 #: lever 1.5 % of the Touch's arm (2000 seeded postures inside its stops reach 2.8 mm/rad, over joint 1).
 SINGULAR = 0.002
-#: What may be compensated (``compensate``).
-TERMS = ("gravity", "friction")
+#: What may be compensated (``compensate``): inertia is a share ``kappa`` of M ddtheta + C dtheta.
+TERMS = ("gravity", "friction", "inertia")
 #: The joint-rate filter's cut-off (Hz) for friction compensation: a first-order low-pass of
 #: the finite differences of the angles (at 1 kHz, 20 Hz passes a hand's motion).
 CUTOFF = 20.0
@@ -115,11 +117,16 @@ class Renderer:
     friction: the model's friction law, or ``friction`` given, e.g. an identified overlay's
     Phantom.config.actuation.friction); ``max_force`` (N, > 0). theta (rad, the report's) and g
     (rad, OpenHaptics' raw gimbal angles; None: locked_at) of one state; ``user`` (N, frame s);
-    ``time`` (s) of the state, needed with friction (the rate is filtered over successive calls).
+    ``time`` (s) of the state, needed with friction or inertia (the rate and the acceleration are
+    estimated over successive calls: device.estimator.Estimator at CUTOFF); with inertia,
+    ``kappa`` (0 < kappa < 1) of M(theta) ddtheta + C(theta, dtheta) dtheta, applied while some
+    joint moves faster than REST (as the pyOpenHaptics Compensator). The joint torques are bounded
+    by the motors' peak for short forces and their continuous rating on average
+    (device.thermal.TorqueBudget, its period the time between states; 1 ms without times).
     """
 
     def __init__(self, phantom: Phantom, profile: Profile, compensate: Sequence[str] = ("gravity",),
-                 max_force: float = math.inf, friction: Friction | None = None) -> None:
+                 max_force: float = math.inf, friction: Friction | None = None, kappa: float = 0.0) -> None:
         if not isinstance(phantom, Phantom):
             raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
         unknown = [term for term in compensate if term not in TERMS]
@@ -130,31 +137,38 @@ class Renderer:
             raise InvalidInputError(f"expected a force > 0 N (inf for none), got {max_force!r}", argument="max_force")
         self.phantom, self.profile = phantom, profile
         self.device = Device(phantom)
+        if isinstance(kappa, bool) or not isinstance(kappa, (int, float)) or not 0 <= kappa < 1 or \
+                ("inertia" in compensate) != (kappa > 0):
+            raise InvalidInputError(f"expected 0 < kappa < 1 with inertia compensated, 0 without, got {kappa!r}",
+                                    argument="kappa")
         self.gravity, self.friction = "gravity" in compensate, "friction" in compensate
+        self.kappa = float(kappa)
         self.law = friction if friction is not None else phantom.config.actuation.friction
         self.limit = min(float(max_force), profile.force.clamp)          # N, the norm
-        self.torque_limit = self.device.saturation_torque                # N m per joint
-        self._previous: tuple[float, np.ndarray] | None = None           # (time s, theta rad)
-        self.rate = np.zeros(3)                                           # the filtered rate, rad/s
+        self.estimator = Estimator(cutoff=CUTOFF)
+        self.budget = TorqueBudget(self.device)                          # the motors' limits in time
 
-    def _filtered_rate(self, theta: np.ndarray, time: float | None) -> np.ndarray:
-        if time is None or not math.isfinite(time):
-            raise InvalidInputError("friction compensation needs each state's time (s)", argument="time")
-        if self._previous is not None and time > self._previous[0]:
-            dt = time - self._previous[0]
-            alpha = 1.0 - math.exp(-2 * math.pi * CUTOFF * dt)
-            self.rate = self.rate + alpha * ((theta - self._previous[1]) / dt - self.rate)
-        self._previous = (time, theta)
-        return self.rate
+    @property
+    def rate(self) -> np.ndarray:
+        """The filtered joint rate (rad/s) of the last state."""
+        return self.estimator.rate
 
     def compensation_torque(self, theta: np.ndarray, gimbal: np.ndarray | None, time: float | None) -> np.ndarray:
-        """The joint torques (N m) F_comp must produce: gravity and friction, as asked."""
+        """The joint torques (N m) F_comp must produce: gravity, friction and inertia, as asked."""
         tau = np.zeros(3)
+        gravity = self.phantom.gravity(theta) if gimbal is None else self.phantom.gravity(theta, gimbal)
         if self.gravity:
-            tau += self.phantom.gravity(theta) if gimbal is None else self.phantom.gravity(theta, gimbal)
-        if self.friction:
-            rate = self._filtered_rate(theta, time)
-            tau += self.law.torque(np.where(np.abs(rate) > REST, rate, 0.0))
+            tau += gravity
+        if self.friction or self.kappa:
+            previous = self.estimator.time
+            rate, acceleration = self.estimator.update_at(theta, time)
+            if previous is not None and time is not None and time > previous:
+                self.budget.period = time - previous
+            moving = np.abs(rate) > REST
+            if self.friction:
+                tau += self.law.torque(np.where(moving, rate, 0.0))
+            if self.kappa and moving.any():
+                tau += self.kappa * (self.phantom.inverse_dynamics(theta, rate, acceleration, gimbal=gimbal) - gravity)
         return tau
 
     def __call__(self, theta: object, gimbal: object = None, user: object = (0.0, 0.0, 0.0),
@@ -175,10 +189,7 @@ class Renderer:
         norm = float(np.linalg.norm(total))
         if norm > self.limit:
             scale = self.limit / norm
-        joint = jacobian.T @ total
-        over = np.abs(joint) * scale > self.torque_limit
-        if over.any():
-            scale = float(min(scale, *(self.torque_limit[over] / np.abs(joint[over]))))
+        scale *= self.budget.scale(jacobian.T @ total * scale)
         force = total * scale
         if not np.isfinite(force).all():  # the inputs were finite: only an overflow gets here
             raise InvalidInputError(f"the force is not finite ({force})", argument="user")

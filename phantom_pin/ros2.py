@@ -114,9 +114,9 @@ class DriverBridge:
     InvalidInputError naming the field of a message that must be dropped."""
 
     def __init__(self, phantom: Phantom, profile: Profile, compensate: Sequence[str] = ("gravity",),
-                 max_force: float = math.inf, friction: Friction | None = None) -> None:
+                 max_force: float = math.inf, friction: Friction | None = None, kappa: float = 0.0) -> None:
         self.phantom, self.profile = phantom, profile
-        self.renderer = Renderer(phantom, profile, compensate, max_force, friction)
+        self.renderer = Renderer(phantom, profile, compensate, max_force, friction, kappa)
         self.frames = Frames(phantom)
         prefix = phantom.description.prefix
         self.names = tuple(prefix + n for n in profile.joint_states.names)

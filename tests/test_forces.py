@@ -150,7 +150,9 @@ def test_bad_states_are_refused_naming_the_argument(touch, call, argument):
 
 def test_bad_options_and_messages_are_refused_naming_them(touch):
     profile = profiles.load("sawsensablephantom")
-    for kwargs, argument in (({"compensate": ("inertia",)}, "compensate"), ({"compensate": "gravity"}, "compensate"),
+    for kwargs, argument in (({"compensate": ("wind",)}, "compensate"), ({"compensate": "gravity"}, "compensate"),
+                             ({"compensate": ("gravity", "inertia")}, "kappa"), ({"kappa": 0.5}, "kappa"),
+                             ({"compensate": ("inertia",), "kappa": 1.0}, "kappa"),
                              ({"max_force": 0.0}, "max_force"), ({"max_force": float("nan")}, "max_force")):
         with pytest.raises(InvalidInputError) as error:
             Renderer(touch, profile, **kwargs)
@@ -294,3 +296,23 @@ def test_a_joint_resting_with_encoder_jitter_gets_no_coulomb_push(touch):
         rendered = renderer(t, None, time=k * 1e-3)
         want = ref.gravity(t, np.zeros(3), touch.config.report)
         assert np.abs(ref.tip_jacobian(t).T @ rendered.openhaptics - want).max() < 2e-6
+
+
+def test_the_renderers_inertia_and_friction_are_the_servo_loops(touch):
+    """The ROS 2 renderer with gravity, friction and kappa = 0.4 of the inertia, fed a stamped
+    1 kHz motion of the Touch, puts on the joints (J^T F_comp) what the pyOpenHaptics Compensator
+    computes from the same angles, tick by tick (1e-9 N m): the two servo paths share one
+    estimator and one law, written twice as terms."""
+    from phantom_pin import Device
+    from phantom_pin.interfaces.openhaptics import Compensator
+    device = Device(touch)
+    renderer = Renderer(touch, profiles.load("sawsensablephantom"), ("gravity", "friction", "inertia"), kappa=0.4)
+    compensate = Compensator("touch", "joint_torque", ("gravity", "friction", "inertia"), kappa=0.4)
+    sign = np.array([-1.0, 1.0, 1.0])
+    for k in range(300):
+        t = k / 1000.0
+        theta = np.array([0.1, 0.4, 0.5]) + 0.15 * np.sin(2 * np.pi * np.array([1.0, 1.3, 0.7]) * t)
+        rendered = renderer(theta, time=t)
+        applied = device.tip_jacobian(theta).T @ rendered.compensation
+        expected = compensate.torque(sign * theta)
+        assert np.abs(applied - expected).max() <= 1e-9

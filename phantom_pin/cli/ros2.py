@@ -13,7 +13,10 @@ from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import MissingDataError, PhantomPinError
 
 #: --compensate's choices and the terms each compensates.
-COMPENSATE = {"gravity": ("gravity",), "gravity,friction": ("gravity", "friction"), "none": ()}
+COMPENSATE = {"gravity": ("gravity",), "gravity,friction": ("gravity", "friction"),
+              "gravity,friction,inertia": ("gravity", "friction", "inertia"), "none": ()}
+#: --kappa's default with inertia compensated: the share docs/feel.md measures (2.2 times less mass felt).
+KAPPA = 0.6
 
 
 def _topics(items: list[str]) -> dict[str, str]:
@@ -72,11 +75,15 @@ def ros2(args: argparse.Namespace) -> int:
             raise PhantomPinError(f"the drivers' profiles are the Touch's; {robot.config.name} has no stylus gimbal "
                                   "(use --model touch)", argument="--driver")
         node.message_type(profile.force.type)  # installed, else one line
-        driver = node.DriverBridge(robot, profile, COMPENSATE[args.compensate], args.max_force)
-    elif args.compensate != "gravity" or not math.isinf(args.max_force) or args.relay:
+        terms = COMPENSATE[args.compensate]
+        kappa = (KAPPA if args.kappa is None else args.kappa) if "inertia" in terms else 0.0
+        if args.kappa is not None and "inertia" not in terms:
+            raise PhantomPinError("goes with --compensate gravity,friction,inertia", argument="--kappa")
+        driver = node.DriverBridge(robot, profile, terms, args.max_force, kappa=kappa)
+    elif args.compensate != "gravity" or not math.isinf(args.max_force) or args.relay or args.kappa is not None:
         raise PhantomPinError("goes with --driver (the force command of a driver)",
                               argument="--relay" if args.relay else "--compensate" if args.compensate != "gravity"
-                              else "--max-force")
+                              else "--kappa" if args.kappa is not None else "--max-force")
     node.Bridge(robot)
     return node.spin(robot, topics, driver)
 
@@ -125,13 +132,16 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     command.add_argument("--compensate", choices=tuple(COMPENSATE), default="gravity",
                          help="what the force compensates (default gravity; friction: the model's law at a filtered "
                               "rate)")
+    command.add_argument("--kappa", type=float, metavar="K",
+                         help=f"with inertia compensated: the share of M ddtheta + C dtheta (0 < K < 1; {KAPPA})")
     command.add_argument("--max-force", type=_max_force, default=math.inf, metavar="N",
                          help="the largest force sent (N; also the driver's clamp and the motors' limits)")
     command.add_argument("--relay", action="store_true",
                          help="send the force as geometry_msgs/Vector3 on the driver's force topic + _relay, for the "
                               "one-file relay of docs/drivers.md (a driver whose message type is not on PyPI)")
     command.set_defaults(run=ros2, options={"prefix": "--prefix", "topics": "--topic", "driver": "--driver",
-                                            "compensate": "--compensate", "max_force": "--max-force"})
+                                            "compensate": "--compensate", "max_force": "--max-force",
+                                            "kappa": "--kappa"})
     simulated = sub.add_parser("sim-driver", help="a simulated driver: the device's plant under a driver's force "
                                                   "command, its joint states published in real time (ROS 2)")
     simulated.add_argument("--driver", required=True, choices=profiles.names(), metavar="PROFILE",

@@ -32,17 +32,34 @@ class Estimator:
                 raise InvalidInputError(f"expected a frequency > 0 Hz, got {value!r}", argument=name)
         if not cutoff < rate / 2:
             raise InvalidInputError(f"must be below half the rate ({rate / 2:g} Hz), got {cutoff!r}", argument="cutoff")
-        self.period = 1.0 / float(rate)
-        self.alpha = 1.0 - math.exp(-2.0 * math.pi * float(cutoff) * self.period)
+        self.period, self.cutoff = 1.0 / float(rate), float(cutoff)
+        self.alpha = 1.0 - math.exp(-2.0 * math.pi * self.cutoff * self.period)
         self.previous: np.ndarray | None = None
+        self.time: float | None = None
         self.rate = np.zeros(3)
         self.acceleration = np.zeros(3)
 
+    def _step(self, theta: np.ndarray, period: float, alpha: float) -> None:
+        rate = self.rate + alpha * ((theta - self.previous) / period - self.rate)
+        self.acceleration = self.acceleration + alpha * ((rate - self.rate) / period - self.acceleration)
+        self.rate = rate
+
     def update(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The estimates after the sample ``theta`` (rad)."""
+        """The estimates after the sample ``theta`` (rad), one period after the last."""
         if self.previous is not None:
-            rate = self.rate + self.alpha * ((theta - self.previous) / self.period - self.rate)
-            self.acceleration = self.acceleration + self.alpha * ((rate - self.rate) / self.period - self.acceleration)
-            self.rate = rate
+            self._step(theta, self.period, self.alpha)
         self.previous = np.array(theta, dtype=float)
+        return self.rate, self.acceleration
+
+    def update_at(self, theta: np.ndarray, time: float | None) -> tuple[np.ndarray, np.ndarray]:
+        """The estimates after the sample ``theta`` (rad) taken at ``time`` (s, a message's stamp):
+        the period is the time since the last sample, the gain 1 - exp(-2 pi cutoff period); a
+        sample at the same time or earlier (a burst with one stamp) replaces the last without a
+        step. InvalidInputError naming ``time`` for a time that is not finite."""
+        if time is None or not math.isfinite(time):
+            raise InvalidInputError("the estimates need each state's time (s)", argument="time")
+        if self.previous is not None and self.time is not None and time > self.time:
+            period = time - self.time
+            self._step(theta, period, 1.0 - math.exp(-2 * math.pi * self.cutoff * period))
+        self.time, self.previous = float(time), np.array(theta, dtype=float)
         return self.rate, self.acceleration

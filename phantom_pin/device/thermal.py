@@ -27,7 +27,8 @@ from phantom_pin.exceptions import InvalidInputError
 
 
 class TorqueBudget:
-    """``clip(tau)`` (N m, (3,)) once per servo period of ``period`` s: the torque the motors may
+    """``clip(tau)`` or ``scale(tau)`` (N m, (3,)) once per servo period of ``period`` s (an
+    attribute: a loop whose period varies sets it before the call): the torque the motors may
     give now (module doc), the winding's average updated with it. Starts cold (e = 0)."""
 
     def __init__(self, device: Device, period: float = 1e-3) -> None:
@@ -36,9 +37,14 @@ class TorqueBudget:
         actuation = device.config.actuation
         self.peak = np.array(actuation.limit("peak"))
         self.continuous = np.array(actuation.limit("continuous"))
-        motor = actuation.motor
-        self.alpha = 1.0 if motor is None else 1.0 - math.exp(-period / motor.thermal_time_constant)
+        self.time_constant = None if actuation.motor is None else actuation.motor.thermal_time_constant
+        self.period = float(period)
         self.mean_square = np.zeros(3)
+
+    @property
+    def alpha(self) -> float:
+        """The average's gain per period, 1 - exp(-period / T) (1 without motor data)."""
+        return 1.0 if self.time_constant is None else 1.0 - math.exp(-self.period / self.time_constant)
 
     def allowed(self) -> np.ndarray:
         """The largest |tau| (N m) per joint this period."""
