@@ -343,8 +343,15 @@ def openhaptics_transform_from_pose(pose: object, origin: object = None) -> np.n
         raise InvalidInputError(f"expected finite 4x4 poses, got shape {p.shape}", argument="pose")
     _rigid(p, "pose")
     with np.errstate(over="ignore", invalid="ignore"):  # reported by finite_result, naming pose
-        p[..., :3, 3] = (p[..., :3, 3] + offset) / METRE_PER_MM
-    return finite_result(np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,)), "pose")
+        return finite_result(transform_of_rigid(p, offset), "pose")
+
+
+def transform_of_rigid(pose: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """openhaptics_transform_from_pose's map without its checks, for a pose known to be a finite
+    rigid transform (a model's own, in a servo loop): (..., 16), a new array."""
+    p = np.array(pose, dtype=float)
+    p[..., :3, 3] = (p[..., :3, 3] + offset) / METRE_PER_MM
+    return np.swapaxes(p, -1, -2).reshape(p.shape[:-2] + (16,))
 
 
 def _reader(convention: object) -> JointConvention:

@@ -143,7 +143,7 @@ class Server:
 
     def state(self) -> list[float]:
         """STATE's numbers of the current (theta, dtheta)."""
-        from phantom_pin.drivers import openhaptics_from_theta, openhaptics_transform_from_pose
+        from phantom_pin.drivers import openhaptics_from_theta, transform_of_rigid
 
         theta, rates = np.array(self.q), np.array(self.v)
         if self.has_gimbal:
@@ -151,7 +151,7 @@ class Server:
         else:                            # no stylus gimbal: the transform's rotation is the identity
             pose = np.eye(4)
             pose[:3, 3] = self.phantom.forward_kinematics(theta)[:3, 3]
-        transform = openhaptics_transform_from_pose(pose, self.origin)
+        transform = transform_of_rigid(pose, self.origin)      # the model's own pose: rigid and finite
         velocity = self.device.tip_jacobian(theta) @ rates * 1000.0
         return [*openhaptics_from_theta(theta).tolist(), *self.gimbal, *transform[12:15].tolist(),
                 *velocity.tolist(), *transform.tolist(), 0.0]
