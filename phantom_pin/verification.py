@@ -15,6 +15,7 @@ from phantom_pin.dynamics._refusals import refusal
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.report import appendix, closed_form
+from phantom_pin.report.parameters import ReportParameters
 
 #: States evaluated at a time: memory stays bounded (tens of MB) whatever the count.
 CHUNK = 10_000
@@ -57,20 +58,9 @@ class Report:
                 "passed": self.passed}
 
 
-def check(phantom: Phantom, states: int = 1000, seed: int = 0,
-          progress: Callable[[float], None] | None = None) -> Report:
-    """Compare ``phantom`` with the report's closed form at ``states`` random states (seed
-    ``seed``) inside its joint limits, CHUNK at a time: the largest error of each method
-    relative to the closed form's largest value (tolerance TOLERANCE); and, where the
-    parameters are the report's, the closed form against the appendix's printed Tau1-Tau3
-    (error over the printed rounding, tolerance 1). ``progress(done)`` gets the states done.
-    A model with a stylus gimbal (the Touch) is checked without it (description.gimbal.arm_only):
-    the report has none; tests/description/test_gimbal.py checks the gimbal's load against its own laws.
-
-    Raises InvalidInputError naming ``states`` outside 1..MAX_STATES, and naming ``phantom``
-    for anything but a Phantom (a model name: check(Phantom.from_model(name))) or a model not
-    written in the report's terms (no closed form applies).
-    """
+def _checked(phantom: Phantom, states: int) -> tuple[Phantom, ReportParameters]:
+    """check's arguments checked (its doc): the Phantom to check (the arm alone of one with a
+    stylus gimbal) and its report parameters."""
     if not isinstance(phantom, Phantom):
         raise refusal("Phantom", "a phantom_pin.Phantom", phantom, "phantom")
     if isinstance(states, bool) or not isinstance(states, int | np.integer) or states < 1:
@@ -87,6 +77,24 @@ def check(phantom: Phantom, states: int = 1000, seed: int = 0,
                                 "full against an independent derivation)", argument="phantom")
     if phantom.config.gimbal is not None:  # the report's arm has no stylus: check the arm alone
         phantom = Phantom(arm_only(phantom.description))
+    return phantom, p
+
+
+def check(phantom: Phantom, states: int = 1000, seed: int = 0,
+          progress: Callable[[float], None] | None = None) -> Report:
+    """Compare ``phantom`` with the report's closed form at ``states`` random states (seed
+    ``seed``) inside its joint limits, CHUNK at a time: the largest error of each method
+    relative to the closed form's largest value (tolerance TOLERANCE); and, where the
+    parameters are the report's, the closed form against the appendix's printed Tau1-Tau3
+    (error over the printed rounding, tolerance 1). ``progress(done)`` gets the states done.
+    A model with a stylus gimbal (the Touch) is checked without it (description.gimbal.arm_only):
+    the report has none; tests/description/test_gimbal.py checks the gimbal's load against its own laws.
+
+    Raises InvalidInputError naming ``states`` outside 1..MAX_STATES, and naming ``phantom``
+    for anything but a Phantom (a model name: check(Phantom.from_model(name))) or a model not
+    written in the report's terms (no closed form applies).
+    """
+    phantom, p = _checked(phantom, states)
     worst = {name: [0.0, 0.0] for name in METHODS}  # max |ours - reference|, max |reference|
     applies = appendix.applies(p)
     as_appendix = dataclasses.replace(p, Iayy=appendix.APPENDIX_IAYY)

@@ -1,6 +1,6 @@
 """The package's shape: no import cycle between its modules, counting function-local imports
 (which would only hide one), every module imports in a fresh interpreter, leaves first, and
-every module and function stays a size a reader can follow.
+every module and function stays a size and a complexity a reader can follow.
 
 The graph is read from the source (ast), one edge per ``import phantom_pin.x`` or ``from
 phantom_pin.x import y`` (to phantom_pin.x.y where y is a module), wherever it stands in the
@@ -12,6 +12,8 @@ import subprocess
 import sys
 from graphlib import CycleError, TopologicalSorter
 from pathlib import Path
+
+from radon.complexity import cc_visit
 
 import phantom_pin
 
@@ -119,3 +121,27 @@ def test_every_module_and_function_stays_readable():
                       if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
                       and node.end_lineno - node.lineno + 1 > FUNCTION_LINES}
     assert not long_modules and not long_functions, (long_modules, long_functions)
+
+
+#: The cyclomatic complexity a reader can follow (issue 51, item 6): radon's, as ruff's mccabe
+#: caps it in pyproject.toml.
+COMPLEXITY = 15
+
+
+def _functions(blocks):
+    """radon's functions and methods among ``blocks``, nested ones included (a class's own
+    figure is its methods' average, no function's)."""
+    for block in blocks:
+        if hasattr(block, "methods"):
+            yield from _functions(block.methods + block.inner_classes)
+        else:
+            yield block
+            yield from _functions(block.closures)
+
+
+def test_no_function_is_above_the_complexity_cap():
+    """No function or method above COMPLEXITY by radon (radon.complexity.cc_visit over every module)."""
+    complex_functions = {f"{name}.{block.fullname}:{block.lineno}": block.complexity
+                         for name, path in MODULES.items() for block in _functions(cc_visit(path.read_text()))
+                         if block.complexity > COMPLEXITY}
+    assert not complex_functions, complex_functions

@@ -158,12 +158,24 @@ def simulate_command(args: argparse.Namespace) -> int:
     if args.trajectory is not None:
         check_record(args.trajectory, robot.config.name, args.convention or "report", "--trajectory")
     run = _tracking(args) if args.trajectory is not None else _free(args, robot)
+    result = _simulated(args, run, device)
+    _warn_run(args, run, result, device)
+    settings = _settings(args, run, result, device)
+    text = _json(result, settings) if form == "json" else _csv(result, robot.config.name)
+    page = None if plot is None else _plot(result, settings, device, robot.config.name)
+    _write(target, text, plot, page, len(result.t))
+    return 0
+
+
+def _simulated(args: argparse.Namespace, run: _Run, device: Device) -> SimulationResult:
+    """simulate() on ``run`` with the command's options, an error of what --trajectory sets
+    named as the file's."""
     bar = Progress("simulate", 1.0, enabled=False if args.quiet else None)
     try:
-        result = simulate(run.theta0, run.duration, run.controller, dtheta0=run.dtheta0, rate=run.rate,
-                          friction=not args.no_friction, hard_stops=not args.no_hard_stops,
-                          saturation=False if args.no_saturation else args.saturation or True,
-                          quantization=args.quantization, device=device, progress=bar.update, gimbal=args.gimbal)
+        return simulate(run.theta0, run.duration, run.controller, dtheta0=run.dtheta0, rate=run.rate,
+                        friction=not args.no_friction, hard_stops=not args.no_hard_stops,
+                        saturation=False if args.no_saturation else args.saturation or True,
+                        quantization=args.quantization, device=device, progress=bar.update, gimbal=args.gimbal)
     except PhantomPinError as error:  # what --trajectory sets is the file's, not an option's
         if args.trajectory is None or error.argument not in TRAJECTORY_SETS:
             raise
@@ -171,33 +183,43 @@ def simulate_command(args: argparse.Namespace) -> int:
                               argument="--trajectory") from None
     finally:
         bar.close()
+
+
+def _warn_run(args: argparse.Namespace, run: _Run, result: SimulationResult, device: Device) -> None:
+    """The run's warnings: torques clipped, the gimbal's angles, a start beyond the stops."""
     saturated = float(np.mean(np.any(result.tau != result.tau_commanded, axis=1)))
     if saturated > SATURATED_SHARE:
         hint = (" (is the file in OpenHaptics' mN m? --convention openhaptics)"
                 if args.trajectory is not None and args.convention is None else "")
         warn(f"{100 * saturated:.1f} % of the commanded torques exceeded the saturation and were clipped{hint}")
-    warn_gimbal(args.gimbal, robot)
+    warn_gimbal(args.gimbal, device.phantom)
     if not args.no_hard_stops and not device.within_limits(run.theta0):  # after the run: a refused one alone
         warn(f"--theta0 {run.theta0} rad starts beyond the stops, which push it back")
+
+
+def _settings(args: argparse.Namespace, run: _Run, result: SimulationResult, device: Device) -> dict:
+    """The run's settings as the JSON output and the plot's facts give them."""
     settings = dataclasses.asdict(run) | {key: getattr(args, key) for key in (
         "controller", "no_friction", "no_hard_stops", "no_saturation", "saturation", "quantization", "gimbal")}
     settings["controller"] = args.controller or "none"
     settings["saturation"] = False if args.no_saturation else args.saturation or device.config.actuation.saturation
     settings["substeps"] = result.substeps
     settings["trajectory"] = None if args.trajectory is None else str(args.trajectory)
-    settings["model"] = robot.config.name
-    text = _json(result, settings) if form == "json" else _csv(result, robot.config.name)
-    page = None if plot is None else _plot(result, settings, device, robot.config.name)
+    settings["model"] = device.phantom.config.name
+    return settings
+
+
+def _write(target: Path | None, text: str, plot: Path | None, page: str | None, samples: int) -> None:
+    """Every file or none: the output (else on stdout) and the plot, each reported."""
     staged = ([] if target is None else [(target, text, "--output")]) + (
         [] if plot is None or page is None else [(plot, page, "--plot")])
     write_texts(staged)                                   # every file or none
     if target is None:
         emit(text)
     else:
-        print(f"wrote {target} ({len(result.t)} samples)")
+        print(f"wrote {target} ({samples} samples)")
     if plot is not None and page is not None:
         print(f"wrote {plot}", file=sys.stderr if target is None else sys.stdout)
-    return 0
 
 
 def _plot(result: SimulationResult, settings: dict, device: Device, name: str) -> str:

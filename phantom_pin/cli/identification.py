@@ -29,7 +29,7 @@ from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import bags, excitation, io, prior, selection, static, timing
 from phantom_pin.identification import page as identification_page
 from phantom_pin.identification.overlays import identified_keys
-from phantom_pin.identification.result import RefusedError, identify, refusal, write_yaml
+from phantom_pin.identification.result import Identification, RefusedError, identify, refusal, write_yaml
 from phantom_pin.identification.structures import General
 
 #: The conventions of the CSV columns (phantom_pin.drivers).
@@ -217,27 +217,7 @@ def excite_command(args: argparse.Namespace) -> int:
     """phantom-pin excite, for the configuration of --model or --config (and the overrides)."""
     output(args)
     plot = plot_target(args)
-    for name in ("duration", "rate", "period"):
-        value = getattr(args, name)
-        if not (math.isfinite(value) and value > 0):
-            raise PhantomPinError(f"expected a finite positive number, got {value!r}", argument=f"--{name}")
-    for name, least in (("harmonics", 2), ("iterations", 1), ("restarts", 1), ("seed", 0)):
-        if getattr(args, name) < least:
-            raise PhantomPinError(f"expected an integer of at least {least}, got {getattr(args, name)}",
-                                  argument=f"--{name}")
-    if not PERIOD_RANGE[0] <= args.period <= PERIOD_RANGE[1]:
-        raise PhantomPinError(f"{args.period:g} s is outside {PERIOD_RANGE[0]:g}..{PERIOD_RANGE[1]:g} s "
-                              "(shorter periods ask more torque than the arm has; longer ones excite nothing)",
-                              argument="--period")
-    if args.rate < MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:
-        raise PhantomPinError(f"{args.rate:g} Hz samples the highest harmonic ({args.harmonics} / "
-                              f"{args.period:g} s) fewer than {MIN_SAMPLES_PER_HARMONIC} times per cycle; use at least "
-                              f"{MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:g} Hz", argument="--rate")
-    rows = args.rate * args.period * math.ceil(min(args.duration, MAX_ROWS * args.period) / args.period) + 1
-    if rows > MAX_ROWS:
-        raise PhantomPinError(f"--duration, --rate: {args.duration:g} s at {args.rate:g} Hz is more than "
-                              f"{MAX_ROWS} rows "
-                              f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
+    _check_excitation(args)
     periods = _periods(args.duration, args.period)
     rows = int(round(periods * args.period * args.rate)) + 1
     _suffix(args.output, (".csv",), "CSV")
@@ -281,6 +261,32 @@ def excite_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_excitation(args: argparse.Namespace) -> None:
+    """excite's numbers checked before any work: positive, enough samples per harmonic, the
+    period in PERIOD_RANGE, at most MAX_ROWS rows."""
+    for name in ("duration", "rate", "period"):
+        value = getattr(args, name)
+        if not (math.isfinite(value) and value > 0):
+            raise PhantomPinError(f"expected a finite positive number, got {value!r}", argument=f"--{name}")
+    for name, least in (("harmonics", 2), ("iterations", 1), ("restarts", 1), ("seed", 0)):
+        if getattr(args, name) < least:
+            raise PhantomPinError(f"expected an integer of at least {least}, got {getattr(args, name)}",
+                                  argument=f"--{name}")
+    if not PERIOD_RANGE[0] <= args.period <= PERIOD_RANGE[1]:
+        raise PhantomPinError(f"{args.period:g} s is outside {PERIOD_RANGE[0]:g}..{PERIOD_RANGE[1]:g} s "
+                              "(shorter periods ask more torque than the arm has; longer ones excite nothing)",
+                              argument="--period")
+    if args.rate < MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:
+        raise PhantomPinError(f"{args.rate:g} Hz samples the highest harmonic ({args.harmonics} / "
+                              f"{args.period:g} s) fewer than {MIN_SAMPLES_PER_HARMONIC} times per cycle; use at least "
+                              f"{MIN_SAMPLES_PER_HARMONIC * args.harmonics / args.period:g} Hz", argument="--rate")
+    rows = args.rate * args.period * math.ceil(min(args.duration, MAX_ROWS * args.period) / args.period) + 1
+    if rows > MAX_ROWS:
+        raise PhantomPinError(f"--duration, --rate: {args.duration:g} s at {args.rate:g} Hz is more than "
+                              f"{MAX_ROWS} rows "
+                              f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
+
+
 def _plot(args: argparse.Namespace, made: Description, result: excitation.Excitation,
           samples: tuple[np.ndarray, ...], effort: np.ndarray) -> str:
     """excite's --plot page: ``samples`` (t s, theta rad, dtheta rad/s, tau N m, in the report's
@@ -314,12 +320,7 @@ def identify_command(args: argparse.Namespace) -> int:
     phantom = Phantom(made)
     if args.static:
         return _static_command(args, phantom, recording, given)
-    if args.structure == "report" and phantom.config.report is None:
-        how = " with its --params/--set overrides" if given else ""
-        raise PhantomPinError(f"report needs a model in the report's form; {phantom.config.name}{how} "
-                              "gives its links in full (use --structure general)", argument="--structure")
-    if not (math.isfinite(args.cutoff) and args.cutoff > 0):
-        raise PhantomPinError(f"expected a finite positive frequency (Hz), got {args.cutoff!r}", argument="--cutoff")
+    _check_fit(args, phantom, given)
     delay = _delay(args.delay)
     if recording is None:
         check_record(args.log, phantom.config.name, args.convention, "LOG")
@@ -341,6 +342,22 @@ def identify_command(args: argparse.Namespace) -> int:
         print(line)
     for warning in result.warnings():
         warn(warning)              # on stderr, as every command's (and in the overlay's header)
+    _write_fit(args, result, phantom, report)
+    return 0
+
+
+def _check_fit(args: argparse.Namespace, phantom: Phantom, given: dict) -> None:
+    """identify's --structure and --cutoff checked against the model before any work."""
+    if args.structure == "report" and phantom.config.report is None:
+        how = " with its --params/--set overrides" if given else ""
+        raise PhantomPinError(f"report needs a model in the report's form; {phantom.config.name}{how} "
+                              "gives its links in full (use --structure general)", argument="--structure")
+    if not (math.isfinite(args.cutoff) and args.cutoff > 0):
+        raise PhantomPinError(f"expected a finite positive frequency (Hz), got {args.cutoff!r}", argument="--cutoff")
+
+
+def _write_fit(args: argparse.Namespace, result: Identification, phantom: Phantom, report: Path | None) -> None:
+    """identify's overlay and --report page (both written, or neither), each reported."""
     page = None if report is None else identification_page.report_page(result, phantom.config.name)
     # --output and --report checked above, before any work; both written, or neither
     write_texts([(args.output, result.text(), "--output")] + ([] if page is None or report is None else
@@ -350,4 +367,3 @@ def identify_command(args: argparse.Namespace) -> int:
     chosen = f"--config {args.config} " if args.config is not None else (
         "" if phantom.config.name == DEFAULT else f"--model {phantom.config.name} ")
     print(f"wrote {args.output} (phantom-pin {chosen}urdf --params {args.output} -o my_phantom.urdf)")
-    return 0

@@ -31,6 +31,7 @@ from phantom_pin.cli.common import (
     write_text,
     write_texts,
 )
+from phantom_pin.config.types import Gimbal
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
@@ -69,15 +70,8 @@ def info(args: argparse.Namespace) -> int:
     lines += ["", "rotor inertia: not public (no armature; the links carry the rotors)" if actuation.motor is None
               else f"rotor inertia {actuation.motor.rotor_inertia:.3e} kg m2 (each motor)"]
     if gimbal is not None:
-        data["gimbal"] = {"joints": list(robot.gimbal_joints), "lower": list(gimbal.lower),
-                          "upper": list(gimbal.upper), "tip_offset": gimbal.tip_offset,
-                          "locked_at": list(gimbal.locked_at)}
-        ranges = ", ".join(f"{j} {lo:.3f}..{hi:.3f}"
-                           for j, lo, hi in zip(robot.gimbal_joints, gimbal.lower, gimbal.upper))
-        lines += ["", f"stylus gimbal (passive; OpenHaptics' raw gimbal angles) [rad]: {ranges}; tip "
-                      f"{gimbal.tip_offset} m along the stylus's -z; the arm's dynamics hold it at "
-                      f"{list(gimbal.locked_at)} rad",
-                  f"  source: {robot.config.sources['gimbal']}"]
+        data["gimbal"], gimbal_lines = _gimbal_info(robot, gimbal)
+        lines += gimbal_lines
     count = len(given)
     data["overrides"] = count
     lines.insert(0, f"model {robot.config.name}" + (f", with {count} overridden number(s) (--params/--set)"
@@ -86,6 +80,18 @@ def info(args: argparse.Namespace) -> int:
     lines += ["", *device_lines]
     show(args, data, "\n".join(lines))
     return 0
+
+
+def _gimbal_info(robot: Phantom, gimbal: Gimbal) -> tuple[dict[str, Any], list[str]]:
+    """info's data and lines of the stylus gimbal ``gimbal`` of ``robot``."""
+    data = {"joints": list(robot.gimbal_joints), "lower": list(gimbal.lower), "upper": list(gimbal.upper),
+            "tip_offset": gimbal.tip_offset, "locked_at": list(gimbal.locked_at)}
+    ranges = ", ".join(f"{j} {lo:.3f}..{hi:.3f}" for j, lo, hi in zip(robot.gimbal_joints, gimbal.lower, gimbal.upper))
+    lines = ["", f"stylus gimbal (passive; OpenHaptics' raw gimbal angles) [rad]: {ranges}; tip "
+                 f"{gimbal.tip_offset} m along the stylus's -z; the arm's dynamics hold it at "
+                 f"{list(gimbal.locked_at)} rad",
+             f"  source: {robot.config.sources['gimbal']}"]
+    return data, lines
 
 
 

@@ -291,10 +291,7 @@ def _generate(description: Description, progress: Callable[[float], None]) -> di
     arm = model.armature
     gravity = _leaner(model.rnea(theta, zero, zero, True))
     progress(0.1)
-    columns = [model.rnea(theta, zero, [sp.Integer(int(i == j)) for i in range(3)], False) for j in range(3)]
-    upper = _leaner([columns[j][i] + (arm[i] if i == j else 0) for i in range(3) for j in range(i, 3)])
-    index = {(i, j): k for k, (i, j) in enumerate((i, j) for i in range(3) for j in range(i, 3))}
-    mass = [[upper[index[min(i, j), max(i, j)]] for j in range(3)] for i in range(3)]
+    mass = _mass(model, theta)
     progress(0.25)
     coriolis = _leaner(model.rnea(theta, dtheta, zero, False))
     progress(0.45)
@@ -321,6 +318,17 @@ def _generate(description: Description, progress: Callable[[float], None]) -> di
         bodies["stylus_pose"] = _stylus_body(description)
         bodies["gravity_stylus"] = _gravity_stylus_body(description)
     return bodies
+
+
+def _mass(model: _Model, theta: list) -> list[list[Any]]:
+    """M(theta) as 3 x 3 expressions, the armature on its diagonal: a column per unit
+    acceleration of Newton-Euler without gravity, its upper triangle made lean once."""
+    zero = [sp.Integer(0)] * 3
+    arm = model.armature
+    columns = [model.rnea(theta, zero, [sp.Integer(int(i == j)) for i in range(3)], False) for j in range(3)]
+    upper = _leaner([columns[j][i] + (arm[i] if i == j else 0) for i in range(3) for j in range(i, 3)])
+    index = {(i, j): k for k, (i, j) in enumerate((i, j) for i in range(3) for j in range(i, 3))}
+    return [[upper[index[min(i, j), max(i, j)]] for j in range(3)] for i in range(3)]
 
 
 def _gravity_stylus_body(description: Description) -> str:

@@ -96,26 +96,32 @@ def _actuation(r: Reader) -> Actuation:
 
 def _drive(r: Reader) -> Actuation:
     arg = "actuation_file"
-
-    def act(*keys: str, **kind: bool) -> float:
-        return r.number(arg, *keys, **kind)
-
     viscous, coulomb = (vector3(r.per_joint(arg, *keys, joints=JOINTS, non_negative=True)) for keys in PER_JOINT[arg])
     friction = Friction(viscous, coulomb)   # PER_JOINT's keys: friction.viscous, friction.coulomb
     saturation = r.text(arg, "saturation")
     if saturation not in SATURATIONS:
         raise r.error(arg, f"saturation must be {' or '.join(SATURATIONS)}, got {saturation!r}")
     public = [r.node(arg, section) is not None for section in DRIVE]
-    document = r.documents[arg]
     if public[0] != public[1]:
         raise r.error(arg, "transmission_ratio and motor are either both given or both null (not public)")
     if public[2] and not public[1]:
         raise r.error(arg, "encoder needs the transmission_ratio and the motor (it is read at the motor shaft)")
     if not public[1]:
-        effort = vector3(act("joint_torque_limit", j, positive=True) for j in JOINTS)
-        velocity = vector3(act("joint_velocity_limit", j, positive=True) for j in JOINTS)
+        effort = vector3(r.number(arg, "joint_torque_limit", j, positive=True) for j in JOINTS)
+        velocity = vector3(r.number(arg, "joint_velocity_limit", j, positive=True) for j in JOINTS)
         return Actuation(None, None, None, friction, effort, velocity, effort, saturation)
-    extra = [key for key in JOINT_LIMITS if key in document]
+    return _motor_drive(r, friction, saturation, encoder=public[2])
+
+
+def _motor_drive(r: Reader, friction: Friction, saturation: str, *, encoder: bool) -> Actuation:
+    """_drive's actuation of a model with public motor data (and an encoder if ``encoder``):
+    its joint limits follow from the motor and the ratios."""
+    arg = "actuation_file"
+
+    def act(*keys: str, **kind: bool) -> float:
+        return r.number(arg, *keys, **kind)
+
+    extra = [key for key in JOINT_LIMITS if key in r.documents[arg]]
     if extra:
         raise r.error(arg, f"{extra[0]} is for a model without motor data; with a motor, the joint limits "
                            "follow from max_continuous_torque, max_speed and the ratios")
@@ -123,10 +129,10 @@ def _drive(r: Reader) -> Actuation:
     problem = motor_problem(motor)
     if problem:
         raise r.error(arg, f"motor: {problem}")
-    encoder = None if not public[2] else \
+    encoders = None if not encoder else \
         Encoder(*(act("encoder", f.name, positive=True) for f in dataclasses.fields(Encoder)))
     ratios = vector3(act("transmission_ratio", j, positive=True) for j in JOINTS)
-    return Actuation(ratios, motor, encoder, friction,
+    return Actuation(ratios, motor, encoders, friction,
                      vector3(motor.max_continuous_torque * k for k in ratios),
                      vector3(motor.max_speed / k for k in ratios),
                      vector3(motor.stall_torque * k for k in ratios), saturation)
@@ -149,6 +155,17 @@ def _limits(r: Reader) -> Limits:
             raise r.error(arg, f"the coupled stops {-backward:.4f} <= theta2 - theta3 <= {forward:.4f} rad "
                                f"leave no posture in the {name}, where theta2 - theta3 spans "
                                f"{low:.4f} .. {high:.4f} rad")
+    postures = _postures(r, lower, upper)
+    return Limits(vector3(lower), vector3(upper),
+                  Stops(vector3(s[0] for s in stops), vector3(s[1] for s in stops), coupled,
+                                      r.number(arg, "stops", "stiffness", positive=True),
+                                      r.number(arg, "stops", "damping", non_negative=True)),
+                  types.MappingProxyType(postures))
+
+
+def _postures(r: Reader, lower: tuple[float, ...], upper: tuple[float, ...]) -> dict[str, Vector3]:
+    """The SRDF's named postures (rad), exactly POSTURES, each within the box ``lower`` .. ``upper``."""
+    arg = "joint_limits_file"
     listed = r.node(arg, "postures")
     if not isinstance(listed, dict) or set(listed) != set(POSTURES):
         raise r.error(arg, f"postures must give exactly {' and '.join(POSTURES)} (the SRDF's named postures, "
@@ -159,11 +176,7 @@ def _limits(r: Reader) -> Limits:
         if not all(lo <= t <= hi for t, lo, hi in zip(theta, lower, upper)):
             raise r.error(arg, f"postures.{name} {list(theta)} rad is outside the box joint1..joint3")
         postures[name] = theta
-    return Limits(vector3(lower), vector3(upper),
-                  Stops(vector3(s[0] for s in stops), vector3(s[1] for s in stops), coupled,
-                                      r.number(arg, "stops", "stiffness", positive=True),
-                                      r.number(arg, "stops", "damping", non_negative=True)),
-                  types.MappingProxyType(postures))
+    return postures
 
 
 def _mujoco(r: Reader) -> MujocoSettings:

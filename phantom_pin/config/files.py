@@ -115,36 +115,49 @@ def apply_overrides(documents: dict[str, dict], overrides: dict[str, object]) ->
     documents = copy.deepcopy(documents)
     stems = {Path(name).stem: arg for arg, name in FILES.items()}
     for key, value in overrides.items():
-        parts = str(key).split(".")
-        if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
-            holders, parts = [stems[parts[0]]], parts[1:]
-        else:
-            holders = [arg for arg, document in documents.items() if parts[0] in document]
-        if not holders:
-            raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
-        if len(holders) > 1:
-            names = [FILES[arg] for arg in holders]
-            raise ParameterFileError(f"{key}: {' and '.join(names)} both have {parts[0]!r}; "
-                                     f"qualify it, e.g. {Path(names[0]).stem}.{key}")
-        name = FILES[holders[0]]
-        node: object = documents[holders[0]]
-        per_joint = PER_JOINT.get(holders[0], ())
-        if tuple(parts[:-1]) in per_joint:      # one joint of a per-joint key
-            _expand(node, parts, key, name)
-        for part in parts[:-1]:
-            node = _child(node, part)
-        if _child(node, parts[-1]) is None and parts[0] not in documents[holders[0]]:
-            raise ParameterFileError(f"{key}: {name} has no key {parts[0]!r}")
-        whole = tuple(parts) in per_joint and isinstance(_child(node, parts[-1]), dict)   # every joint at once
-        if not is_number(_child(node, parts[-1])) and not whole:
-            raise ParameterFileError(f"{key}: not a number in {name}, cannot override it")
-        if not is_number(value) or not math.isfinite(cast(float, value)):
-            raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
-        if isinstance(node, list):
-            node[int(parts[-1])] = float(cast(float, value))
-        else:
-            cast(dict, node)[parts[-1]] = float(cast(float, value))
+        arg, parts = _holder(documents, stems, key)
+        _override(documents[arg], arg, parts, key, value)
     return documents
+
+
+def _holder(documents: dict[str, dict], stems: dict[str, str], key: object) -> tuple[str, list[str]]:
+    """The file argument that holds the override ``key`` (by its stem if qualified, else the
+    one file with its first part), and the key's parts within it."""
+    parts = str(key).split(".")
+    if parts[0] in stems and len(parts) > 1:  # qualified: "actuation.motor.rotor_inertia"
+        holders, parts = [stems[parts[0]]], parts[1:]
+    else:
+        holders = [arg for arg, document in documents.items() if parts[0] in document]
+    if not holders:
+        raise ParameterFileError(f"{key}: no parameter file has the key {parts[0]!r}")
+    if len(holders) > 1:
+        names = [FILES[arg] for arg in holders]
+        raise ParameterFileError(f"{key}: {' and '.join(names)} both have {parts[0]!r}; "
+                                 f"qualify it, e.g. {Path(names[0]).stem}.{key}")
+    return holders[0], parts
+
+
+def _override(document: dict, arg: str, parts: list[str], key: object, value: object) -> None:
+    """The number at ``parts`` in ``document`` (the file of ``arg``) set to ``value``, in place
+    (apply_overrides' doc)."""
+    name = FILES[arg]
+    node: object = document
+    per_joint = PER_JOINT.get(arg, ())
+    if tuple(parts[:-1]) in per_joint:      # one joint of a per-joint key
+        _expand(node, parts, key, name)
+    for part in parts[:-1]:
+        node = _child(node, part)
+    if _child(node, parts[-1]) is None and parts[0] not in document:
+        raise ParameterFileError(f"{key}: {name} has no key {parts[0]!r}")
+    whole = tuple(parts) in per_joint and isinstance(_child(node, parts[-1]), dict)   # every joint at once
+    if not is_number(_child(node, parts[-1])) and not whole:
+        raise ParameterFileError(f"{key}: not a number in {name}, cannot override it")
+    if not is_number(value) or not math.isfinite(cast(float, value)):
+        raise ParameterFileError(f"{key}: expected a finite number, got {value!r}")
+    if isinstance(node, list):
+        node[int(parts[-1])] = float(cast(float, value))
+    else:
+        cast(dict, node)[parts[-1]] = float(cast(float, value))
 
 
 def _expand(document: object, parts: list[str], key: object, name: str) -> None:

@@ -7,6 +7,9 @@ them). Needs MuJoCo (``pip install phantom_pin[interop]``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 
 from phantom_pin.device.device import Device
@@ -39,14 +42,7 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
     data = mujoco.MjData(model)
     steps = _steps(model.opt.timestep, rate, duration, samples, "rate" if timestep is None else "timestep")
     coupling = device.phantom.coupling
-    names = coupling.tree.names[1:]
-    qpos = [model.joint(name).qposadr[0] for name in names]
-    dofs = [model.joint(name).dofadr[0] for name in names]
-    primaries = [f"{description.prefix}joint{j}" for j in (1, 2, 3)]
-    primary_q = [model.joint(name).qposadr[0] for name in primaries]
-    primary_v = [model.joint(name).dofadr[0] for name in primaries]
-    actuators = [next(i for i in range(model.nu) if model.actuator_trnid[i, 0] == model.joint(name).id)
-                 for name in primaries]
+    qpos, dofs, primary_q, primary_v, actuators = _addresses(model, coupling.tree.names[1:], description.prefix)
     gear = model.actuator_gear[actuators, 0].copy()
     low, high = model.actuator_ctrlrange[actuators, 0], model.actuator_ctrlrange[actuators, 1]
     data.qpos[qpos] = coupling.configuration(theta)
@@ -85,6 +81,19 @@ def simulate_mujoco(theta0: object, duration: float, controller: Controller | No
         t=np.arange(samples) / rate, theta=out_theta, dtheta=out_dtheta, tau=applied, tau_commanded=commanded,
         current=None if device.config.actuation.motor is None else device.motor_currents(applied),
         tip=device.phantom.forward_kinematics(out_theta)[:, :3, 3], rate=rate, substeps=steps)
+
+
+def _addresses(model: Any, names: Sequence[str], prefix: str) -> tuple[list[int], ...]:
+    """In the MuJoCo ``model``: the qpos and dof addresses of the tree's joints ``names``, those
+    of the three primary joints, and the primaries' actuators (the motors)."""
+    qpos = [model.joint(name).qposadr[0] for name in names]
+    dofs = [model.joint(name).dofadr[0] for name in names]
+    primaries = [f"{prefix}joint{j}" for j in (1, 2, 3)]
+    primary_q = [model.joint(name).qposadr[0] for name in primaries]
+    primary_v = [model.joint(name).dofadr[0] for name in primaries]
+    actuators = [next(i for i in range(model.nu) if model.actuator_trnid[i, 0] == model.joint(name).id)
+                 for name in primaries]
+    return qpos, dofs, primary_q, primary_v, actuators
 
 
 def _steps(timestep: float, rate: float, duration: float, samples: int, argument: str) -> int:

@@ -250,6 +250,10 @@ class Plant:
         v0, v1, v2 = v
         if v0 and v1 and v2:
             return (1 if v0 > 0 else -1, 1 if v1 > 0 else -1, 1 if v2 > 0 else -1)
+        return self._released(q, v, tau, contact)
+
+    def _released(self, q: List3, v: List3, tau: List3, contact: Contact) -> Mode:
+        """_mode's with a joint at rest: each stuck joint released or held in turn (_mode's doc)."""
         mode = [1 if x > 0 else -1 if x < 0 else 0 for x in v]
         while 0 in mode:
             holding = self._held_torque(q, v, tau, (mode[0], mode[1], mode[2]), contact)
@@ -300,6 +304,16 @@ class Plant:
         end = self._events(q_end, v_end, tau, mode, contact, signs, end_margins)
         if not end or min(end) > 0 or depth >= MAX_EVENTS:
             return q_end, v_end
+        return self._past_event(acceleration, q, v, tau, h, depth, mode, contact, signs, start_margins,
+                                end, (q_end, v_end))
+
+    def _past_event(self, acceleration: Callable, q: List3, v: List3, tau: List3, h: float, depth: int,
+                    mode: Mode, contact: Contact, signs: List3, start_margins: List3, end: List3,
+                    state_end: tuple[List3, List3]) -> tuple[List3, List3]:
+        """_advance's step from (q, v) once an event function ``end`` is <= 0 at its end
+        ``state_end``: the first event located, a sliding joint that reversed or stopped set at
+        rest, and the rest of the step advanced from there."""
+        q_end, v_end = state_end
         start = self._events(q, v, tau, mode, contact, signs, start_margins)
         shares = [a / (a - b) if b <= 0 < a else (0.0 if b <= 0 and a > 0 else 1.0)
                   for a, b in zip(start, end)]  # noqa: B905

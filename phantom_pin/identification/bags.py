@@ -105,20 +105,26 @@ def _connection(connections: list, path: Path, topic: str | None, driver: str | 
     """The JointState connection to read (read_bag's ``topic`` and ``driver``)."""
     streams = [c for c in connections if c.msgtype == JOINT_STATE]
     if topic is not None:
-        chosen = [c for c in connections if c.topic == topic]
-        if not chosen or chosen[0].msgtype != JOINT_STATE:
-            raise LogError(f"{topic} is not a {JOINT_STATE} topic of {path} (those: "
-                           f"{', '.join(sorted({c.topic for c in streams})) or 'none'})", argument="topic")
-        return chosen[0]
+        return _named(connections, streams, path, topic)
     if driver is not None:
         chosen = [c for c in streams if c.topic == profiles.load(driver).joint_states.topic]
         if chosen:
             return chosen[0]
-    if len({c.topic for c in streams}) != 1:
-        raise LogError(f"{path} holds {len({c.topic for c in streams})} {JOINT_STATE} topics"
-                       + (f" ({', '.join(sorted({c.topic for c in streams}))}): choose one with --topic"
+    topics = {c.topic for c in streams}
+    if len(topics) != 1:
+        raise LogError(f"{path} holds {len(topics)} {JOINT_STATE} topics"
+                       + (f" ({', '.join(sorted(topics))}): choose one with --topic"
                           if streams else ""), argument="topic")
     return streams[0]
+
+
+def _named(connections: list, streams: list, path: Path, topic: str) -> Any:
+    """The connection of ``topic``, one of the JointState ``streams``; LogError naming them otherwise."""
+    chosen = [c for c in connections if c.topic == topic]
+    if not chosen or chosen[0].msgtype != JOINT_STATE:
+        raise LogError(f"{topic} is not a {JOINT_STATE} topic of {path} (those: "
+                       f"{', '.join(sorted({c.topic for c in streams})) or 'none'})", argument="topic")
+    return chosen[0]
 
 
 def _profile(messages: list, topic: str, driver: str | None) -> profiles.Profile:

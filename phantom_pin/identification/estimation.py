@@ -214,10 +214,7 @@ def _arguments(log: object, phantom: object, cutoff: object, structure: object, 
         raise InvalidInputError(f"expected a phantom_pin.identification.Log (read_log), got {log!r}", argument="log")
     if not isinstance(phantom, Phantom):
         raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
-    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)) + (
-            () if min_speed is None else (("min_speed", min_speed),)):
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
-            raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
+    _check_positive(cutoff, prior_weight, min_speed)
     spread = priors.spread_argument(prior_spread)
     checked = delay_argument(delay)
     if progress is not None and not callable(progress):
@@ -237,6 +234,15 @@ def _arguments(log: object, phantom: object, cutoff: object, structure: object, 
     if structure not in STRUCTURES:
         raise InvalidInputError(f"expected one of {', '.join(STRUCTURES)}, got {structure!r}", argument="structure")
     return spread, checked
+
+
+def _check_positive(cutoff: object, prior_weight: object, min_speed: object) -> None:
+    """estimate's numbers that must be finite and > 0 (``min_speed`` unless None): InvalidInputError
+    naming the first that is not."""
+    for name, value in (("cutoff", cutoff), ("prior_weight", prior_weight)) + (
+            () if min_speed is None else (("min_speed", min_speed),)):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
+            raise InvalidInputError(f"expected a finite number > 0, got {value!r}", argument=name)
 
 
 def _regression(log: Log, phantom: Phantom, cutoff: float, structure: str, timing: str | None, spread: float,
@@ -350,8 +356,14 @@ def _timing_and_gains(ready: _Regression, timing: str, delay: float | None, gain
     residuals = {name: weighted(samples.at(HOLD[name] / samples.rate - given, gain).tau - tau0)
                  for name in TIMINGS}     # in joint 1's scale, the gains applied
     return _Timed(used, at, beta, covariance, information, log_beta, log_rms, gain, estimated, residuals,
-                  {} if scores is None else {"kept at 1": scores[0], "corrected": scores[1],
-                                             "quarters better": float(scores[2])})
+                  _gain_scores(scores))
+
+
+def _gain_scores(scores: tuple[float, float, int] | None) -> dict[str, float]:
+    """The held-out check of the corrected gains (validate_gains) as the fit records it: {} where
+    none was run."""
+    return {} if scores is None else {"kept at 1": scores[0], "corrected": scores[1],
+                                      "quarters better": float(scores[2])}
 
 
 def _projection(ready: _Regression, beta: np.ndarray, covariance: np.ndarray,

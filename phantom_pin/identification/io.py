@@ -100,17 +100,7 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, s
     """(data lines as (line number, text), {column: values}) of the CSV at ``path``, whose
     header must name ``columns`` (module doc: the dialects it takes); LogError naming the line
     of a bad row. The header is the first data line; its units (in []) by column, _units."""
-    try:
-        text = path.read_text(encoding="utf-8-sig")           # a UTF-8 byte order mark is dropped
-    except OSError as error:
-        raise LogError(f"{path}: cannot read ({error.strerror})", argument="path") from None
-    except UnicodeDecodeError as error:
-        raise LogError(f"{path}: not a text file (not UTF-8 at byte {error.start})", argument="path") from None
-    # (line number, text) of the lines that hold data: blank lines and # comments are skipped
-    lines = [(number, line) for number, line in enumerate(text.splitlines(), start=1)
-             if line.strip() and not line.lstrip().startswith("#")]
-    if not lines:
-        raise LogError(f"{path}: empty file")
+    lines = _data_lines(path)
     first = lines[0][1]
     separator = max((",", ";", "\t"), key=first.count)        # the dialects spreadsheets write
     header = [_column_name(name) for name in first.split(separator)]
@@ -126,6 +116,23 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[list[tuple[int, s
         row = lines[1 + int(np.where(~np.isfinite(table).all(axis=1))[0][0])][0]
         raise LogError(f"{path}: NaN or inf on line {row}")
     return lines, {name: table[:, header.index(name)] for name in columns}
+
+
+def _data_lines(path: Path) -> list[tuple[int, str]]:
+    """(line number, text) of the lines of the file at ``path`` that hold data (blank lines and
+    # comments skipped); LogError where it cannot be read as text or holds none."""
+    try:
+        text = path.read_text(encoding="utf-8-sig")           # a UTF-8 byte order mark is dropped
+    except OSError as error:
+        raise LogError(f"{path}: cannot read ({error.strerror})", argument="path") from None
+    except UnicodeDecodeError as error:
+        raise LogError(f"{path}: not a text file (not UTF-8 at byte {error.start})", argument="path") from None
+    # (line number, text) of the lines that hold data: blank lines and # comments are skipped
+    lines = [(number, line) for number, line in enumerate(text.splitlines(), start=1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise LogError(f"{path}: empty file")
+    return lines
 
 
 def _numbers(path: Path, lines: list[tuple[int, str]], separator: str, width: int) -> np.ndarray:

@@ -261,25 +261,37 @@ def gain_warning(fit: Fit) -> str | None:
               and j not in rejected]
     parts = []
     if off:
-        hint = "" if fit.ratios is None else " (or were they converted with transmission ratio " + ", ".join(
-            f"{fit.ratios[j] / fit.gains[j]:.4g} instead of the model's {fit.ratios[j]:.4g}" for j in off) + "?)"
-        parts.append(" and ".join(f"tau{j + 1} is {1 / fit.gains[j]:.4g} times" for j in off)
-                     + " joint 1's torque scale (gain " + ", ".join(f"{fit.gains[j]:.4g}" for j in off)
-                     + "): corrected in the written model; multiply " + " and ".join(
-                         f"joint {j + 1}'s torque constant in your driver by {fit.gains[j]:.4g}" for j in off)
-                     + f" so that its commands are the model's torques{hint}")
+        parts.append(_corrected(fit, off))
     if unsure:
         parts.append(", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in unsure)
                      + f": kept at 1, the log cannot show it differs (needs {GAIN_EVIDENCE:g} standard "
                      "deviations); a log that moves joint 1 more (phantom-pin excite) would tell")
     if rejected:
-        kept, corrected = (100 * np.sqrt(fit.gain_scores[name] / 3) for name in ("kept at 1", "corrected"))
-        parts.append(", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in rejected)
-                     + f": kept at 1 (the prior's), the log cannot tell: correcting it did not improve the held-out "
-                     f"prediction on every quarter of the log (better on {fit.gain_scores['quarters better']:.0f} of "
-                     f"{FOLDS}; {corrected:.3g} % of the torque RMS against {kept:.3g} % kept at 1); a log that "
-                     "moves joint 1 more (phantom-pin excite) would tell")
+        parts.append(_rejected(fit, rejected))
     return "; ".join(parts) or None
+
+
+def _corrected(fit: Fit, off: list[int]) -> str:
+    """gain_warning's part on the gains corrected (joints ``off``): what to write into the driver."""
+    hint = "" if fit.ratios is None else " (or were they converted with transmission ratio " + ", ".join(
+        f"{fit.ratios[j] / fit.gains[j]:.4g} instead of the model's {fit.ratios[j]:.4g}" for j in off) + "?)"
+    return (" and ".join(f"tau{j + 1} is {1 / fit.gains[j]:.4g} times" for j in off)
+            + " joint 1's torque scale (gain " + ", ".join(f"{fit.gains[j]:.4g}" for j in off)
+            + "): corrected in the written model; multiply " + " and ".join(
+                f"joint {j + 1}'s torque constant in your driver by {fit.gains[j]:.4g}" for j in off)
+            + f" so that its commands are the model's torques{hint}")
+
+
+def _rejected(fit: Fit, rejected: list[int]) -> str:
+    """gain_warning's part on the gains kept at 1 though the evidence rule passed (joints
+    ``rejected``): the held-out prediction did not improve."""
+    values, sigma = fit.gains_estimated
+    kept, corrected = (100 * np.sqrt(fit.gain_scores[name] / 3) for name in ("kept at 1", "corrected"))
+    return (", ".join(f"joint {j + 1}'s torque gain ({values[j]:.4g} +- {sigma[j]:.2g})" for j in rejected)
+            + f": kept at 1 (the prior's), the log cannot tell: correcting it did not improve the held-out "
+            f"prediction on every quarter of the log (better on {fit.gain_scores['quarters better']:.0f} of "
+            f"{FOLDS}; {corrected:.3g} % of the torque RMS against {kept:.3g} % kept at 1); a log that "
+            "moves joint 1 more (phantom-pin excite) would tell")
 
 
 def recommendation(fit: Fit) -> str | None:

@@ -40,6 +40,25 @@ def _per_joint(value: object, name: str, unit: str, least: float, strict: bool) 
     return array
 
 
+def _trajectory(t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray,
+                tau: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """track's trajectory as float arrays, checked: shapes (N,) and (N, 3) with N >= 2, finite,
+    the times at a fixed rate; InvalidInputError otherwise."""
+    try:
+        t, theta, dtheta, tau = (np.asarray(x, float) for x in (t, theta, dtheta, tau))
+    except (TypeError, ValueError):
+        raise InvalidInputError("t, theta, dtheta, tau: expected arrays of numbers") from None
+    if t.ndim != 1 or len(t) < 2 or any(x.shape != (len(t), 3) for x in (theta, dtheta, tau)):
+        raise InvalidInputError(f"t, theta, dtheta, tau: expected shapes (N,), (N, 3), (N, 3), (N, 3) with N >= 2, "
+                                f"got {t.shape}, {theta.shape}, {dtheta.shape}, {tau.shape}")
+    if not all(np.isfinite(x).all() for x in (t, theta, dtheta, tau)):
+        raise InvalidInputError("t, theta, dtheta, tau: must be finite (no NaN or inf)")
+    step = np.diff(t)
+    if not (step > 0).all() or np.ptp(step) > 1e-6 * step.mean():
+        raise InvalidInputError("the times must increase at a fixed rate", argument="t")
+    return t, theta, dtheta, tau
+
+
 def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, tau: np.ndarray,
           torque_noise: float | np.ndarray = 0.0, quantization: bool = True, seed: int = 0,
           gains: float | np.ndarray = 1.0,
@@ -62,18 +81,7 @@ def track(device: Device, t: np.ndarray, theta: np.ndarray, dtheta: np.ndarray, 
                                 f"{disturbance!r}", argument="disturbance")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise InvalidInputError(f"expected an integer >= 0, got {seed!r}", argument="seed")
-    try:
-        t, theta, dtheta, tau = (np.asarray(x, float) for x in (t, theta, dtheta, tau))
-    except (TypeError, ValueError):
-        raise InvalidInputError("t, theta, dtheta, tau: expected arrays of numbers") from None
-    if t.ndim != 1 or len(t) < 2 or any(x.shape != (len(t), 3) for x in (theta, dtheta, tau)):
-        raise InvalidInputError(f"t, theta, dtheta, tau: expected shapes (N,), (N, 3), (N, 3), (N, 3) with N >= 2, "
-                                f"got {t.shape}, {theta.shape}, {dtheta.shape}, {tau.shape}")
-    if not all(np.isfinite(x).all() for x in (t, theta, dtheta, tau)):
-        raise InvalidInputError("t, theta, dtheta, tau: must be finite (no NaN or inf)")
-    step = np.diff(t)
-    if not (step > 0).all() or np.ptp(step) > 1e-6 * step.mean():
-        raise InvalidInputError("the times must increase at a fixed rate", argument="t")
+    t, theta, dtheta, tau = _trajectory(t, theta, dtheta, tau)
     if quantization:
         device.require("encoder", "quantization")
     follow = tracking(t, theta, dtheta, tau)

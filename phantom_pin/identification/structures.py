@@ -158,21 +158,7 @@ class General(Structure):
         self.names = tuple(f"{b}.{p}" for b in BODIES for p in INERTIAL_NAMES) + (
             ("actuation.motor.rotor_inertia",) if self.motor else ()) + FRICTION
         n = len(self.names)
-        # pi (the regressor's parameters) = A x + b: each tree link is its body less the
-        # pins' shares (constant: carve), the pins are fixed, the rotors J r^2
-        a, b = np.zeros((regressor.size, n)), np.zeros(regressor.size)
-        b[regressor.inertial] = regressor.carried  # a locked stylus gimbal: a known load
-        for k, link in enumerate(regressor.bodies):
-            name, rows = link[len(prefix):], slice(10 * k, 10 * k + 10)
-            if name in BODIES:
-                i = BODIES.index(name)
-                a[rows, 10 * i:10 * i + 10] = np.eye(10)
-                b[rows] += config.links[name].dynamic_parameters() - self.bodies[name].dynamic_parameters()
-            else:
-                b[rows] += config.links[name].dynamic_parameters()
-        if self.motor:
-            a[regressor.rotors, 50] = np.square(np.asarray(config.actuation.ratios, dtype=float))
-        a[regressor.friction, n - 6:] = np.eye(6)
+        a, b = self._affine_map(prefix, n)
         self.affine, self.constant = a, b
         self.rotor = 50 if self.motor else None
         self.prior = np.concatenate([*(self.bodies[name].dynamic_parameters() for name in BODIES),
@@ -190,6 +176,26 @@ class General(Structure):
         self.base_names = tuple(self.base.words(k) for k in range(self.base.rank))
         self.units = tuple(_unit(self.names[i]) for i in self.independent)
         self._friction_columns = [self.independent.index(i) for i in range(n - 6, n)]
+
+    def _affine_map(self, prefix: str, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """(A, b) of pi (the regressor's parameters) = A x + b over the ``n`` parameters x: each
+        tree link is its body less the pins' shares (constant: carve), the pins are fixed, the
+        rotors J r^2."""
+        regressor, config = self.regressor, self.config
+        a, b = np.zeros((regressor.size, n)), np.zeros(regressor.size)
+        b[regressor.inertial] = regressor.carried  # a locked stylus gimbal: a known load
+        for k, link in enumerate(regressor.bodies):
+            name, rows = link[len(prefix):], slice(10 * k, 10 * k + 10)
+            if name in BODIES:
+                i = BODIES.index(name)
+                a[rows, 10 * i:10 * i + 10] = np.eye(10)
+                b[rows] += config.links[name].dynamic_parameters() - self.bodies[name].dynamic_parameters()
+            else:
+                b[rows] += config.links[name].dynamic_parameters()
+        if self.motor:
+            a[regressor.rotors, 50] = np.square(np.asarray(config.actuation.ratios, dtype=float))
+        a[regressor.friction, n - 6:] = np.eye(6)
+        return a, b
 
     def regressor_of(self, theta, dtheta, ddtheta, friction=None) -> tuple[np.ndarray, np.ndarray]:
         """(Phi (N, 3, rank), tau_0 (N, 3)): the independent columns of the regressor in x,
