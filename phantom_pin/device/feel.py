@@ -16,7 +16,6 @@ import weakref
 from typing import Any
 
 import numpy as np
-from scipy import optimize
 
 from phantom_pin._validation import as_state
 from phantom_pin.config.types import STOP_COORDINATES
@@ -212,6 +211,8 @@ def workspace_box(device: Device) -> tuple[np.ndarray, np.ndarray]:
     inside the stops (joint intervals and the parallelogram's coupled stops; the URDF's box plays
     no part). Each extreme: the best of a BOX_GRID^3 grid inside the stops, refined by SLSQP on the
     stops' linear constraints with the tip Jacobian as gradient."""
+    from scipy import optimize  # here: importing scipy.optimize costs every `import phantom_pin` 0.28 s
+
     lower, upper = _stop_region(device)
     axes = [np.linspace(lower[i], upper[i], BOX_GRID) for i in range(3)]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
