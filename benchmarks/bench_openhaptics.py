@@ -71,6 +71,9 @@ def main() -> None:
     reference = per_call(lambda t, g: phantom.gravity(t), list(theta), list(gimbal), args.rounds)
     python = per_call(lambda a, g: compensate(a, g if stylus else None), [list(a) for a in angles],
                       [list(g) for g in gimbal], args.rounds)
+    transparent = Compensator(args.model, compensate=("gravity", "friction", "inertia"), kappa=0.6)
+    moving = per_call(lambda a, g: transparent(a, g if stylus else None), [list(a) for a in angles],
+                      [list(g) for g in gimbal], args.rounds)
     with tempfile.TemporaryDirectory() as scratch:
         folder = Path(scratch)
         (folder / "model.h").write_text(header(args.model))
@@ -100,6 +103,8 @@ def main() -> None:
     print("|---|---|---|")
     print(f"| Phantom.gravity (reference) | {reference * 1e6:.1f} us | 1.00 |")
     print(f"| Compensator (pyOpenHaptics' call a tick) | {python * 1e6:.1f} us | {python / reference:.2f} |")
+    print(f"| Compensator, gravity, friction and inertia (the arm moving) | {moving * 1e6:.1f} us | "
+          f"{moving / reference:.2f} |")
     print(f"| header NAME_openhaptics_force (C, -O2) | {c * 1e9:.1f} ns | {c / reference:.4f} |")
     print(f"| stand-in device tick (plant.Server.tick) | {tick * 1e6:.1f} us | {tick / reference:.2f} |")
 

@@ -132,7 +132,7 @@ class Compensator:
         """The joint torques tau (N m on theta) of the terms, updating the estimates."""
         theta = _three(joints, "joints") * self._sign
         gimbal = self._gimbal(gimbals)
-        rate, acceleration = self.estimator.update(theta)
+        rate, acceleration = self.estimator.update(theta) if self.terms != ("gravity",) else (np.zeros(3),) * 2
         if rates is not None:
             rate = _three(rates, "rates") * self._sign
         tau = np.zeros(3)
