@@ -115,6 +115,7 @@ GROUPS = {
     "integration/test_interop.py::": "interop",                   # each model's Drake plant
     "integration/test_gazebo.py::": "gazebo",
     "codegen/test_generate.py::": "codegen",
+    "interfaces/test_stand_in.py::": "stand_in",                  # each model's stand-in and programs, built once
     "config/test_cad_model.py::": "cad_model",
     "report/test_derivation.py::": "derivation",
     "tests/test_ros2.py::test_the_node_": "ros2",
