@@ -144,6 +144,10 @@ class Renderer:
         self.gravity, self.friction = "gravity" in compensate, "friction" in compensate
         self.kappa = float(kappa)
         self.law = friction if friction is not None else phantom.config.actuation.friction
+        if self.friction and not any(self.law.viscous) and not any(self.law.coulomb):
+            raise InvalidInputError(f"the model {phantom.config.name!r} has no friction data (every viscous and "
+                                    "Coulomb coefficient 0): give friction= (an identified overlay's)",
+                                    argument="compensate")
         self.limit = min(float(max_force), profile.force.clamp)          # N, the norm
         self.estimator = Estimator(cutoff=CUTOFF)
         self.budget = TorqueBudget(self.device)                          # the motors' limits in time

@@ -13,6 +13,7 @@ import pytest
 
 import driver_reference as ref
 from phantom_pin import InvalidInputError, Phantom, profiles
+from phantom_pin.config.types import Friction
 from phantom_pin.forces import SINGULAR, Renderer
 from phantom_pin.ros2 import DriverBridge, fill_force
 
@@ -153,6 +154,8 @@ def test_bad_options_and_messages_are_refused_naming_them(touch):
     for kwargs, argument in (({"compensate": ("wind",)}, "compensate"), ({"compensate": "gravity"}, "compensate"),
                              ({"compensate": ("gravity", "inertia")}, "kappa"), ({"kappa": 0.5}, "kappa"),
                              ({"compensate": ("inertia",), "kappa": 1.0}, "kappa"),
+                             ({"compensate": ("gravity", "friction"), "friction": Friction((0.0,) * 3, (0.0,) * 3)},
+                              "compensate"),
                              ({"max_force": 0.0}, "max_force"), ({"max_force": float("nan")}, "max_force")):
         with pytest.raises(InvalidInputError) as error:
             Renderer(touch, profile, **kwargs)

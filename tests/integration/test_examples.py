@@ -126,11 +126,12 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
     each along them (the black motors and the dark base, onto which some postures project
     their tip, cannot fake those). The candidates are the sweep at 32 times its keyframe rate:
     the page may be caught between two keyframes (where it has loaded decides when the clip
-    starts, later on a loaded machine), where meshcat shows the posture in between."""
+    starts, later on a loaded machine), where meshcat shows the posture in between. At most two
+    captures: in the suite on a fresh clone the first was seen twice in about 30 runs to show no
+    posture of the sweep (never reproduced alone, idle or beside two busy loops), the page caught
+    before the browser had drawn it; a second capture is a new browser's clock, not a looser check."""
     result = run("visualize.py", tmp_path)
     assert result.returncode == 0, result.stderr
-    image = render(tmp_path / "visualize.html", tmp_path / "visualize.png")
-    assert np.count_nonzero(np.ptp(image[40:], axis=2) < 30) > 3000
     robot = load()
     _, postures = example("visualize").sweep(robot.model.lowerPositionLimit, robot.model.upperPositionLimit,
                                              dataclasses.astuple(CONFIG.limits.stops.coupled))
@@ -147,7 +148,12 @@ def test_visualize_page_shows_the_arm_on_its_sweep(tmp_path):
         tubes = np.vstack([along * elbow, hinge + along * (tip - hinge)])  # the shoulder is the origin
         return dark(patch(image, tip)) and all(light_grey(patch(image, point)) for point in tubes)
 
-    assert any(shows(theta) for theta in postures)
+    for attempt in range(2):
+        image = render(tmp_path / "visualize.html", tmp_path / f"visualize{attempt}.png")
+        assert np.count_nonzero(np.ptp(image[40:], axis=2) < 30) > 3000
+        if any(shows(theta) for theta in postures):
+            return
+    raise AssertionError("no posture of the sweep is shown in two captures")
 
 
 @pytest.mark.parametrize("script", ["gravity_compensation.py", "simulate.py", "workspace.py",
