@@ -127,20 +127,9 @@ class Renderer:
 
     def __init__(self, phantom: Phantom, profile: Profile, compensate: Sequence[str] = ("gravity",),
                  max_force: float = math.inf, friction: Friction | None = None, kappa: float = 0.0) -> None:
-        if not isinstance(phantom, Phantom):
-            raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
-        unknown = [term for term in compensate if term not in TERMS]
-        if unknown or isinstance(compensate, str):
-            raise InvalidInputError(f"expected a subset of {', '.join(TERMS)}, got {compensate!r}",
-                                    argument="compensate")
-        if isinstance(max_force, bool) or not isinstance(max_force, (int, float)) or not max_force > 0:
-            raise InvalidInputError(f"expected a force > 0 N (inf for none), got {max_force!r}", argument="max_force")
+        _check_options(phantom, compensate, max_force, kappa)
         self.phantom, self.profile = phantom, profile
         self.device = Device(phantom)
-        if isinstance(kappa, bool) or not isinstance(kappa, (int, float)) or not 0 <= kappa < 1 or \
-                ("inertia" in compensate) != (kappa > 0):
-            raise InvalidInputError(f"expected 0 < kappa < 1 with inertia compensated, 0 without, got {kappa!r}",
-                                    argument="kappa")
         self.gravity, self.friction = "gravity" in compensate, "friction" in compensate
         self.kappa = float(kappa)
         self.law = friction if friction is not None else phantom.config.actuation.friction
@@ -198,6 +187,21 @@ class Renderer:
         if not np.isfinite(force).all():  # the inputs were finite: only an overflow gets here
             raise InvalidInputError(f"the force is not finite ({force})", argument="user")
         return Rendered(force, self.profile.message_from_openhaptics(force), comp, scale, singular, smallest)
+
+
+def _check_options(phantom: object, compensate: Sequence[str], max_force: object, kappa: object) -> None:
+    """Renderer's options checked: InvalidInputError naming the bad one."""
+    if not isinstance(phantom, Phantom):
+        raise InvalidInputError(f"expected a phantom_pin.Phantom, got {phantom!r}", argument="phantom")
+    unknown = [term for term in compensate if term not in TERMS]
+    if unknown or isinstance(compensate, str):
+        raise InvalidInputError(f"expected a subset of {', '.join(TERMS)}, got {compensate!r}", argument="compensate")
+    if isinstance(max_force, bool) or not isinstance(max_force, (int, float)) or not max_force > 0:
+        raise InvalidInputError(f"expected a force > 0 N (inf for none), got {max_force!r}", argument="max_force")
+    if isinstance(kappa, bool) or not isinstance(kappa, (int, float)) or not 0 <= kappa < 1 or \
+            ("inertia" in compensate) != (kappa > 0):
+        raise InvalidInputError(f"expected 0 < kappa < 1 with inertia compensated, 0 without, got {kappa!r}",
+                                argument="kappa")
 
 
 def _vector(value: object, argument: str) -> np.ndarray:
