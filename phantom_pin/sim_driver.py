@@ -32,7 +32,7 @@ import pinocchio as pin
 
 from phantom_pin import drivers
 from phantom_pin.device.device import Device
-from phantom_pin.device.plant import MAX_STEP, Plant, contact_substeps
+from phantom_pin.device.plant import servo_plant
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.profiles import Profile, StateTopic
 from phantom_pin.ros2 import _qos, message_type, run
@@ -61,9 +61,7 @@ class DriverSimulation:
         if isinstance(hold, bool) or not isinstance(hold, (int, float)) or not 0 <= hold < math.inf:
             raise InvalidInputError(f"expected a time >= 0 s, got {hold!r}", argument="hold")
         self.device, self.profile, self.hold = device, profile, float(hold)
-        self.steps = max(1, math.ceil(PERIOD / MAX_STEP * (1 - 1e-12)))
-        substeps = max(self.steps, contact_substeps(device, theta, PERIOD, True, True))
-        self.plant = Plant(device, friction=True, hard_stops=True, saturation=True, contact_step=PERIOD / substeps)
+        self.plant, self.steps = servo_plant(device, theta, PERIOD)
         self.q, self.v = theta.tolist(), [0.0, 0.0, 0.0]
         self.x0 = device.phantom.forward_kinematics(theta)[:3, 3]     # m, frame s: the spring's target
         self.time = 0.0                                                 # s, simulated

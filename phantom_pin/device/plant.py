@@ -80,6 +80,17 @@ def contact_substeps(device: Device, theta0: np.ndarray, period: float, friction
     return max(1, math.ceil(need * (1 - 1e-12)))
 
 
+def servo_plant(device: Device, theta0: np.ndarray, period: float,
+                friction: bool = True) -> tuple[Plant, int]:
+    """A servo loop's plant at ``period`` s (the stops and saturation on, ``friction`` as asked)
+    and its RK4 steps per period away from the stops, ceil(period / MAX_STEP); on a stop the
+    steps contact_substeps asks at ``theta0`` (rad). What simulated drivers and the libHD
+    stand-in step once a tick."""
+    steps = max(1, math.ceil(period / MAX_STEP * (1 - 1e-12)))
+    substeps = max(steps, contact_substeps(device, np.asarray(theta0, dtype=float), period, friction, True))
+    return Plant(device, friction=friction, hard_stops=True, saturation=True, contact_step=period / substeps), steps
+
+
 class Plant:
     """The device between two samples, for simulate(): ``saturate`` a command, then ``hold`` it
     over a sample period.

@@ -48,14 +48,12 @@ def run(compensator, theta0, duration, hand, friction=True, wall=None, noise=0.0
     ``wall`` (n, w, K, B) adds the virtual wall's force to the command; ``noise`` (rad) is the
     standard deviation of a seeded Gaussian noise on the angles before their rounding to counts
     (an encoder's transitions flicker). Returns a Run."""
-    from phantom_pin.device.plant import MAX_STEP, Plant, contact_substeps
+    from phantom_pin.device.plant import servo_plant
 
     device = compensator.device if compensator is not None else None
     if device is None:
         raise InvalidInputError("expected a Compensator (its device is the plant's)", argument="compensator")
-    steps = max(1, math.ceil(PERIOD / MAX_STEP * (1 - 1e-12)))
-    substeps = max(steps, contact_substeps(device, np.array(theta0), PERIOD, friction, True))
-    plant = Plant(device, friction=friction, hard_stops=True, saturation=True, contact_step=PERIOD / substeps)
+    plant, steps = servo_plant(device, np.array(theta0, dtype=float), PERIOD, friction)
     quantized = device.config.actuation.encoder is not None
     sign = compensator._sign
     q, v = list(map(float, theta0)), [0.0, 0.0, 0.0]

@@ -74,7 +74,7 @@ class Server:
     def __init__(self, environ: dict[str, str] | None = None) -> None:
         from phantom_pin.description.build import description_of, held
         from phantom_pin.device.device import Device
-        from phantom_pin.device.plant import MAX_STEP, Plant, contact_substeps
+        from phantom_pin.device.plant import servo_plant
         from phantom_pin.drivers import openhaptics_from_theta, openhaptics_origin
         from phantom_pin.dynamics.model import Phantom
 
@@ -100,10 +100,7 @@ class Server:
             self.hold = math.nan
         if not 0 <= self.hold < math.inf:
             raise InvalidInputError(f"expected a time >= 0 s, got {hold_text!r}", argument="PHANTOM_PIN_HD_HOLD")
-        steps = max(1, math.ceil(PERIOD / MAX_STEP * (1 - 1e-12)))
-        substeps = max(steps, contact_substeps(device, np.array(theta0), PERIOD, True, True))
-        self.steps = steps
-        self.plant = Plant(device, friction=True, hard_stops=True, saturation=True, contact_step=PERIOD / substeps)
+        self.plant, self.steps = servo_plant(device, np.array(theta0), PERIOD)
         self.q, self.v = list(theta0), [0.0, 0.0, 0.0]
         self.theta0 = list(theta0)
         self.hand = np.array(_numbers("PHANTOM_PIN_HD_HAND", [0.0, 0.0, 0.0]))
