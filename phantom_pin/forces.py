@@ -30,6 +30,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.config.types import Friction
+from phantom_pin.device import estimator
 from phantom_pin.device.device import Device
 from phantom_pin.device.estimator import Estimator
 from phantom_pin.device.thermal import TorqueBudget
@@ -46,12 +47,9 @@ Vector = Sequence[float] | np.ndarray
 SINGULAR = 0.002
 #: What may be compensated (``compensate``): inertia is a share ``kappa`` of M ddtheta + C dtheta.
 TERMS = ("gravity", "friction", "inertia")
-#: The joint-rate filter's cut-off (Hz) for friction compensation: a first-order low-pass of
-#: the finite differences of the angles (at 1 kHz, 20 Hz passes a hand's motion).
-CUTOFF = 20.0
-#: Below this filtered rate (rad/s) a joint is taken at rest: no Coulomb term (a compensation
-#: that pushed a resting joint would start it moving).
-REST = 0.01
+#: The joint-rate filter's cut-off (Hz, device.estimator's) and the rate (rad/s) below which a
+#: joint is taken at rest (no Coulomb term, no inertia), as every servo path has them.
+CUTOFF, REST = estimator.CUTOFF, estimator.REST
 
 
 @dataclasses.dataclass(frozen=True)

@@ -20,6 +20,10 @@ from phantom_pin.exceptions import InvalidInputError
 #: The low-pass's default cut-off (Hz): at 1 kHz it passes a hand's motion (a few Hz) and
 #: attenuates an encoder's steps, differentiated, by the filter's gain.
 CUTOFF = 20.0
+#: Below this estimated rate (rad/s) a joint is taken at rest by the compensations beyond gravity:
+#: no Coulomb term (a compensation that pushed a resting joint would start it moving) and no
+#: inertia while every joint is (docs/feel.md measures the choice).
+REST = 0.01
 
 
 class Estimator:

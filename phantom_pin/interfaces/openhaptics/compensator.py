@@ -44,14 +44,15 @@ from collections.abc import Sequence
 import numpy as np
 
 from phantom_pin.config.types import Friction
+from phantom_pin.device.estimator import REST
 from phantom_pin.exceptions import InvalidInputError
 
 #: What a Compensator computes: HD_CURRENT_FORCE (N) or HD_CURRENT_JOINT_TORQUE (mN m).
 MODES = ("force", "joint_torque")
 #: What it may compensate.
 TERMS = ("gravity", "friction", "inertia")
-#: The dead band's default (rad/s): below it a joint counts as at rest (forces.REST's value).
-DEAD_BAND = 0.01
+#: The dead band's default (rad/s): below it a joint counts as at rest (device.estimator.REST).
+DEAD_BAND = REST
 
 
 def _three(values: object, argument: str) -> np.ndarray:
@@ -135,16 +136,13 @@ class Compensator:
         rate, acceleration = self.estimator.update(theta) if self.terms != ("gravity",) else (np.zeros(3),) * 2
         if rates is not None:
             rate = _three(rates, "rates") * self._sign
-        tau = np.zeros(3)
-        if "gravity" in self.terms:
-            tau += self.phantom.gravity(theta) if gimbal is None else self.phantom.gravity(theta, gimbal=gimbal)
+        gravity = self.phantom.gravity(theta) if gimbal is None else self.phantom.gravity(theta, gimbal=gimbal)
+        tau = gravity.copy() if "gravity" in self.terms else np.zeros(3)
         moving = np.abs(rate) > self.dead_band
         if "friction" in self.terms:
             tau += np.asarray(self.law.torque(np.where(moving, rate, 0.0)))
         if "inertia" in self.terms and moving.any():
-            tau += self.kappa * self.phantom.inverse_dynamics(theta, rate, acceleration, gimbal=gimbal)
-            tau -= self.kappa * (self.phantom.gravity(theta) if gimbal is None else
-                                 self.phantom.gravity(theta, gimbal=gimbal))
+            tau += self.kappa * (self.phantom.inverse_dynamics(theta, rate, acceleration, gimbal=gimbal) - gravity)
         return tau
 
     def __call__(self, joints: Sequence[float], gimbals: Sequence[float] | None = None,
