@@ -206,18 +206,26 @@ def _stop_region(device: Device) -> tuple[np.ndarray, np.ndarray]:
     return device.config.limits.stops.bounds()
 
 
-def workspace_box(device: Device) -> tuple[np.ndarray, np.ndarray]:
-    """(lower, upper) (3,) m: the tip's least and greatest x, y, z in frame s over every posture
-    inside the stops (joint intervals and the parallelogram's coupled stops; the URDF's box plays
-    no part). Each extreme: the best of a BOX_GRID^3 grid inside the stops, refined by SLSQP on the
-    stops' linear constraints with the tip Jacobian as gradient."""
-    from scipy import optimize  # here: importing scipy.optimize costs every `import phantom_pin` 0.28 s
-
+def workspace_grid(device: Device) -> tuple[np.ndarray, np.ndarray]:
+    """(postures (N, 3) rad, tips (N, 3) m in frame s) of a BOX_GRID^3 grid over the stops' region,
+    the postures inside the stops: the tip's extremes over it bound the workspace box from inside
+    (workspace_box refines them; the libHD stand-in reports them as they are)."""
     lower, upper = _stop_region(device)
     axes = [np.linspace(lower[i], upper[i], BOX_GRID) for i in range(3)]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     grid = grid[device.within_limits(grid)]
-    tips = device.phantom.forward_kinematics(grid)[:, :3, 3]
+    return grid, device.phantom.forward_kinematics(grid)[:, :3, 3]
+
+
+def workspace_box(device: Device) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) (3,) m: the tip's least and greatest x, y, z in frame s over every posture
+    inside the stops (joint intervals and the parallelogram's coupled stops; the URDF's box plays
+    no part). Each extreme: the best of workspace_grid's, refined by SLSQP on the stops' linear
+    constraints with the tip Jacobian as gradient."""
+    from scipy import optimize  # here: importing scipy.optimize costs every `import phantom_pin` 0.28 s
+
+    lower, upper = _stop_region(device)
+    grid, tips = workspace_grid(device)
     bounds = list(zip(lower[:3], upper[:3]))
     coupled = STOP_COORDINATES[3]
     constraints = [{"type": "ineq", "fun": lambda q: upper[3] - coupled @ q, "jac": lambda q: -coupled},

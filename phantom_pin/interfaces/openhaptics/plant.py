@@ -51,8 +51,6 @@ from phantom_pin.interfaces.openhaptics.protocol import COMMAND, ENABLED, QUIT, 
 
 #: The servo period the plant's RK4 substeps are chosen for (s): OpenHaptics' 1 kHz.
 PERIOD = 1e-3
-#: Grid points per joint over the stops' box for the workspace's box (HD_MAX_WORKSPACE_DIMENSIONS).
-WORKSPACE_GRID = 25
 
 
 def _numbers(name: str, default: list[float]) -> list[float]:
@@ -104,6 +102,7 @@ class Server:
         self.q, self.v = list(theta0), [0.0, 0.0, 0.0]
         self.theta0 = list(theta0)
         self.hand = np.array(_numbers("PHANTOM_PIN_HD_HAND", [0.0, 0.0, 0.0]))
+        self._jacobian = device.tip_jacobian(np.array(theta0))    # J_p at (q, v), m/rad: state() keeps it
         self.time, self.tick_count = 0.0, 0
         self.to_theta = openhaptics_from_theta(np.eye(3)).T      # da/dtheta (OpenHaptics' angles are linear in theta)
         self.origin = openhaptics_origin(phantom) if self.has_gimbal else np.zeros(3)
@@ -124,19 +123,19 @@ class Server:
         the motors' continuous torque renders along OpenHaptics' +-x, +-y, +-z at the zero posture,
         gravity held: Device.tip_force_capacity), the stiffness, the peak joint torques (mN m on
         OpenHaptics' angles), whether a gimbal is there, the workspace box (mm, OpenHaptics'
-        coordinates: the tip over a grid of the stops)."""
+        coordinates: the tip's extremes over device.feel.workspace_grid, within a grid step of
+        workspace_box's refined ones, which would cost each start scipy.optimize's import)."""
+        from phantom_pin.device.feel import workspace_grid
+
         openhaptics, device = config.actuation.openhaptics, self.device
         zero = np.array(config.limits.postures["zero"])
         axes = np.vstack([np.eye(3), -np.eye(3)])
         continuous = float(min(openhaptics.max_force, device.tip_force_capacity(np.tile(zero, (6, 1)), axes).min()))
         peak = (np.array(config.actuation.peak) * 1000.0).tolist()
-        lower, upper = np.array(config.limits.lower), np.array(config.limits.upper)
-        grid = np.stack(np.meshgrid(*(np.linspace(lo, hi, WORKSPACE_GRID) for lo, hi in zip(lower, upper)),
-                                    indexing="ij"), axis=-1).reshape(-1, 3)
-        inside = grid[device.within_limits(grid)]
-        tips = (self.phantom.forward_kinematics(inside)[:, :3, 3] + self.origin) * 1000.0
+        tips = (workspace_grid(device)[1] + self.origin) * 1000.0
+        lower, upper = tips.min(axis=0), tips.max(axis=0)
         return [openhaptics.max_force, continuous, openhaptics.max_stiffness, *peak, float(self.has_gimbal),
-                *tips.min(axis=0).tolist(), *tips.max(axis=0).tolist()]
+                *lower.tolist(), *upper.tolist()]
 
     def state(self) -> list[float]:
         """STATE's numbers of the current (theta, dtheta)."""
@@ -149,7 +148,8 @@ class Server:
             pose = np.eye(4)
             pose[:3, 3] = self.phantom.forward_kinematics(theta)[:3, 3]
         transform = transform_of_rigid(pose, self.origin)      # the model's own pose: rigid and finite
-        velocity = self.device.tip_jacobian(theta) @ rates * 1000.0
+        self._jacobian = self.device.tip_jacobian(theta)       # the next tick's, at this state
+        velocity = self._jacobian @ rates * 1000.0
         return [*openhaptics_from_theta(theta).tolist(), *self.gimbal, *transform[12:15].tolist(),
                 *velocity.tolist(), *transform.tolist(), 0.0]
 
@@ -160,8 +160,7 @@ class Server:
         enabled = command[0] == ENABLED
         force, torque = np.array(command[1:4]), np.array(command[4:7])
         period, hand = command[7], np.array(command[8:11]) + self.hand
-        theta = np.array(self.q)
-        jacobian = self.device.tip_jacobian(theta)
+        theta, jacobian = np.array(self.q), self._jacobian
         tau = jacobian.T @ (hand + force) + self.to_theta @ torque / 1000.0 if enabled else jacobian.T @ hand
         held = self.time < self.hold
         applied = [0.0, 0.0, 0.0] if held else self.plant.saturate(tau.tolist())
