@@ -10,6 +10,10 @@ files), each Description from ``describe(name or folder, overrides=...)``. A Pha
 
 from importlib.metadata import PackageNotFoundError, version
 
+from phantom_pin import _moved
+
+_moved.install()    # the old paths of moved modules, for one release (CHANGELOG.md)
+
 from phantom_pin import drivers
 from phantom_pin.config import Config, models
 from phantom_pin.description.build import Description, describe
@@ -28,6 +32,13 @@ from phantom_pin.exceptions import (
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
 from phantom_pin.verification import check
+
+
+
+def __getattr__(name: str):  # noqa: ANN202 - a module's __getattr__
+    """``phantom_pin.X`` for a module X that moved (phantom_pin._moved: a DeprecationWarning)."""
+    return _moved.root_attribute(name)
+
 
 try:
     __version__ = version("phantom_pin")
