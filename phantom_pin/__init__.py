@@ -10,11 +10,7 @@ files), each Description from ``describe(name or folder, overrides=...)``. A Pha
 
 from importlib.metadata import PackageNotFoundError, version
 
-from phantom_pin import _moved
-
-_moved.install()    # the old paths of moved modules, for one release (CHANGELOG.md)
-
-from phantom_pin import drivers
+from phantom_pin import _moved, drivers
 from phantom_pin.config import Config, models
 from phantom_pin.description.build import Description, describe
 from phantom_pin.device import Device, Feel, SimulationResult, feel, simulate
@@ -22,17 +18,18 @@ from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.dynamics.loader import PhantomLoader, load, load_files
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import (
-                                    InvalidInputError,
-                                    MissingDataError,
-                                    MissingDependencyError,
-                                    ParameterFileError,
-                                    PhantomPinError,
-                                    UnreachableTargetError,
+    InvalidInputError,
+    MissingDataError,
+    MissingDependencyError,
+    ParameterFileError,
+    PhantomPinError,
+    UnreachableTargetError,
 )
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
 from phantom_pin.verification import check
 
+_moved.install()    # the old paths of moved modules, for one release (CHANGELOG.md)
 
 
 def __getattr__(name: str):  # noqa: ANN202 - a module's __getattr__
