@@ -19,7 +19,7 @@ import time
 
 import numpy as np
 
-from phantom_pin import profiles
+from phantom_pin.interfaces import profiles
 
 ECHO = """
 import sys, rclpy

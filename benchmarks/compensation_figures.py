@@ -30,7 +30,7 @@ import numpy as np
 from phantom_pin import Device
 from phantom_pin.config import models
 from phantom_pin.interfaces.openhaptics import Compensator, hand
-from phantom_pin.plots import Curve, Panel, figure_svg, page, write_page
+from phantom_pin.viewer.plots import Curve, Panel, figure_svg, page, write_page
 
 AXES = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
 

@@ -126,7 +126,7 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import Device, Phantom, describe, drivers, profiles
+from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main as cli
 from phantom_pin.config import Friction, read_overrides
 from phantom_pin.config.sampling import random_states, sample_postures
@@ -138,6 +138,7 @@ from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.prediction import CALIBRATION
 from phantom_pin.identification.result import fit_warnings
 from phantom_pin.identification.structures import General
+from phantom_pin.interfaces import conventions, profiles
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
 #: The report-structured devices: each report parameter (parameterization.SYMBOLS) times its
@@ -445,8 +446,8 @@ def available(setup: Setup, condition: Condition) -> tuple[Condition | None, str
 def through_openhaptics(log: io.Log, folder: Path) -> Path:
     """``log`` written in OpenHaptics' joint angles (rad) and joint torques (mN m): the file."""
     path = folder / "openhaptics_log.csv"
-    io.write_csv(path, io.LOG_COLUMNS, np.column_stack([log.t, drivers.openhaptics_from_theta(log.theta),
-                                                         drivers.openhaptics_torque_from_tau(log.tau)]))
+    io.write_csv(path, io.LOG_COLUMNS, np.column_stack([log.t, conventions.openhaptics_from_theta(log.theta),
+                                                         conventions.openhaptics_torque_from_tau(log.tau)]))
     return path
 
 
@@ -758,7 +759,7 @@ def write_bag(path: Path, profile: profiles.Profile, log: io.Log, gimbal: np.nda
     state, header, stamp_type = (types.types[name] for name in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header",
                                                                  "builtin_interfaces/msg/Time"))
     spec = profile.joint_states
-    efforts = drivers.openhaptics_torque_from_tau(log.tau)
+    efforts = conventions.openhaptics_torque_from_tau(log.tau)
     held = profile.state_from_gimbal(gimbal)
     with Writer(path, version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
         connection = writer.add_connection(spec.topic, state.__msgtype__, typestore=types)

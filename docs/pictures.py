@@ -8,8 +8,8 @@ chromium (phantom_pin.viewer.screenshot). Needs Debian's chromium and pillow (th
 
 Frames (m): the viewer's world is base_link (REP-103: x forward, y left, z up, origin at the
 shoulder); frame s is the report's (x left, y up, z forward, origin at the zero posture's tip);
-OpenHaptics' frame has frame s's axes and its origin at phantom_pin.drivers.openhaptics_origin
-(an ESTIMATE for the Touch: phantom_pin/drivers.py).
+OpenHaptics' frame has frame s's axes and its origin at phantom_pin.interfaces.conventions.openhaptics_origin
+(an ESTIMATE for the Touch: phantom_pin/interfaces/conventions.py).
 """
 
 from __future__ import annotations
@@ -26,8 +26,8 @@ from PIL import Image, ImageDraw, ImageFont
 
 from phantom_pin import config, describe, load, models
 from phantom_pin._validation import output_path
-from phantom_pin.drivers import openhaptics_origin
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.interfaces.conventions import openhaptics_origin
 from phantom_pin.viewer import CAMERA_POSITION, Viewer
 from phantom_pin.viewer.screenshot import screenshot
 

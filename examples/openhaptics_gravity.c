@@ -5,7 +5,7 @@
  * Against a real device: gcc -I $OH/include examples/openhaptics_gravity.c -L $OH/lib -lHD -lm
  *   -I robots/phantom_description/include -DPHANTOM_HEADER='"phantom_touch.h"'
  * Without one: phantom-pin --model touch openhaptics-sim build sim, then the same with
- *   -I sim/include -L sim/lib, and run with LD_LIBRARY_PATH=sim/lib (tests/interfaces/test_stand_in.py).
+ *   -I sim/include -L sim/lib, and run with LD_LIBRARY_PATH=sim/lib (tests/interfaces/openhaptics/test_stand_in.py).
  *
  * ./openhaptics_gravity [SECONDS] runs the loop that long (default 5) and prints the stylus's
  * start and end positions (mm, HD_CURRENT_POSITION). -DJOINT_TORQUE sends the compensation as

@@ -10,13 +10,14 @@ files), each Description from ``describe(name or folder, overrides=...)``. A Pha
 
 from importlib.metadata import PackageNotFoundError, version
 
-from phantom_pin import _moved, drivers
+from phantom_pin import _moved
 from phantom_pin.config import Config, models
 from phantom_pin.description.build import Description, describe
 from phantom_pin.device import Device, Feel, SimulationResult, feel, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.dynamics.loader import PhantomLoader, load, load_files
 from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.verification import check
 from phantom_pin.exceptions import (
     InvalidInputError,
     MissingDataError,
@@ -27,7 +28,6 @@ from phantom_pin.exceptions import (
 )
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
-from phantom_pin.verification import check
 
 _moved.install()    # the old paths of moved modules, for one release (CHANGELOG.md)
 
@@ -45,5 +45,5 @@ except PackageNotFoundError:  # a source tree on sys.path, not installed
 __all__ = ["__version__", "Phantom", "Device", "simulate", "feel", "Feel", "simulate_mujoco", "SimulationResult",
            "load", "load_files", "PhantomLoader", "Description", "describe", "check", "models", "Config",
            "ReportParameters", "closed_form",
-           "drivers", "PhantomPinError", "InvalidInputError", "ParameterFileError", "UnreachableTargetError",
+           "PhantomPinError", "InvalidInputError", "ParameterFileError", "UnreachableTargetError",
            "MissingDataError", "MissingDependencyError"]

@@ -50,13 +50,14 @@ class _Forward(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         module.__dir__ = lambda: dir(target)                        # type: ignore[method-assign]
         module.__doc__ = f"Moved to {target.__name__}.\n\n{target.__doc__ or ''}"
         if hasattr(target, "__all__"):
-            module.__all__ = list(target.__all__)
+            module.__dict__["__all__"] = list(target.__all__)
 
 
 def _importer_level() -> int:
     """warnings.warn's stacklevel of the frame that asked for the import (past importlib's own
     frames and this file's), so that Python's default filters show it in a user's script."""
-    frame, level = sys._getframe(1), 1
+    frame: types.FrameType | None = sys._getframe(1)
+    level = 1
     while frame is not None and (frame.f_code.co_filename.startswith("<frozen importlib")
                                  or frame.f_code.co_filename == __file__):
         frame, level = frame.f_back, level + 1

@@ -9,3 +9,5 @@ DESCRIPTION_DIR = next(
     (p for p in (_PACKAGE / "robots" / "phantom_description",
                  _PACKAGE.parent / "robots" / "phantom_description") if p.is_dir()),
     _PACKAGE.parent / "robots" / "phantom_description")
+#: The driver profiles: one YAML file per public ROS driver, named after its repository.
+PROFILES_DIR = DESCRIPTION_DIR / "config" / "drivers"

@@ -13,7 +13,7 @@ XACRO_ARGS (the xacro arguments that select the model: ``xacro XACRO_PATH *XACRO
 CONFIG_PATH (its YAML). The
 Touch, whose ROS drivers publish joint_states in their own convention, also has
 DRIVER_URDF_PATH (urdf/phantom_touch_driver.urdf: the same arm jointed as the older drivers' waist,
-shoulder, elbow, yaw, pitch, roll, phantom_pin.drivers.FIXED_CONVENTION, for
+shoulder, elbow, yaw, pitch, roll, phantom_pin.interfaces.conventions.FIXED_CONVENTION, for
 robot_state_publisher; phantom-pin urdf --convention driver; kinisi's and CalaW's drivers publish
 the waist with the other sign: docs/ros2.md).
 

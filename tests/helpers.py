@@ -5,15 +5,19 @@ a world point to its pixel with meshcat's camera (75 degrees vertical field of v
 the world origin, z up, from viewer.CAMERA_POSITION)."""
 
 import json
+import os
 import re
 import shutil
 import subprocess
+import sys
 from contextlib import redirect_stderr, redirect_stdout
 from io import StringIO
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pinocchio as pin
+import yaml
 from PIL import Image
 
 from phantom_pin import Phantom, config
@@ -202,7 +206,7 @@ AFFINE_TOLERANCE = 1e-5
 
 def svg_points(page: str, gid: str) -> np.ndarray:
     """The (x, y) vertices (SVG px) of the path in the group ``gid`` (M x y L x y ...) of a page
-    drawn by phantom_pin.plots."""
+    drawn by phantom_pin.viewer.plots."""
     group = re.search(rf'<g id="{re.escape(gid)}">\s*<path d="([^"]*)"', page)
     assert group is not None, gid
     return np.array([float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", group.group(1))]).reshape(-1, 2)
@@ -215,7 +219,7 @@ def affine(source: np.ndarray, image: np.ndarray) -> tuple[float, float, float]:
 
 
 def check_page(html: Path, tmp_path: Path, figures: int) -> str:
-    """A phantom_pin.plots page renders in chromium with something drawn, no console line and no
+    """A phantom_pin.viewer.plots page renders in chromium with something drawn, no console line and no
     request, holds no script, ``figures`` SVGs and no address but the SVG namespaces'; its text."""
     image, console, urls = browse(html, tmp_path / "page.png")
     assert console == [] and urls == []
@@ -258,3 +262,109 @@ def light_grey(pixels: np.ndarray) -> bool:
 
 def red(pixels: np.ndarray) -> bool:
     return bool(np.any((pixels[:, 0] > 140) & (pixels[:, 1] < 90) & (pixels[:, 2] < 90)))
+
+
+# -- shared by several test files (issue 51: no test file imports another's helpers) ---------
+
+#: The arm's actuated joints.
+ACTUATED = ("joint1", "joint2", "joint3")
+#: Fast DDS's discovery announcements for processes on loopback (the file says why).
+DISCOVERY = str(Path(__file__).with_name("fastdds_loopback.xml"))
+#: The scripts of examples/.
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def inside_stops(n: int, seed: int, pool: np.ndarray | None = None, config_dir: Path = CONFIG_DIR) -> np.ndarray:
+    """At most ``n`` seeded theta (rad), uniform in the URDF box and inside the coupled
+    stops of ``config_dir``'s joint_limits.yaml: the first of ``pool`` (default: 4 n seeded
+    states in the box) that are inside."""
+    limits = yaml.safe_load((config_dir / "joint_limits.yaml").read_text())
+    stops = limits["stops"]
+    if pool is None:
+        lower = [limits[j]["lower"] for j in ACTUATED]
+        upper = [limits[j]["upper"] for j in ACTUATED]
+        pool = np.random.default_rng(seed).uniform(lower, upper, (4 * n, 3))
+    keep = ((pool[:, 1] - pool[:, 2] <= stops["theta2_minus_theta3_max"])
+            & (pool[:, 2] - pool[:, 1] <= stops["theta3_minus_theta2_max"]))
+    return pool[keep][:n]
+
+
+class MujocoArm:
+    """A MuJoCo model with its joints addressed in the coupling's tree order."""
+
+    def __init__(self, model, coupling: object, case: object = None) -> None:
+        import mujoco  # the MuJoCo tests only
+
+        self.model, self.data, self.coupling, self.case = model, mujoco.MjData(model), coupling, case
+        names = [model.joint(i).name for i in range(model.njnt)]
+        assert sorted(names) == sorted(coupling.tree.names[1:])
+        self.qpos = [model.jnt_qposadr[names.index(n)] for n in coupling.tree.names[1:]]
+        self.dof = [model.jnt_dofadr[names.index(n)] for n in coupling.tree.names[1:]]
+
+    def set(self, theta: np.ndarray) -> None:
+        full = theta if self.case is None else self.case.full(theta)  # a model without a gimbal: theta
+        import mujoco
+
+        self.data.qpos[self.qpos] = self.coupling.configuration(full)
+        self.data.qvel[:] = 0
+        mujoco.mj_forward(self.model, self.data)
+
+    def reduced_mass_and_gravity(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        self.set(theta)
+        import mujoco
+
+        full = np.zeros((self.model.nv, self.model.nv))
+        mujoco.mj_fullM(self.model, self.data, full)
+        tree = full[np.ix_(self.dof, self.dof)]
+        G = self.coupling.matrix  # the arm's block: the gimbal held (locked) at rest
+        return (G.T @ tree @ G)[:3, :3], (G.T @ self.data.qfrc_bias[self.dof])[:3]  # bias at rest = gravity
+
+
+def ros_environment(domain: int | None = None) -> dict[str, str]:
+    """Loopback only, Fast DDS's discovery of DISCOVERY, and a ROS domain of this test run alone
+    (``domain``, else one from the process id)."""
+    return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "FASTDDS_DEFAULT_PROFILES_FILE": DISCOVERY,
+            "ROS_DOMAIN_ID": str(1 + os.getpid() % 100 if domain is None else domain), "PYTHONUNBUFFERED": "1"}
+
+
+def in_process(environment: dict[str, str]) -> None:
+    """This process's own nodes (rclpy in the test) in ``environment``'s domain and discovery."""
+    os.environ.update({k: v for k, v in environment.items() if k.startswith(("ROS_", "FASTDDS_"))})
+
+
+def stop_process(process: subprocess.Popen, sig: int) -> tuple[int, str]:
+    process.send_signal(sig)
+    try:
+        _, err = process.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+        raise AssertionError(f"the node did not stop on signal {sig}: {err}") from None
+    return process.returncode, err
+
+
+def run_script(script: str, out: Path, *argv: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, str(EXAMPLES / script), "--out", str(out), *argv],
+                          capture_output=True, text=True, timeout=300, env=env)
+
+
+def number(pattern: str, text: str) -> float:
+    match = re.search(pattern, text)
+    assert match, f"{pattern!r} not in the output:\n{text}"
+    return float(match.group(1))
+
+
+def figure(path: Path) -> None:
+    with Image.open(path) as image:
+        assert image.format == "PNG" and image.width >= 600 and image.height >= 400
+
+
+def message(profile: object) -> SimpleNamespace:
+    """An empty force message of the profile's type, as attributes (the ROS classes' layout)."""
+    vector = SimpleNamespace(x=0.0, y=0.0, z=0.0)
+    kind = profile.force.type.rsplit("/", 1)[1]
+    if kind == "Vector3":
+        return vector
+    if kind == "WrenchStamped":
+        return SimpleNamespace(header=SimpleNamespace(stamp=None), wrench=SimpleNamespace(force=vector))
+    return SimpleNamespace(force=vector)

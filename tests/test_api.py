@@ -58,7 +58,7 @@ def test_every_parameter_holding_a_phantom_device_or_description_has_its_role_na
 def test_the_entry_points_have_top_level_names():
     from phantom_pin.device.mujoco_plant import simulate_mujoco
     from phantom_pin.dynamics.loader import load_files
-    from phantom_pin.verification import check
+    from phantom_pin.dynamics.verification import check
 
     assert (phantom_pin.check, phantom_pin.simulate_mujoco, phantom_pin.load_files) == (check, simulate_mujoco,
                                                                                          load_files)

@@ -65,10 +65,11 @@ def test_the_import_graph_has_no_cycle():
 
 #: Every module's layer (DEVELOPERS.md, "Map of the package"), by the longest matching prefix
 #: of its name after ``phantom_pin.``: a module imports from its own layer or below only.
-LAYERS = {"exceptions": 0, "_validation": 0, "_blas": 0, "_paths": 0, "_integration": 0, "_progress": 0, "inertial": 0,
-          "report": 1, "config": 2, "description": 3, "dynamics": 4, "drivers": 4, "profiles": 4,
-          "device": 5, "verification": 5, "plots": 5, "identification": 6, "forces": 6, "codegen": 6,
-          "viewer": 6, "robot_descriptions": 6, "ros2": 7, "sim_driver": 7, "interfaces": 7, "cli": 8, "": 9}
+LAYERS = {"exceptions": 0, "_validation": 0, "_blas": 0, "_paths": 0, "_integration": 0, "_progress": 0, "_moved": 0,
+          "description.inertial": 0, "report": 1, "config": 2, "description": 3, "dynamics": 4,
+          "interfaces.conventions": 4, "interfaces.profiles": 4, "device": 5, "dynamics.verification": 5,
+          "viewer.plots": 5, "identification": 6, "interfaces.forces": 6, "codegen": 6, "viewer": 6,
+          "robot_descriptions": 6, "interfaces": 7, "cli": 8, "": 9}
 
 
 def _layer(name: str) -> int | None:

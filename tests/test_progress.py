@@ -38,7 +38,7 @@ def test_check_shows_progress_on_a_terminal_unless_quiet(capsys, monkeypatch):
     its report), and --quiet draws nothing."""
     monkeypatch.setattr(progress, "DELAY", 0.0)
     monkeypatch.setattr(progress, "INTERVAL", 0.0)
-    monkeypatch.setattr("phantom_pin.verification.CHUNK", 100)
+    monkeypatch.setattr("phantom_pin.dynamics.verification.CHUNK", 100)
     monkeypatch.setattr("sys.stderr.isatty", lambda: True, raising=False)
     assert main(["check", "-n", "500"]) == 0
     out, err = capsys.readouterr()

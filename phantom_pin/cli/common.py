@@ -15,12 +15,12 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from phantom_pin import plots
 from phantom_pin._validation import output_path, within_box
 from phantom_pin.config import DEFAULT, models, read_overrides
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
+from phantom_pin.viewer import plots
 
 #: The options that choose the model, accepted before or after the command (dest: option).
 MODEL_OPTIONS = {"model": "--model", "config": "--config", "params": "--params", "set": "--set"}
@@ -290,7 +290,7 @@ def positive_integer(text: str) -> int:
 
 
 def add_plot_option(parser: argparse.ArgumentParser, what: str) -> None:
-    """``--plot FILE``: one self-contained HTML page of ``what`` (phantom_pin.plots)."""
+    """``--plot FILE``: one self-contained HTML page of ``what`` (phantom_pin.viewer.plots)."""
     parser.add_argument("--plot", type=Path, metavar="FILE.html", action=Once,
                         help=f"also write {what} as one self-contained HTML page (matplotlib's SVG, no script; "
                              "needs the plots extra: pip install 'phantom_pin[plots]'); --force overwrites it")

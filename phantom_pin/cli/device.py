@@ -12,7 +12,6 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import plots
 from phantom_pin._progress import Progress
 from phantom_pin._validation import fixed_rate
 from phantom_pin.cli.common import (
@@ -35,6 +34,7 @@ from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import io
+from phantom_pin.viewer import plots
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization", "gimbal")} | {

@@ -8,11 +8,11 @@ import sys
 
 import numpy as np
 
-from phantom_pin import plots
 from phantom_pin.cli.common import add_plot_option, phantom, plot_target, show, vector, write_texts
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.device import Device
 from phantom_pin.device.feel import DEFAULT_SPEED, Feel, feel
+from phantom_pin.viewer import plots
 
 #: The library's argument names and the options that give them (PhantomPinError.argument).
 OPTIONS = {"theta": "--theta", "speed": "--speed"}

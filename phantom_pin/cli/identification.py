@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import drivers, plots, profiles
 from phantom_pin._progress import Progress
 from phantom_pin.cli.common import (
     Once,
@@ -31,8 +30,10 @@ from phantom_pin.identification import page as identification_page
 from phantom_pin.identification.overlays import identified_keys
 from phantom_pin.identification.result import Identification, RefusedError, identify, refusal, write_yaml
 from phantom_pin.identification.structures import General
+from phantom_pin.interfaces import conventions, profiles
+from phantom_pin.viewer import plots
 
-#: The conventions of the CSV columns (phantom_pin.drivers).
+#: The conventions of the CSV columns (phantom_pin.interfaces.conventions).
 CONVENTIONS = ("report", "openhaptics")
 #: Fewest samples per cycle of the excitation's highest harmonic that excite writes.
 MIN_SAMPLES_PER_HARMONIC = 20
@@ -242,8 +243,8 @@ def excite_command(args: argparse.Namespace) -> int:
     effort = excitation.continuous_effort(made)
     page = None if plot is None else _plot(args, made, result, (t, theta, dtheta, tau), effort)
     if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
-        theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
-        tau = drivers.openhaptics_torque_from_tau(tau)
+        theta, dtheta, ddtheta = (conventions.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
+        tau = conventions.openhaptics_torque_from_tau(tau)
     files = [(args.output, csv_text(list(io.TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
                                     made.config.name, args.convention), "--output")]
     write_texts(files + ([] if plot is None or page is None else [(plot, page, "--plot")]))  # all or none

@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 
-from phantom_pin import verification
 from phantom_pin._progress import Progress
 from phantom_pin._validation import within_box
 from phantom_pin.cli import device
@@ -33,6 +32,7 @@ from phantom_pin.cli.common import (
 )
 from phantom_pin.config.types import Gimbal
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
+from phantom_pin.dynamics import verification
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import LogError, PhantomPinError
@@ -97,7 +97,7 @@ def _gimbal_info(robot: Phantom, gimbal: Gimbal) -> tuple[dict[str, Any], list[s
 
 
 def check(args: argparse.Namespace) -> int:
-    """phantom_pin.verification.check(), printed: exit code 1 when a comparison fails."""
+    """phantom_pin.dynamics.verification.check(), printed: exit code 1 when a comparison fails."""
     bar = Progress("check", args.n, enabled=False if args.quiet else None)
     try:
         report = verification.check(phantom(args), args.n, args.seed, progress=bar.update)

@@ -1,5 +1,5 @@
-"""``phantom-pin ros2`` (the node of phantom_pin.ros2) and ``phantom-pin sim-driver`` (a
-simulated driver, phantom_pin.sim_driver): the ``ros2`` extra."""
+"""``phantom-pin ros2`` (the node of phantom_pin.interfaces.ros2.node) and ``phantom-pin sim-driver`` (a
+simulated driver, phantom_pin.interfaces.ros2.simulated_driver): the ``ros2`` extra."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import argparse
 import dataclasses
 import math
 
-from phantom_pin import profiles
 from phantom_pin.cli.common import description, overrides
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import MissingDataError, PhantomPinError
+from phantom_pin.interfaces import profiles
 
 #: --compensate's choices and the terms each compensates.
 COMPENSATE = {"gravity": ("gravity",), "gravity,friction": ("gravity", "friction"),
@@ -22,7 +22,7 @@ KAPPA = 0.6
 def _topics(items: list[str]) -> dict[str, str]:
     """--topic ROLE=NAME items as a mapping; PhantomPinError naming --topic otherwise (an
     unknown role, a role given twice, two roles on one topic)."""
-    from phantom_pin.ros2 import TOPICS
+    from phantom_pin.interfaces.ros2.node import TOPICS
 
     topics: dict[str, str] = {}
     for item in items:
@@ -62,7 +62,7 @@ def _max_force(text: str) -> float:
 def ros2(args: argparse.Namespace) -> int:
     """Check everything the node needs, then spin it until SIGINT or SIGTERM."""
     _rclpy()
-    from phantom_pin import ros2 as node
+    from phantom_pin.interfaces.ros2 import node
 
     topics = _topics(args.topic)
     robot = Phantom(description(args, prefix=args.prefix))  # refused before ROS starts
@@ -91,9 +91,9 @@ def ros2(args: argparse.Namespace) -> int:
 def sim_driver(args: argparse.Namespace) -> int:
     """Check everything the simulated driver needs, then run it until SIGINT or SIGTERM."""
     _rclpy()
-    from phantom_pin import sim_driver as simulated
     from phantom_pin.device.device import Device
-    from phantom_pin.ros2 import message_type
+    from phantom_pin.interfaces.ros2 import simulated_driver as simulated
+    from phantom_pin.interfaces.ros2.node import message_type
 
     profile = profiles.load(args.driver)
     probe = description(args)

@@ -1,4 +1,4 @@
-"""The header's functions in OpenHaptics' terms (phantom_pin.drivers' conventions): the angles'
+"""The header's functions in OpenHaptics' terms (phantom_pin.interfaces.conventions' conventions): the angles'
 and joint torques' maps, and the compensation that a servo callback sends, HD_CURRENT_FORCE (N)
 or HD_CURRENT_JOINT_TORQUE (mN m) of the angles that HD_CURRENT_JOINT_ANGLES and
 HD_CURRENT_GIMBAL_ANGLES give, optionally with the friction law at the caller's rates."""
@@ -22,7 +22,7 @@ _SOLVE = """    double J[9], det;
 
 
 def openhaptics(prefix: str, body: dict[str, str], has_gimbal: bool) -> str:
-    """OpenHaptics' conventions (phantom_pin.drivers): angles theta = (-a1, a2, a3);
+    """OpenHaptics' conventions (phantom_pin.interfaces.conventions): angles theta = (-a1, a2, a3);
     HD_CURRENT_JOINT_TORQUE (mN m) = 1000 (-tau1, tau2, tau3); and the compensation in the servo
     loop's own terms: HD_CURRENT_FORCE (N) or HD_CURRENT_JOINT_TORQUE (mN m) of the angles
     HD_CURRENT_JOINT_ANGLES and HD_CURRENT_GIMBAL_ANGLES give, optionally with friction."""
@@ -35,11 +35,12 @@ def openhaptics(prefix: str, body: dict[str, str], has_gimbal: bool) -> str:
              "differences); the friction law in motion of the model is added (viscous and Coulomb, 0 at rest).")
     parts = [
         _function("The report's theta (rad) of OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad): (-a1, a2, a3)\n"
-                  "(phantom_pin.drivers.theta_from_openhaptics).",
+                  "(phantom_pin.interfaces.conventions.theta_from_openhaptics).",
                   f"{p}_theta_from_openhaptics(const double angles[3], double theta[3])",
                   "    theta[0] = -angles[0];\n    theta[1] = angles[1];\n    theta[2] = angles[2];"),
         _function("OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau\n"
-                  "(N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau),\n"
+                  "(N m on theta): 1000 (-tau1, tau2, tau3)\n"
+                  "(phantom_pin.interfaces.conventions.openhaptics_torque_from_tau),\n"
                   "each torque acting on its own OpenHaptics angle (SensAble's CommandJointTorque sample\n"
                   "renders a restoring joint spring T = k (0 - a), k > 0, on that reading: docs/servo-loop.md).",
                   f"{p}_openhaptics_torque_from_tau(const double tau[3], double torque[3])",

@@ -21,7 +21,7 @@ from phantom_pin.config.types import (
     Scene,
     Stops,
 )
-from phantom_pin.inertial import Inertial
+from phantom_pin.description.inertial import Inertial
 
 __all__ = ["read", "MODEL_KEY", "Config", "Inertial", "models", "Model", "MODELS", "DEFAULT", "FILES", "read_overrides",
            "Actuation", "CoupledStops", "Encoder", "Friction", "Kinematics", "Limits", "Motor",

@@ -36,7 +36,7 @@ from phantom_pin.config.types import (
     Stops,
     freeze,
 )
-from phantom_pin.inertial import INERTIA_KEYS, Vector3, carve, problem, tensor6, uncarve, vector3
+from phantom_pin.description.inertial import INERTIA_KEYS, Vector3, carve, problem, tensor6, uncarve, vector3
 from phantom_pin.report.parameters import ReportParameters, Unprinted
 from phantom_pin.report.parameters import links as report_links
 

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from phantom_pin.description.inertial import Inertial, vector3
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.inertial import Inertial, vector3
 from phantom_pin.report.parameters import ReportParameters, Unprinted
 
 JOINTS = ("joint1", "joint2", "joint3")
@@ -279,7 +279,7 @@ class Gimbal:
     those links are computed from and drawn as (read-only YAML data, m); ``openhaptics_shoulder``:
     the shoulder (the joint-1/joint-2 axes' intersection) in OpenHaptics' coordinates (m; an
     ESTIMATE for the Touch), where HD_CURRENT_TRANSFORM's translation puts it
-    (phantom_pin.drivers.openhaptics_origin)."""
+    (phantom_pin.interfaces.conventions.openhaptics_origin)."""
 
     lower: tuple[float, float, float]
     upper: tuple[float, float, float]

@@ -52,7 +52,7 @@ def locked(urdf_xml: str, prefix: str, angles: Sequence[float]) -> str:
 def arm_only(description: Description) -> Description:
     """``description`` without its stylus gimbal: the URDF's subtree from joint4 down removed
     (the gimbal's joints, links and the stylus frames) and ``config.gimbal`` None; the arm the
-    report's closed form describes (phantom_pin.verification checks it). A description without
+    report's closed form describes (phantom_pin.dynamics.verification checks it). A description without
     a gimbal is returned as it is."""
     config = description.config
     if config.gimbal is None:

@@ -1,5 +1,5 @@
 """Physical validity of a URDF document: every <inertial> passes the one physical check of a
-link (phantom_pin.inertial.problem), every primitive has positive sizes.
+link (phantom_pin.description.inertial.problem), every primitive has positive sizes.
 
 describe() checks the links of a configuration before xacro runs (naming the parameter
 keys) and the URDF xacro generated after; load() checks a URDF file it is given.
@@ -10,9 +10,9 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 
+from phantom_pin.description.inertial import Inertial, problem, tensor6, vector3
 from phantom_pin.description.urdf import parse
 from phantom_pin.exceptions import ParameterFileError
-from phantom_pin.inertial import Inertial, problem, tensor6, vector3
 
 #: Attributes of each URDF primitive that are sizes (m).
 _SIZES = {"cylinder": ("radius", "length"), "sphere": ("radius",), "box": ("size",)}
@@ -56,7 +56,7 @@ def _check_geometry(source: str, link: str, element: ET.Element) -> None:
 def check_urdf(urdf_xml: str, source: str = "URDF") -> None:
     """Raise ParameterFileError (naming ``source``, the link and the problem) unless the URDF
     is physical: every <inertial> has an origin without rotation and six finite numbers
-    that pass phantom_pin.inertial.problem (positive mass, positive definite inertia at
+    that pass phantom_pin.description.inertial.problem (positive mass, positive definite inertia at
     the centre of mass, the triangle inequality with MuJoCo's margin); every <cylinder>
     radius and length, <box> size and <sphere> radius is finite and > 0 (m).
     Links without <inertial> (pure frames) are accepted.

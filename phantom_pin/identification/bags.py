@@ -1,5 +1,5 @@
 """A driver's rosbag2 recording (sqlite3 or mcap, read with ``rosbags``: no ROS install) as a
-device log: the JointState topic of a driver profile (phantom_pin.profiles), its positions and
+device log: the JointState topic of a driver profile (phantom_pin.interfaces.profiles), its positions and
 efforts in that profile's conventions and units, at the messages' header stamps.
 
 The drivers that publish efforts publish OpenHaptics' joint torques (mN m, on OpenHaptics' joint
@@ -21,10 +21,10 @@ from typing import Any
 
 import numpy as np
 
-from phantom_pin import drivers, profiles
 from phantom_pin._validation import uneven
 from phantom_pin.exceptions import LogError, MissingDataError
 from phantom_pin.identification.io import MIN_DURATION, RATE_TOLERANCE, Log
+from phantom_pin.interfaces import conventions, profiles
 
 __all__ = ["Recording", "read_bag", "is_bag"]
 
@@ -177,7 +177,7 @@ def _recording(messages: list, profile: profiles.Profile, topic: str) -> Recordi
     t, q, e = t[keep], q[keep], e[keep]
     t, q, e, resampled = _uniform(t, q, e, topic)
     theta = np.array([profile.arm_from_state(row) for row in q[:, :3].tolist()])
-    tau = drivers.tau_from_openhaptics_torque(e[:, :3])             # mN m on OpenHaptics' angles
+    tau = conventions.tau_from_openhaptics_torque(e[:, :3])             # mN m on OpenHaptics' angles
     gimbal = np.array([profile.gimbal_from_state(row) for row in q[:, 3:].tolist()])
     return Recording(Log(t, theta, tau), gimbal, profile.name, topic, len(messages), int((~keep).sum()),
                      reordered, resampled)

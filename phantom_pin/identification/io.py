@@ -5,7 +5,7 @@ quoted or with units in [] as simulate writes them; separated by commas, semicol
 a UTF-8 byte order mark, blank lines and # comment lines are skipped): time
 (s) at a fixed rate, joint angles (rad, the report's theta, as measured) and joint torques
 (N m, as commanded); or, in OpenHaptics' convention (``read_log(path, "openhaptics")``), its
-joint angles (rad) and joint torques (mN m), converted by phantom_pin.drivers. ``read_log``
+joint angles (rad) and joint torques (mN m), converted by phantom_pin.interfaces.conventions. ``read_log``
 raises LogError with one line on a malformed log.
 """
 
@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin import drivers
 from phantom_pin._validation import as_states, fixed_rate, output_path, uneven
 from phantom_pin.exceptions import LogError
+from phantom_pin.interfaces import conventions
 
 LOG_COLUMNS = ("t", "theta1", "theta2", "theta3", "tau1", "tau2", "tau3")
 TRAJECTORY_COLUMNS = ("t", "theta1", "theta2", "theta3", "dtheta1", "dtheta2", "dtheta3",
@@ -188,8 +188,8 @@ def read_trajectory(path: Path | str, convention: str = "report") -> tuple[np.nd
     _consistent(path, "theta", "dtheta", t, theta, dtheta)
     _consistent(path, "dtheta", "ddtheta", t, dtheta, ddtheta)
     if convention == "openhaptics":
-        theta, dtheta, ddtheta = (drivers.theta_from_openhaptics(x) for x in (theta, dtheta, ddtheta))
-        tau = drivers.tau_from_openhaptics_torque(tau)
+        theta, dtheta, ddtheta = (conventions.theta_from_openhaptics(x) for x in (theta, dtheta, ddtheta))
+        tau = conventions.tau_from_openhaptics_torque(tau)
     return t, theta, dtheta, ddtheta, tau
 
 
@@ -250,7 +250,7 @@ def read_log(path: Path | str, convention: str = "report") -> Log:
     theta = np.column_stack([column[f"theta{j}"] for j in (1, 2, 3)])
     tau = np.column_stack([column[f"tau{j}"] for j in (1, 2, 3)])
     if convention == "openhaptics":
-        theta, tau = drivers.theta_from_openhaptics(theta), drivers.tau_from_openhaptics_torque(tau)
+        theta, tau = conventions.theta_from_openhaptics(theta), conventions.tau_from_openhaptics_torque(tau)
     return Log(t, theta, tau)
 
 

@@ -1,4 +1,4 @@
-"""identify --report: one self-contained HTML page of an Identification (phantom_pin.plots:
+"""identify --report: one self-contained HTML page of an Identification (phantom_pin.viewer.plots:
 matplotlib's inline SVG, no script, nothing fetched). What a lab looks at: the measured and
 predicted joint torques over time, the held-out check (the predicted torques over seeded states
 inside the stops, which the log never visited), the torque left to friction and the residual
@@ -16,10 +16,10 @@ import html
 
 import numpy as np
 
-from phantom_pin import plots
 from phantom_pin.identification.fit import Curves
 from phantom_pin.identification.prediction import STATES
 from phantom_pin.identification.result import Identification, gain_lines, timing_lines
+from phantom_pin.viewer import plots
 
 #: Colour of the predicted torques and of the friction law (the measured ones take the joint's).
 PREDICTED = "#222222"

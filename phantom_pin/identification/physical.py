@@ -9,7 +9,7 @@ form a convex set, and the nearest of them to an estimate in any quadratic metri
 problem: ``nearest`` solves it by a log-det barrier (interior point) method whose Newton steps
 do not mind the metric's conditioning (the torques fix some combinations to 1e-8 and leave
 others to a prior). The decision stays with the one physical check of a link
-(phantom_pin.inertial.problem), which asks a margin of TRIANGLE_SLACK inside the boundary; the
+(phantom_pin.description.inertial.problem), which asks a margin of TRIANGLE_SLACK inside the boundary; the
 barrier keeps a margin of its own that implies it (``margined``), so that its optimum passes the
 check by construction.
 """
@@ -21,9 +21,9 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from phantom_pin.config import Config
+from phantom_pin.description.inertial import TRIANGLE_SLACK, problem
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import parameterization
-from phantom_pin.inertial import TRIANGLE_SLACK, problem
 from phantom_pin.report.parameters import links
 
 #: The barrier method's end: the duality gap (in units of the whitened cost, a chi-square). The
@@ -51,7 +51,7 @@ MARGIN = TRIANGLE_SLACK
 
 def consistent(x: np.ndarray, config: Config) -> bool:
     """True if the report parameters ``x`` give links (report.parameters.links, as describe()
-    computes them from the written overlay) that all pass phantom_pin.inertial.problem, with
+    computes them from the written overlay) that all pass phantom_pin.description.inertial.problem, with
     positive masses and rotor inertia x[ROTOR] (zero, without public motor data: Actuation.rotor)."""
     x = np.asarray(x, float)
     rotor = x[parameterization.ROTOR]

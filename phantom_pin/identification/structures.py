@@ -15,7 +15,7 @@ in N m) and the base parameters the joint torques determine, beta = matrix x + o
   eight constants (constants.NAMES) and friction. Written as the report's keys; only for a
   model in the report's form.
 
-Each structure's physical check of x is the one of a link (phantom_pin.inertial.problem on
+Each structure's physical check of x is the one of a link (phantom_pin.description.inertial.problem on
 every link the overlay gives), with J > 0 for a model with a motor and friction >= 0.
 """
 
@@ -26,13 +26,13 @@ import dataclasses
 import numpy as np
 
 from phantom_pin.config.types import BODIES
+from phantom_pin.description.inertial import INERTIA_KEYS, Inertial, carve, problem, uncarve
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import constants, parameterization, physical
 from phantom_pin.identification.base import base_parameters, sample, words
 from phantom_pin.identification.cache import cached
 from phantom_pin.identification.regressor import INERTIAL_NAMES, Regressor
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, carve, problem, uncarve
 
 FRICTION = constants.FRICTION_NAMES
 #: The unit of each standard parameter (INERTIAL_NAMES order).

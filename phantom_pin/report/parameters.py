@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from phantom_pin.inertial import Inertial, carve
+from phantom_pin.description.inertial import Inertial, carve
 
 
 @dataclasses.dataclass(frozen=True)

@@ -296,8 +296,8 @@ def test_check_draws_and_evaluates_in_chunks(monkeypatch, cli):
     def spy(limits, n, seed):
         sizes.append(n)
         return random_states(limits, n, seed)
-    monkeypatch.setattr("phantom_pin.verification.CHUNK", 7)
-    monkeypatch.setattr("phantom_pin.verification.random_states", spy)
+    monkeypatch.setattr("phantom_pin.dynamics.verification.CHUNK", 7)
+    monkeypatch.setattr("phantom_pin.dynamics.verification.random_states", spy)
     report = json.loads(cli("check", "-n", "250", "--json")[1])
     assert sizes == [7] * 35 + [5] and report["passed"] and report["states"] == 250
 

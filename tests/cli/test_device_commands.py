@@ -95,8 +95,9 @@ def test_simulate_warns_once_when_it_starts_inside_a_stop(capsys):
 def _trajectory(path, degrees=(), milliseconds=False, openhaptics=False):
     """A smooth 3 s trajectory inside the stops at 1 kHz with its exact derivatives and the
     report model's torque (N m), written as excite writes it; optionally with a unit slip."""
-    from phantom_pin import Phantom, drivers
+    from phantom_pin import Phantom
     from phantom_pin.identification import io
+    from phantom_pin.interfaces import conventions
 
     t = np.arange(3001) / 1000.0
     w = 2 * np.pi / 3.0
@@ -107,8 +108,8 @@ def _trajectory(path, degrees=(), milliseconds=False, openhaptics=False):
     ddtheta = amplitude * (-w**2 * np.sin(w * t) + 2 * w**2 * np.sin(2 * w * t))[:, None] / 2
     tau = Phantom().inverse_dynamics(theta, dtheta, ddtheta)
     if openhaptics:
-        theta, dtheta, ddtheta = (drivers.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
-        tau = drivers.openhaptics_torque_from_tau(tau)
+        theta, dtheta, ddtheta = (conventions.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
+        tau = conventions.openhaptics_torque_from_tau(tau)
     columns = {"theta": theta, "dtheta": dtheta, "ddtheta": ddtheta}
     for name in degrees:
         columns[name] = np.degrees(columns[name])

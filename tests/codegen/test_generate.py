@@ -162,7 +162,7 @@ def test_the_stylus_pose_matches_phantom_and_pinocchio_on_the_touch_urdf(tmp_pat
 
 def test_openhaptics_helpers_follow_the_published_conventions(tmp_path):
     """The header's OpenHaptics conversions against the published conventions written out here,
-    not against phantom_pin.drivers (the same convention twice). Angles: Ubitrack/
+    not against phantom_pin.interfaces.conventions (the same convention twice). Angles: Ubitrack/
     component_haptic_calibration's PhantomForwardKinematics.h lines 101-103 put the tip of
     OpenHaptics' angles a at x = -(l1 c2 + l2 s3) s1, y = l1 s2 - l2 c3 + l2, z = -l1 + (l1 c2 +
     l2 s3) c1 (l1 = l2 = 133.35 mm, its default): the header's tip at theta_from_openhaptics(a)
@@ -327,11 +327,11 @@ def test_the_servo_loop_functions_compensate_gravity_and_friction(name, tmp_path
     """NAME_openhaptics_force and _joint_torque (and their _friction forms), compiled strictly,
     on 200 seeded states inside the stops (the Touch's gimbal inside its ranges, OpenHaptics'
     angles a = (-theta1, theta2, theta3)): J^T F and the joint torques on theta equal the
-    gravity of references independent of Phantom (tests/openhaptics_reference.py: the closed
+    gravity of references independent of Phantom (tests/references/openhaptics.py: the closed
     form, the CAD's re-derivation, the Touch's six-joint URDF in Pinocchio) to 1e-9 N m, plus the
     friction law (actuation.yaml's numbers) at the rates given; NAME_STYLUS says whether the
     model has a gimbal."""
-    from openhaptics_reference import gravity_and_jacobian
+    from references.openhaptics import gravity_and_jacobian
     text = generated(name)
     library = build(text, tmp_path, SERVO_SHIM)
     config = describe(name).config

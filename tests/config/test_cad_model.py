@@ -1,5 +1,5 @@
 """The configuration premium_1_5_cad (mahilab/Phantom's CAD mass properties) against an
-independent SymPy derivation in mahilab's own DH frames (tests/cad_reference.py), at seeded
+independent SymPy derivation in mahilab's own DH frames (tests/references/cad.py), at seeded
 states inside the stops: (a) a numeric model built by hand in Pinocchio from the YAML of
 robots/phantom_description/config/premium_1_5_cad, (b) phantom_pin.Phantom.from_model("premium_1_5_cad")."""
 
@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 import yaml
 
-from cad_reference import gravity, mass_matrix
+from references.cad import gravity, mass_matrix
 
 FOLDER = Path(__file__).resolve().parents[2] / "robots/phantom_description/config/premium_1_5_cad"
 JOINTS = ("joint1", "joint2", "joint3")
@@ -114,9 +114,9 @@ def test_the_cad_mjcf_in_mujoco_matches_the_reference(reference):
     """(c) MuJoCo's reading of the committed MJCF (armature, gravity 9.80665 m/s^2 as an option)."""
     import mujoco
 
+    from helpers import MujocoArm
     from phantom_pin.config import MODELS
     from phantom_pin.dynamics.coupling import Coupling
-    from test_interop import MujocoArm
 
     model = MODELS["premium_1_5_cad"]
     arm = MujocoArm(mujoco.MjModel.from_xml_path(str(model.mjcf)), Coupling(model.urdf.read_text()))

@@ -1,4 +1,4 @@
-"""The model touch: its ESTIMATED inertias against the stated geometry (tests/touch_reference.py),
+"""The model touch: its ESTIMATED inertias against the stated geometry (tests/references/touch.py),
 its torque limits against CHAI3D's force, what a model without public motor data does and
 refuses, and the identification of a simulated Touch through OpenHaptics' joint torques."""
 
@@ -13,8 +13,6 @@ import pytest
 import yaml
 import yourdfpy
 
-import touch_reference
-from gimbal_reference import gimbal_gravity, gimbal_mass_matrix
 from helpers import run_cli
 from phantom_pin import (
     Device,
@@ -24,7 +22,6 @@ from phantom_pin import (
     closed_form,
     config,
     describe,
-    drivers,
     simulate,
 )
 from phantom_pin.cli import main
@@ -32,6 +29,9 @@ from phantom_pin.config import MODELS, read_overrides
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.identification import io, simulation
 from phantom_pin.identification import parameterization as pz
+from phantom_pin.interfaces import conventions
+from references import touch as touch_reference
+from references.gimbal import gimbal_gravity, gimbal_mass_matrix
 
 #: config/touch/gimbal.yaml's locked_at: the gimbal angles (rad) the arm's dynamics hold it at
 LOCKED = np.array(yaml.safe_load((MODELS["touch"].config / "gimbal.yaml").read_text())["locked_at"], float)
@@ -198,8 +198,8 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     assert run_cli("--model", "touch", "excite", "-o", tmp_path / "traj.csv", "--duration", "10",
                    "--iterations", "15", "--restarts", "1", "--convention", "openhaptics")[0] == 0
     table = np.loadtxt(tmp_path / "traj.csv", delimiter=",", skiprows=1)
-    t, theta, dtheta, tau = table[:, 0], *(drivers.theta_from_openhaptics(table[:, k:k + 3]) for k in (1, 4)), \
-        drivers.tau_from_openhaptics_torque(table[:, 10:13])
+    t, theta, dtheta, tau = table[:, 0], *(conventions.theta_from_openhaptics(table[:, k:k + 3]) for k in (1, 4)), \
+        conventions.tau_from_openhaptics_torque(table[:, 10:13])
     x = np.array([getattr(truth, s) for s in ("ma", "Iaxx", "Iayy", "Iazz", "mc", "Icxx", "Icyy", "Iczz", "mbe")]
                  + [truth.mbe * truth.l5] + [getattr(truth, s) for s in ("Ibexx", "Ibeyy", "Ibezz", "mdf")]
                  + [truth.mdf * truth.l6] + [getattr(truth, s) for s in ("Idfxx", "Idfyy", "Idfzz", "Ibaseyy")] + [0.0])
@@ -210,8 +210,8 @@ def test_a_simulated_touch_is_identified_through_openhaptics_joint_torques(tmp_p
     np.testing.assert_allclose(closed_form.mass_matrix(theta[::500], truth) + stylus_mass(theta[::500]),
                                device.phantom.mass_matrix(theta[::500]), rtol=0, atol=1e-12)  # the device is the truth
     io.write_csv(tmp_path / "log.csv", io.LOG_COLUMNS,
-                 np.column_stack([log.t, drivers.openhaptics_from_theta(log.theta),
-                                  drivers.openhaptics_torque_from_tau(log.tau)]))
+                 np.column_stack([log.t, conventions.openhaptics_from_theta(log.theta),
+                                  conventions.openhaptics_torque_from_tau(log.tau)]))
     assert run_cli("--model", "touch", "identify", tmp_path / "log.csv", "-o", tmp_path / "id.yaml",
                    "--convention", "openhaptics")[0] == 0
     overlay = read_overrides(tmp_path / "id.yaml")

@@ -16,9 +16,9 @@ import pinocchio as pin
 import yaml
 import yourdfpy
 
-import driver_reference
 from phantom_pin.config import MODELS
 from phantom_pin.description.build import driver_urdf
+from references import driver as driver_reference
 
 DRIVER_URDF = MODELS["touch"].urdf.with_name("phantom_touch_driver.urdf")
 TOUCH = MODELS["touch"].config

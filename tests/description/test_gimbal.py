@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 import yaml
 
-import touch_reference
-from gimbal_reference import H, gimbal_gravity, gimbal_mass_matrix, openhaptics, step, ubitrack
 from helpers import CONFIG_DIR
-from phantom_pin import InvalidInputError, ParameterFileError, Phantom, config, drivers
+from phantom_pin import InvalidInputError, ParameterFileError, Phantom, config
+from phantom_pin.interfaces import conventions
 from phantom_pin.report import closed_form
+from references import touch as touch_reference
+from references.gimbal import H, gimbal_gravity, gimbal_mass_matrix, openhaptics, step, ubitrack
 
 TOUCH = CONFIG_DIR.parent / "touch"
 GIMBAL_YAML = yaml.safe_load((TOUCH / "gimbal.yaml").read_text())
@@ -176,22 +177,22 @@ def test_the_drivers_gimbal_conventions():
     yaw = -g1 + pi, pitch = -g2 - 3 pi / 4, roll = -g3 - pi (omni_state.cpp lines 188-193),
     written here independently; rates carry no offsets."""
     _, gimbal = states(10, seed=8)
-    names, raw = drivers.joint_state_from_gimbal(gimbal, prefix="left_")
+    names, raw = conventions.joint_state_from_gimbal(gimbal, prefix="left_")
     assert names == ["left_yaw", "left_pitch", "left_roll"] and np.array_equal(raw, gimbal)
-    _, omni = drivers.joint_state_from_gimbal(gimbal, convention="omni_firewire")
+    _, omni = conventions.joint_state_from_gimbal(gimbal, convention="omni_firewire")
     expected = np.stack([-gimbal[:, 0] + np.pi, -gimbal[:, 1] - 3 * np.pi / 4, -gimbal[:, 2] - np.pi], axis=1)
     assert np.abs(omni - expected).max() < 1e-15
     shuffled = ["roll", "waist", "pitch", "yaw"]
     position = np.stack([omni[:, 2], np.zeros(10), omni[:, 1], omni[:, 0]], axis=1)
-    back = drivers.gimbal_from_joint_state(shuffled, position, convention="omni_firewire")
+    back = conventions.gimbal_from_joint_state(shuffled, position, convention="omni_firewire")
     assert np.abs(back - gimbal).max() < 1e-14
-    _, rates = drivers.joint_state_from_gimbal(gimbal, convention="omni_firewire", rates=True)
+    _, rates = conventions.joint_state_from_gimbal(gimbal, convention="omni_firewire", rates=True)
     assert np.array_equal(rates, -gimbal)
     with pytest.raises(InvalidInputError) as error:
-        drivers.gimbal_from_joint_state(["yaw", "pitch"], [0, 0])
+        conventions.gimbal_from_joint_state(["yaw", "pitch"], [0, 0])
     assert error.value.argument == "names"
     with pytest.raises(InvalidInputError) as error:
-        drivers.joint_state_from_gimbal(gimbal, convention="omni")
+        conventions.joint_state_from_gimbal(gimbal, convention="omni")
     assert error.value.argument == "convention"
 
 
@@ -204,20 +205,20 @@ def test_hd_current_transform_is_the_stylus_pose_column_major_in_mm(touch):
     origin = np.array(GIMBAL_YAML["openhaptics_shoulder"]) - [0, kinematics["l2"], -kinematics["l1"]]
     theta, gimbal = states(5, seed=9)
     pose = touch.stylus_pose(theta[0], gimbal[0])
-    flat = drivers.openhaptics_transform_from_pose(pose)
+    flat = conventions.openhaptics_transform_from_pose(pose)
     assert np.array_equal(flat[0:3], pose[:3, 0]) and np.array_equal(flat[4:7], pose[:3, 1])
     assert np.allclose(flat[12:15], (pose[:3, 3] + origin) * 1000, rtol=1e-14) and flat[15] == 1 and flat[3] == 0
-    at_zero = drivers.openhaptics_transform_from_pose(pose, origin=np.zeros(3))
+    at_zero = conventions.openhaptics_transform_from_pose(pose, origin=np.zeros(3))
     assert np.allclose(at_zero[12:15], pose[:3, 3] * 1000, rtol=1e-15)
-    back = drivers.pose_from_openhaptics_transform(flat)
+    back = conventions.pose_from_openhaptics_transform(flat)
     assert np.abs(back - pose).max() < 1e-15
-    batch = drivers.pose_from_openhaptics_transform(drivers.openhaptics_transform_from_pose(
+    batch = conventions.pose_from_openhaptics_transform(conventions.openhaptics_transform_from_pose(
         touch.stylus_pose(theta, gimbal)))
     assert batch.shape == (5, 4, 4)
     skewed = flat.copy()
     skewed[0] *= 1.1
     with pytest.raises(InvalidInputError) as error:
-        drivers.pose_from_openhaptics_transform(skewed)
+        conventions.pose_from_openhaptics_transform(skewed)
     assert error.value.argument == "transform"
 
 

@@ -13,9 +13,9 @@ from phantom_pin import ParameterFileError, Phantom
 from phantom_pin.cli import main
 from phantom_pin.config import MODELS
 from phantom_pin.config.files import FILES, apply_overrides, read_documents
+from phantom_pin.description.inertial import TRIANGLE_SLACK
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics.loader import PhantomLoader, load_files
-from phantom_pin.inertial import TRIANGLE_SLACK
 
 #: Overrides that write a non-physical link (the issue's list), and the link they break.
 NON_PHYSICAL = [
@@ -72,7 +72,7 @@ def test_shipped_urdf_and_pure_frames_pass():
 def test_triangle_inequality_at_its_stated_tolerance():
     """A thin rod 1e-9 relative inside the triangle boundary (a + b - c = 1e-9 c) passes, and
     so does one only 2 TRIANGLE_SLACK inside; one on the boundary (c = a + b, which MuJoCo
-    may refuse after rounding: tests/test_inertial.py), 1e-10 past it (which the former law,
+    may refuse after rounding: tests/description/test_inertial.py), 1e-10 past it (which the former law,
     c - (a + b) <= 1e-9 c, accepted) or 1e-6 past it fails; rotating the tensor
     (off-diagonal terms) does not change the verdict."""
     assert TRIANGLE_SLACK == 1e-12

@@ -12,9 +12,9 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+from helpers import inside_stops
 from phantom_pin._paths import DESCRIPTION_DIR
 from phantom_pin.config import MODELS, models
-from test_interop import inside_stops
 
 
 @pytest.fixture(scope="module", params=models())

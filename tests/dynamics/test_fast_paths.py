@@ -8,10 +8,11 @@ import pinocchio as pin
 import pytest
 
 from helpers import REPORT, URDF_PATH, relative_error
-from phantom_pin import Device, InvalidInputError, drivers
+from phantom_pin import Device, InvalidInputError
 from phantom_pin import closed_form as cf
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.model import solve_spd
+from phantom_pin.interfaces import conventions
 
 # method, number of (3,) arguments; inverse_kinematics takes positions (below)
 METHODS = [("forward_kinematics", 1), ("spatial_jacobian", 1), ("body_jacobian", 1),
@@ -255,8 +256,8 @@ def test_closed_form_refuses_booleans_by_name(function, count):
 @pytest.mark.parametrize("call, name", [(lambda d, b: d.friction(b), "dtheta"),
                                         (lambda d, b: d.motor_currents(b), "tau"),
                                         (lambda d, b: d.stop_torque(b, np.zeros(3)), "theta"),
-                                        (lambda d, b: drivers.joint_state_from_theta(b), "theta"),
-                                        (lambda d, b: drivers.openhaptics_torque_from_tau(b), "tau")])
+                                        (lambda d, b: conventions.joint_state_from_theta(b), "theta"),
+                                        (lambda d, b: conventions.openhaptics_torque_from_tau(b), "tau")])
 def test_the_device_and_the_drivers_refuse_booleans_by_name(call, name):
     """L9 beyond the dynamics: the Device and the drivers' conversions."""
     with pytest.raises(InvalidInputError, match=f"^{name}: expected real numbers, got booleans"):

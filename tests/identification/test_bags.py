@@ -11,12 +11,13 @@ import pytest
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
 
-import driver_reference
-from phantom_pin import Phantom, config, describe, drivers
+from phantom_pin import Phantom, config, describe
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import LogError, MissingDataError
 from phantom_pin.identification import bags, io
+from phantom_pin.interfaces import conventions
+from references import driver as driver_reference
 
 TYPES = get_typestore(Stores.ROS2_HUMBLE)
 JointState, Header, Time = (TYPES.types[name] for name in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header",
@@ -160,12 +161,12 @@ def test_a_sawsensablephantom_bag_identifies_as_its_csv_does(tmp_path, cli, repo
 
 def test_a_log_in_openhaptics_convention_identifies_as_in_the_reports(tmp_path, cli, report_csv):
     """identify --convention openhaptics of the same samples as OpenHaptics' joint angles and mN m
-    torques (drivers.openhaptics_from_theta, openhaptics_torque_from_tau; read back within
+    torques (conventions.openhaptics_from_theta, openhaptics_torque_from_tau; read back within
     rounding, not bit for bit) writes the report convention's overlay: the same keys, every link
     number within LINKS_AGREE of its link's size (issue 42's L14: those the data cannot see
     too), the friction within 1e-9 relative."""
     log, from_csv = report_csv
-    angles, torques = drivers.openhaptics_from_theta(log.theta), drivers.openhaptics_torque_from_tau(log.tau)
+    angles, torques = conventions.openhaptics_from_theta(log.theta), conventions.openhaptics_torque_from_tau(log.tau)
     io.write_log(tmp_path / "openhaptics.csv", log.t, angles, torques)
     read = io.read_log(tmp_path / "openhaptics.csv", "openhaptics")
     assert np.abs(read.tau - log.tau).max() < 1e-15 and (read.tau != log.tau).any()     # rounding apart

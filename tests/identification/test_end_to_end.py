@@ -88,7 +88,7 @@ def test_overlay_is_accepted_by_phantom_and_mujoco(identified, tmp_path):
     (mass matrix with the rotors, and gravity, through the mimic coupling)."""
     import mujoco
 
-    from test_interop import MujocoArm
+    from helpers import MujocoArm
 
     report = overlaid(identified / "id.yaml").config.report
     loader = type("Identified", (PhantomLoader,), {"urdf_path": identified / "id.urdf",

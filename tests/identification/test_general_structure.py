@@ -15,8 +15,8 @@ from helpers import CONFIG, excitation_file, run_cli
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
+from phantom_pin.description.inertial import INERTIA_KEYS, Inertial, problem, uncarve
 from phantom_pin.identification import estimation, io, simulation
-from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, uncarve
 
 #: Per body: factor on mass and inertia, centre of mass offset (m), products xy, xz, yz (kg m^2).
 CHANGES = {
@@ -125,8 +125,8 @@ def test_the_overlay_is_a_model_in_full_that_mujoco_agrees_with(run, tmp_path):
     Pinocchio's on the identified model to 1e-9 of their largest entries."""
     import mujoco
 
+    from helpers import MujocoArm
     from phantom_pin.dynamics.coupling import Coupling
-    from test_interop import MujocoArm
 
     overlay = run.folder / "general.yaml"
     assert run.identified.config.report is None

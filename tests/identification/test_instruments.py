@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from helpers import run_cli
-from phantom_pin import Device, Phantom, describe, drivers
+from phantom_pin import Device, Phantom, describe
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, LogError, PhantomPinError
 from phantom_pin.identification import estimate, overlay, result, simulation
+from phantom_pin.interfaces import conventions
 from test_prior import sum_of_sines
 
 TRUTH = describe("premium_1_5_cad")
@@ -137,9 +138,9 @@ def test_identify_reference_on_the_command_line(tmp_path, capsys):
     assert "the torque gains not estimated" in out
     assert "torque gains: not estimated (a closed loop given its reference" in out     # not --fixed-gains
     # the same in OpenHaptics' convention, as `excite --convention openhaptics` writes the reference
-    oh = drivers.openhaptics_from_theta
+    oh = conventions.openhaptics_from_theta
     io.write_csv(tmp_path / "log_oh.csv", io.LOG_COLUMNS,
-                 np.column_stack([log.t, oh(log.theta), drivers.openhaptics_torque_from_tau(log.tau)]))
+                 np.column_stack([log.t, oh(log.theta), conventions.openhaptics_torque_from_tau(log.tau)]))
     io.write_csv(tmp_path / "traj_oh.csv", io.TRAJECTORY_COLUMNS,
                  np.column_stack([t_, oh(theta_), oh(dtheta), oh(ddtheta), np.zeros_like(theta_)]))
     code, out_oh, err = run_cli("-q", *lengths, "identify", tmp_path / "log_oh.csv", "--convention", "openhaptics",

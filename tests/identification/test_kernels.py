@@ -36,11 +36,11 @@ def kernel_sensitive() -> dict:
     from threadpoolctl import threadpool_info
 
     from phantom_pin import Phantom, describe
+    from phantom_pin.description.inertial import Inertial
     from phantom_pin.identification import optimise
     from phantom_pin.identification.io import Log
     from phantom_pin.identification.selection import choose_min_speed
     from phantom_pin.identification.structures import General
-    from phantom_pin.inertial import Inertial
 
     device = Phantom(describe("touch", overrides={"actuation.friction.coulomb.joint3": 0.02}))
     design = optimise(Phantom.from_model("touch"), restarts=1, iterations=5, samples=60)

@@ -26,7 +26,7 @@ NOT_RUN = {"bash-ci": 2,       # the README's quick start: .ci/run runs it (chec
                                # docs/feel.md's reproduction (tests/device/test_feel.py and
                                # tests/cli/test_feel_command.py check what it prints)
            "python-norun": 2,  # the relay (the driver's omni_msgs); a pyOpenHaptics callback (a device,
-                               # or the stand-in: tests/interfaces/test_compensator.py runs it)
+                               # or the stand-in: tests/interfaces/openhaptics/test_compensator.py runs it)
            "c": 2,             # the lines inside an OpenHaptics servo callback (examples/openhaptics_gravity.c)
            "text": 5}          # formulas (cad.md, identification.md)
 
@@ -155,13 +155,14 @@ def test_the_command_table_lists_every_command():
 
 def test_the_frames_page_says_what_the_urdf_and_the_drivers_module_do():
     """docs/frames.md against the Touch's URDF (Pinocchio's frame placements at the zero posture)
-    and phantom_pin.drivers: frame s's axes are base_link's (y, z, x), as are the report's
+    and phantom_pin.interfaces.conventions: frame s's axes are base_link's (y, z, x), as are the report's
     dynamics frame's, the tool frame's and the stylus's at zero; stylus_tip is 39 mm from the
     gimbal's centre; OpenHaptics' angles and torques map as the page writes them."""
     import numpy as np
     import pinocchio as pin
 
-    from phantom_pin import describe, drivers, load
+    from phantom_pin import describe, load
+    from phantom_pin.interfaces import conventions
 
     text = " ".join((ROOT / "docs" / "frames.md").read_text().split())
     assert "x left, y up, z forward: base_link's (y, z, x)" in text
@@ -179,8 +180,8 @@ def test_the_frames_page_says_what_the_urdf_and_the_drivers_module_do():
         assert np.allclose(pose(frame).rotation, axes, atol=1e-12), frame
     assert np.linalg.norm(pose("stylus_tip").translation - pose("stylus").translation) == pytest.approx(0.039)
     assert np.allclose(pose("report_dynamics").translation, 0)    # the shoulder: base_link's origin
-    assert np.allclose(drivers.theta_from_openhaptics([0.1, 0.2, 0.3]), [-0.1, 0.2, 0.3])
-    assert np.allclose(drivers.tau_from_openhaptics_torque([1.0, 2.0, 3.0]), [-1e-3, 2e-3, 3e-3])
+    assert np.allclose(conventions.theta_from_openhaptics([0.1, 0.2, 0.3]), [-0.1, 0.2, 0.3])
+    assert np.allclose(conventions.tau_from_openhaptics_torque([1.0, 2.0, 3.0]), [-1e-3, 2e-3, 3e-3])
 
 
 def test_the_readme_is_one_screen_that_points_into_the_site():

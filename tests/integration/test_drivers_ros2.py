@@ -25,14 +25,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import driver_reference as ref
-from phantom_pin import Phantom, closed_form, profiles
+from helpers import in_process
+from helpers import ros_environment as environment
+from helpers import stop_process as stop
+from phantom_pin import Phantom, closed_form
 from phantom_pin.exceptions import MissingDataError
-from phantom_pin.ros2 import message_type
-from phantom_pin.sim_driver import FIRST_COMMAND
-from test_ros2 import _environment as environment
-from test_ros2 import _stop as stop
-from test_ros2 import in_process
+from phantom_pin.interfaces import profiles
+from phantom_pin.interfaces.ros2.node import message_type
+from phantom_pin.interfaces.ros2.simulated_driver import FIRST_COMMAND
+from references import driver as ref
 
 
 def _installed(name: str) -> bool:

@@ -5,38 +5,19 @@ finite differences, the page rendered in chromium)."""
 import dataclasses
 import importlib.util
 import re
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
-from helpers import CONFIG, REPORT, dark, frame_pose, light_grey, patch, render
+from helpers import CONFIG, EXAMPLES, REPORT, dark, figure, frame_pose, light_grey, number, patch, render
+from helpers import run_script as run
 from phantom_pin import Device, Phantom, load
 from phantom_pin import closed_form as cf
 
 #: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
 pytestmark = pytest.mark.slow
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-
-
-def run(script: str, out: Path, *argv: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, str(EXAMPLES / script), "--out", str(out), *argv],
-                          capture_output=True, text=True, timeout=300, env=env)
-
-
-def number(pattern: str, text: str) -> float:
-    match = re.search(pattern, text)
-    assert match, f"{pattern!r} not in the output:\n{text}"
-    return float(match.group(1))
-
-
-def figure(path: Path) -> None:
-    with Image.open(path) as image:
-        assert image.format == "PNG" and image.width >= 600 and image.height >= 400
 
 
 def test_gravity_compensation_matches_the_closed_form(tmp_path):

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from test_examples import figure, number, run
+from helpers import figure, number
+from helpers import run_script as run
 
 #: Runs a script of examples/ or benchmarks/ in a fresh interpreter (pytest -m "not slow": the quick loop).
 pytestmark = pytest.mark.slow

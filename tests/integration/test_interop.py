@@ -19,14 +19,13 @@ import pydrake.all as drake
 import pytest
 import yaml
 
-from gimbal_reference import gimbal_gravity, gimbal_mass_matrix
-from helpers import CONFIG_DIR, relative_error
+from helpers import ACTUATED, MujocoArm, inside_stops, relative_error
 from phantom_pin import config
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.report import closed_form
+from references.gimbal import gimbal_gravity, gimbal_mass_matrix
 
-ACTUATED = ("joint1", "joint2", "joint3")
 THETA0 = np.array([0.3, 0.8, 0.4])  # rad, the free swing's rest state (inside every model's stops)
 SWING = 0.5  # s of the free swing: every model turns a joint by more than 2.9 rad (measured)
 
@@ -95,21 +94,6 @@ def coupling(case) -> Coupling:
     return Coupling(case.urdf.read_text())
 
 
-def inside_stops(n: int, seed: int, pool: np.ndarray | None = None, config_dir: Path = CONFIG_DIR) -> np.ndarray:
-    """At most ``n`` seeded theta (rad), uniform in the URDF box and inside the coupled
-    stops of ``config_dir``'s joint_limits.yaml: the first of ``pool`` (default: 4 n seeded
-    states in the box) that are inside."""
-    limits = yaml.safe_load((config_dir / "joint_limits.yaml").read_text())
-    stops = limits["stops"]
-    if pool is None:
-        lower = [limits[j]["lower"] for j in ACTUATED]
-        upper = [limits[j]["upper"] for j in ACTUATED]
-        pool = np.random.default_rng(seed).uniform(lower, upper, (4 * n, 3))
-    keep = ((pool[:, 1] - pool[:, 2] <= stops["theta2_minus_theta3_max"])
-            & (pool[:, 2] - pool[:, 1] <= stops["theta3_minus_theta2_max"]))
-    return pool[keep][:n]
-
-
 def rk4_closed_form(theta0: np.ndarray, duration: float, step: float, case: Case, damping: float = 0.0) -> np.ndarray:
     """theta (rad) after ``duration`` s of motion from rest under tau = -damping * dtheta
     (N m s/rad), RK4 on eq. 80 with the case's closed form (and its locked gimbal)."""
@@ -128,31 +112,6 @@ def rk4_closed_form(theta0: np.ndarray, duration: float, step: float, case: Case
 
 
 # -- MuJoCo ------------------------------------------------------------------------------
-
-class MujocoArm:
-    """A MuJoCo model with its joints addressed in the coupling's tree order."""
-
-    def __init__(self, model, coupling: Coupling, case: Case | None = None) -> None:
-        self.model, self.data, self.coupling, self.case = model, mujoco.MjData(model), coupling, case
-        names = [model.joint(i).name for i in range(model.njnt)]
-        assert sorted(names) == sorted(coupling.tree.names[1:])
-        self.qpos = [model.jnt_qposadr[names.index(n)] for n in coupling.tree.names[1:]]
-        self.dof = [model.jnt_dofadr[names.index(n)] for n in coupling.tree.names[1:]]
-
-    def set(self, theta: np.ndarray) -> None:
-        full = theta if self.case is None else self.case.full(theta)  # a model without a gimbal: theta
-        self.data.qpos[self.qpos] = self.coupling.configuration(full)
-        self.data.qvel[:] = 0
-        mujoco.mj_forward(self.model, self.data)
-
-    def reduced_mass_and_gravity(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        self.set(theta)
-        full = np.zeros((self.model.nv, self.model.nv))
-        mujoco.mj_fullM(self.model, self.data, full)
-        tree = full[np.ix_(self.dof, self.dof)]
-        G = self.coupling.matrix  # the arm's block: the gimbal held (locked) at rest
-        return (G.T @ tree @ G)[:3, :3], (G.T @ self.data.qfrc_bias[self.dof])[:3]  # bias at rest = gravity
-
 
 def test_mujoco_loads_the_committed_urdf_with_the_report_dynamics(case, coupling):
     arm = MujocoArm(mujoco.MjModel.from_xml_path(str(case.urdf)), coupling, case)

@@ -93,8 +93,8 @@ class Compensator:
         from phantom_pin.device.device import Device
         from phantom_pin.device.estimator import CUTOFF, Estimator
         from phantom_pin.device.thermal import TorqueBudget
-        from phantom_pin.drivers import openhaptics_from_theta
         from phantom_pin.dynamics.model import Phantom
+        from phantom_pin.interfaces.conventions import openhaptics_from_theta
 
         if mode not in MODES:
             raise InvalidInputError(f"expected one of {', '.join(MODES)}, got {mode!r}", argument="mode")

@@ -73,8 +73,8 @@ class Server:
         from phantom_pin.description.build import description_of, held
         from phantom_pin.device.device import Device
         from phantom_pin.device.plant import servo_plant
-        from phantom_pin.drivers import openhaptics_from_theta, openhaptics_origin
         from phantom_pin.dynamics.model import Phantom
+        from phantom_pin.interfaces.conventions import openhaptics_from_theta, openhaptics_origin
 
         env = os.environ if environ is None else environ
         description = description_of(env.get("PHANTOM_PIN_HD_MODEL") or "premium_1_5", "PHANTOM_PIN_HD_MODEL")
@@ -139,7 +139,7 @@ class Server:
 
     def state(self) -> list[float]:
         """STATE's numbers of the current (theta, dtheta)."""
-        from phantom_pin.drivers import openhaptics_from_theta, transform_of_rigid
+        from phantom_pin.interfaces.conventions import openhaptics_from_theta, transform_of_rigid
 
         theta, rates = np.array(self.q), np.array(self.v)
         if self.has_gimbal:

@@ -341,7 +341,7 @@ static inline void phantom_jacobian_transpose_force(const double theta[3], const
 
 /*
  * The report's theta (rad) of OpenHaptics' HD_CURRENT_JOINT_ANGLES (rad): (-a1, a2, a3)
- * (phantom_pin.drivers.theta_from_openhaptics).
+ * (phantom_pin.interfaces.conventions.theta_from_openhaptics).
  */
 static inline void phantom_theta_from_openhaptics(const double angles[3], double theta[3])
 {
@@ -352,7 +352,8 @@ static inline void phantom_theta_from_openhaptics(const double angles[3], double
 
 /*
  * OpenHaptics joint torques (mN m, for HD_CURRENT_JOINT_TORQUE) of joint torques tau
- * (N m on theta): 1000 (-tau1, tau2, tau3) (phantom_pin.drivers.openhaptics_torque_from_tau),
+ * (N m on theta): 1000 (-tau1, tau2, tau3)
+ * (phantom_pin.interfaces.conventions.openhaptics_torque_from_tau),
  * each torque acting on its own OpenHaptics angle (SensAble's CommandJointTorque sample
  * renders a restoring joint spring T = k (0 - a), k > 0, on that reading: docs/servo-loop.md).
  */

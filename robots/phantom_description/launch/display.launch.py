@@ -13,7 +13,7 @@ and rviz2.
 phantom_1_5_cad, phantom_touch). ``convention``: report (joint1..joint6, the report's theta and
 the raw gimbal angles) or driver (the drivers' joint names and conventions: urdf/ROBOT_driver.urdf,
 committed for the Touch). ``gui``: false leaves joint_states to a running driver. ``node``: true
-also runs ``phantom-pin --model MODEL ros2`` (phantom_pin.ros2: joint_states in; gravity_torque,
+also runs ``phantom-pin --model MODEL ros2`` (phantom_pin.interfaces.ros2.node: joint_states in; gravity_torque,
 gravity_torque_openhaptics, tip_pose, stylus_pose and model_joint_states out).
 """
 

@@ -1,4 +1,4 @@
-"""The simulated driver without ROS (phantom_pin.sim_driver.DriverSimulation): the force it
+"""The simulated driver without ROS (phantom_pin.interfaces.ros2.simulated_driver.DriverSimulation): the force it
 renders against each driver's own formula (its damping, spring, clamp and hold transcribed from
 its source lines), and, in lockstep with the node's computation (ros2.DriverBridge), the stylus
 floating where it was released, falling without the compensation, and moved by a user's force:
@@ -9,11 +9,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import driver_reference as ref
-from phantom_pin import Device, Phantom, closed_form, profiles
-from phantom_pin.ros2 import DriverBridge, fill_force
-from phantom_pin.sim_driver import DriverSimulation
-from test_forces import message
+from helpers import message
+from phantom_pin import Device, Phantom, closed_form
+from phantom_pin.interfaces import profiles
+from phantom_pin.interfaces.ros2.node import DriverBridge, fill_force
+from phantom_pin.interfaces.ros2.simulated_driver import DriverSimulation
+from references import driver as ref
 
 PROFILES = profiles.names()
 #: Seeded releases where gravity beats static friction (|G| > 0.01 N m on joints 2 and 3).
@@ -182,7 +183,7 @@ def test_the_state_topics_are_each_drivers_own_of_the_stylus_pose_and_velocity(d
     seeded states inside the stops and the gimbal's ranges."""
     import yaml
 
-    from gimbal_reference import derivative, openhaptics, ubitrack
+    from references.gimbal import derivative, openhaptics, ubitrack
 
     shoulder = np.array(yaml.safe_load((ref.TOUCH / "gimbal.yaml").read_text())["openhaptics_shoulder"])
     origin = shoulder - [0.0, ref.L2, -ref.L1]       # the zero posture's gimbal centre in OpenHaptics' frame

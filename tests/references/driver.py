@@ -10,8 +10,8 @@ import math
 import numpy as np
 import yaml
 
-from gimbal_reference import L1, L2, derivative, gimbal_gravity, openhaptics, ubitrack
 from helpers import CONFIG_DIR
+from references.gimbal import L1, L2, derivative, gimbal_gravity, openhaptics, ubitrack
 
 TOUCH = CONFIG_DIR.parent / "touch"
 LIMITS = yaml.safe_load((TOUCH / "joint_limits.yaml").read_text())["stops"]

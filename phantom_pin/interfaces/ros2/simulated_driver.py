@@ -4,7 +4,7 @@ time over ROS 2, so that users (and the tests) develop against a driver without 
 ``DriverSimulation`` is the computation without ROS: each servo tick (1 ms) it turns the last
 force command into the force OpenHaptics renders, as the profile's driver does (its frame A,
 its damping and start-up spring, its NaN handling, its norm clamp, the command held or applied
-for one tick: phantom_pin.profiles), applies J_p(theta)^T F at the gimbal centre to the plant
+for one tick: phantom_pin.interfaces.profiles), applies J_p(theta)^T F at the gimbal centre to the plant
 (Device's gravity, friction, stops and saturation; device.plant), and gives the joint states in
 the driver's conventions. No hand holds the stylus, except that ``hold`` keeps it at theta0 for
 its first seconds, as a user's hand would until a node started alongside connects (``release()``
@@ -30,12 +30,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin import drivers
 from phantom_pin.device.device import Device
 from phantom_pin.device.plant import servo_plant
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.profiles import Profile, StateTopic
-from phantom_pin.ros2 import _qos, message_type, run
+from phantom_pin.interfaces import conventions
+from phantom_pin.interfaces.profiles import Profile, StateTopic
+from phantom_pin.interfaces.ros2.node import _qos, message_type, run
 
 __all__ = ["DriverSimulation", "make_node", "loop", "spin"]
 
@@ -135,25 +135,25 @@ class DriverSimulation:
         positions = [*self.profile.state_from_arm(self.q), *self.profile.state_from_gimbal(gimbal)]
         efforts: list[float] = []
         if self.profile.joint_states.effort_unit == "mN m":
-            efforts = [*drivers.openhaptics_torque_from_tau(self.applied).tolist(), 0.0, 0.0, 0.0]
+            efforts = [*conventions.openhaptics_torque_from_tau(self.applied).tolist(), 0.0, 0.0, 0.0]
         return list(self.profile.joint_states.names), [float(p) for p in positions], efforts
 
 
     def state_topics(self, gimbal: Sequence[float]) -> list[tuple[StateTopic, np.ndarray, np.ndarray]]:
         """The profile's state topics now: (topic, position m or linear velocity m/s, rotation
         (3, 3) or angular velocity rad/s), in the driver's axes. OpenHaptics' HD_CURRENT_TRANSFORM
-        of the stylus (drivers.openhaptics_transform_from_pose: its origin an ESTIMATE), its
+        of the stylus (conventions.openhaptics_transform_from_pose: its origin an ESTIMATE), its
         velocity J_p dtheta and the stylus's angular velocity (Phantom.stylus_jacobian), the
         gimbal held still."""
         phantom, theta, g = self.device.phantom, np.array(self.q), np.asarray(gimbal, dtype=float)
         out = []
         for spec in self.profile.state_topics:
             if spec.type.endswith("PoseStamped"):
-                flat = drivers.openhaptics_transform_from_pose(phantom.stylus_pose(theta, g),
-                                                               drivers.openhaptics_origin(phantom))
+                flat = conventions.openhaptics_transform_from_pose(phantom.stylus_pose(theta, g),
+                                                               conventions.openhaptics_origin(phantom))
                 transform = flat.reshape(4, 4).T                              # column-major, mm
                 turned = spec.rotation_axes
-                out.append((spec, spec.axes @ transform[:3, 3] * drivers.METRE_PER_MM,
+                out.append((spec, spec.axes @ transform[:3, 3] * conventions.METRE_PER_MM,
                             turned @ transform[:3, :3] @ turned.T @ spec.after))
             else:
                 rates = np.concatenate([self.v, np.zeros(3)])

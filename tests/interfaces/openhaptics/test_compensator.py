@@ -1,5 +1,5 @@
 """The pyOpenHaptics compensator (phantom_pin.interfaces.openhaptics.Compensator): its forces and
-joint torques against references independent of Phantom (tests/openhaptics_reference.py), the
+joint torques against references independent of Phantom (tests/references/openhaptics.py), the
 friction law added at the caller's rates, bad input named; and an unchanged pyOpenHaptics (PyPI)
 callback with it, on the libHD stand-in, floats the stylus of every model; pyOpenHaptics'
 hd_define.py agrees with SensAble's values but where it is known to differ."""
@@ -12,7 +12,12 @@ import textwrap
 import numpy as np
 import pytest
 
-from openhaptics_reference import (
+from phantom_pin.config import models, read
+from phantom_pin.config.sampling import random_states
+from phantom_pin.config.types import Friction
+from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.interfaces.openhaptics import Compensator, build, read_record
+from references.openhaptics import (
     HDDEFINES,
     PYOPENHAPTICS_DIFFERS,
     PYOPENHAPTICS_SPELLING,
@@ -24,11 +29,6 @@ from openhaptics_reference import (
     residuals,
     tips,
 )
-from phantom_pin.config import models, read
-from phantom_pin.config.sampling import random_states
-from phantom_pin.config.types import Friction
-from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.interfaces.openhaptics import Compensator, build, read_record
 
 SIGN = np.array([-1.0, 1.0, 1.0])     # theta = SIGN * OpenHaptics' angles (Ubitrack's eq., tests/codegen)
 

@@ -43,7 +43,7 @@ table):
   touch_hardware/include/touch_hardware/device_transforms.hpp lines 77-87 (no sign); and
   RViMLab/geomagic_touch_x_ros2 57da5c9 src/device.cpp line 54, src/geomagic_touch_x_component.cpp
   lines 161 and 177 (raw, elbow absolute). Read these through their profiles
-  (phantom_pin.profiles: Profile.joint_states.convention; ``ros2 --driver``): FIXED_CONVENTION
+  (phantom_pin.interfaces.profiles: Profile.joint_states.convention; ``ros2 --driver``): FIXED_CONVENTION
   would mirror them about joint 1.
 
 The gimbal's yaw, pitch, roll are OpenHaptics' raw g1..g3 (rad) in the Touch-era drivers
@@ -68,7 +68,7 @@ base_ref, which puts the shoulder at (0, 35, -157) mm). Ubitrack's calibration m
 (PhantomForwardKinematics.h above) puts OpenHaptics' origin at frame s's (its offsets zero);
 a real Touch's logged HD_CURRENT_TRANSFORM positions (iLUVE69/Limb-Impedance-measurement-
 using-GeoMagic-Touch-Haptic-Device) reach no posture inside the stops with that, and all of
-them with the estimate (tests/test_drivers.py). Check it on your device: the gimbal
+them with the estimate (tests/interfaces/test_conventions.py). Check it on your device: the gimbal
 centre's HD_CURRENT_POSITION at a known posture gives it.
 
 Arrays: one vector (3,) or a batch (..., 3), as the rest of phantom_pin.
@@ -82,9 +82,11 @@ import math
 
 import numpy as np
 
+from phantom_pin._paths import PROFILES_DIR
 from phantom_pin._validation import as_states, finite_result
 from phantom_pin.config import Config, read
-from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.config.files import read_yaml
+from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 
 #: The names of the drivers' joint_states for theta1..theta3 (without prefix).
 JOINT_STATE_NAMES = ("waist", "shoulder", "elbow")
@@ -100,7 +102,7 @@ GIMBAL_CONVENTIONS = {
 METRE_PER_MM = 1e-3
 #: OpenHaptics' angle i = OPENHAPTICS_SIGN[i] * theta_i; its joint torque (mN m) =
 #: OPENHAPTICS_SIGN[i] * tau_i * 1000 (the module's doc gives the sources). The one statement
-#: of the law: phantom_pin.profiles reads it from here.
+#: of the law: phantom_pin.interfaces.profiles reads it from here.
 OPENHAPTICS_SIGN = (-1.0, 1.0, 1.0)
 _SIGN = np.array(OPENHAPTICS_SIGN)
 #: mN m per N m (HD_CURRENT_JOINT_TORQUE's unit).
@@ -180,10 +182,34 @@ class JointConvention:
         return p if rates else p + self.gimbal_offsets
 
 
-#: The older drivers' fixed convention (the module's doc): waist = -a1 = theta1, shoulder = a2,
-#: elbow = a3 - a2, the gimbal raw (sawSensablePhantom's; the fsuarez6 lineage's gimbal is
-#: GIMBAL_CONVENTIONS["omni_firewire"]). urdf/phantom_touch_driver.urdf is jointed in it.
-FIXED_CONVENTION = JointConvention((-1.0, 1.0, 1.0), "relative", *GIMBAL_CONVENTIONS["raw"])
+def _three(values: object, where: str) -> tuple[float, float, float]:
+    if not isinstance(values, list) or len(values) != 3 or not all(
+            isinstance(v, (int, float)) and math.isfinite(v) for v in values):
+        raise ParameterFileError(f"{where}: expected three finite numbers, got {values!r}")
+    return float(values[0]), float(values[1]), float(values[2])
+
+
+def convention_of(node: dict, where: str) -> JointConvention:
+    """The JointConvention of a driver profile's ``joint_states`` node (config/drivers/NAME.yaml:
+    ``arm: {signs, elbow}``, ``gimbal: {signs, offsets}``); ParameterFileError naming ``where``."""
+    arm, gimbal = node["arm"], node["gimbal"]
+    if arm.get("elbow") not in ELBOWS:
+        raise ParameterFileError(f"{where}.arm.elbow: expected relative or absolute, got {arm.get('elbow')!r}")
+    signs = _three(arm["signs"], f"{where}.arm.signs") + _three(gimbal["signs"], f"{where}.gimbal.signs")
+    if any(s not in (-1.0, 1.0) for s in signs):
+        raise ParameterFileError(f"{where}: every sign must be 1 or -1, got {signs}")
+    offsets = _three(gimbal["offsets"], f"{where}.gimbal.offsets")
+    return JointConvention(signs[:3], arm["elbow"], signs[3:], offsets)
+
+
+#: The profile of the older drivers' fixed convention (the module's doc): sawSensablePhantom's,
+#: waist = -a1 = theta1, shoulder = a2, elbow = a3 - a2, the gimbal raw (the fsuarez6 lineage
+#: shares the arm; its gimbal is GIMBAL_CONVENTIONS["omni_firewire"]).
+FIXED_PROFILE = "sawsensablephantom"
+#: That profile's joint-state convention, read from config/drivers/FIXED_PROFILE.yaml: the one
+#: urdf/phantom_touch_driver.urdf is jointed in, and the ``ros2`` node's without a driver.
+FIXED_CONVENTION = convention_of(read_yaml(PROFILES_DIR / f"{FIXED_PROFILE}.yaml")["joint_states"],
+                                 f"{FIXED_PROFILE}.yaml: joint_states")
 
 
 def theta_from_openhaptics(angles: object) -> np.ndarray:
@@ -356,8 +382,8 @@ def transform_of_rigid(pose: np.ndarray, offset: np.ndarray) -> np.ndarray:
 
 def _reader(convention: object) -> JointConvention:
     if not isinstance(convention, JointConvention):
-        raise InvalidInputError(f"expected a phantom_pin.drivers.JointConvention (FIXED_CONVENTION, or a profile's "
-                                f"joint_states.convention), got {convention!r}", argument="convention")
+        raise InvalidInputError(f"expected a phantom_pin.interfaces.conventions.JointConvention (FIXED_CONVENTION, "
+                                f"or a profile's joint_states.convention), got {convention!r}", argument="convention")
     return convention
 
 

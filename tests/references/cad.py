@@ -23,7 +23,7 @@ rotor inertia J_mot Eta_i^2 is added on the diagonal, as mahilab's step_dynamics
 
     mass_matrix(theta) -> (3, 3) kg m^2,  gravity(theta) -> (3,) N m (dV/dtheta)
 
-both lambdified once, on first use. ``python tests/cad_reference.py`` runs the self-check
+both lambdified once, on first use. ``python tests/references/cad.py`` runs the self-check
 against a purely numeric model of the links in our YAML (see ``_self_check``).
 """
 
@@ -120,7 +120,7 @@ def gravity(theta) -> np.ndarray:
     return np.array(_lambdified()[1](*t), dtype=float).reshape(3)
 
 
-# --- self-check (run: python tests/cad_reference.py) ------------------------------------------
+# --- self-check (run: python tests/references/cad.py) ------------------------------------------
 # A second, purely numeric model, of OUR links (robots/phantom_description/config/premium_1_5_cad,
 # physical_parameters.yaml, kinematics.yaml and actuation.yaml), in OUR link frames: M = sum over
 # links of m Jv^T Jv + Jw^T R I R^T Jw, N = -sum m g^T Jv, with analytic Jacobians of each

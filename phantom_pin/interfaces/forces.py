@@ -4,7 +4,7 @@ computation of ``phantom-pin ros2 --driver``, without ROS.
 Every public Touch driver takes a Cartesian force F (N) and sends it as OpenHaptics'
 HD_CURRENT_FORCE, which the device renders at the gimbal centre (the tool frame t, URDF frame
 ``tip``) as the joint torques J_p(theta)^T F, J_p the tip's position Jacobian in frame s
-(m/rad; OpenHaptics' axes are frame s's: phantom_pin.profiles). So
+(m/rad; OpenHaptics' axes are frame s's: phantom_pin.interfaces.profiles). So
 
     F = F_user + F_comp,   J_p(theta)^T F_comp = G(theta, g) [+ tau_f(dtheta)]
 
@@ -36,7 +36,7 @@ from phantom_pin.device.estimator import Estimator
 from phantom_pin.device.thermal import TorqueBudget
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.profiles import Profile
+from phantom_pin.interfaces.profiles import Profile
 
 __all__ = ["Renderer", "Frames", "Rendered"]
 
@@ -111,7 +111,7 @@ class Renderer:
     """F for one state: ``__call__(theta, gimbal=None, user=(0, 0, 0), time=None)`` -> Rendered.
 
     ``phantom``: the device's model (its gravity, its stylus); ``profile``: the driver
-    (phantom_pin.profiles: its frame and clamp); ``compensate``: a subset of TERMS (gravity,
+    (phantom_pin.interfaces.profiles: its frame and clamp); ``compensate``: a subset of TERMS (gravity,
     friction: the model's friction law, or ``friction`` given, e.g. an identified overlay's
     Phantom.config.actuation.friction); ``max_force`` (N, > 0). theta (rad, the report's) and g
     (rad, OpenHaptics' raw gimbal angles; None: locked_at) of one state; ``user`` (N, frame s);

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-import touch_reference
+from references import touch as touch_reference
 
 L1 = L2 = 0.13335   # m, Ubitrack's PhantomForwardKinematics.xml "defaults to Phantom Omni: 133.35mm"
 G = 9.80665         # m/s^2, standard gravity (config/touch's)
@@ -42,7 +42,7 @@ def ubitrack(o: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def openhaptics(theta: np.ndarray, gimbal: np.ndarray) -> np.ndarray:
     """OpenHaptics' six angles of the report's theta and the raw gimbal angles: the joint
-    angles are (-theta1, theta2, theta3) (phantom_pin.drivers' module doc)."""
+    angles are (-theta1, theta2, theta3) (phantom_pin.interfaces.conventions' module doc)."""
     return np.array([-theta[0], theta[1], theta[2], *gimbal])
 
 

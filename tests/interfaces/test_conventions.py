@@ -1,4 +1,4 @@
-"""phantom_pin.drivers against the drivers' own published formulas, written out here:
+"""phantom_pin.interfaces.conventions against the drivers' own published formulas, written out here:
 
 - Ubitrack's forward kinematics of OpenHaptics' joint angles (Ubitrack/component_haptic_calibration,
   src/utHaptics/Function/PhantomForwardKinematics.h lines 101-103, without calibration offsets),
@@ -16,11 +16,12 @@ import math
 import numpy as np
 import pytest
 
-import driver_reference
-from phantom_pin import Phantom, closed_form, drivers, profiles
+from phantom_pin import Phantom, closed_form
 from phantom_pin.config import read
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.exceptions import InvalidInputError
+from phantom_pin.interfaces import conventions, profiles
+from references import driver as driver_reference
 
 L = 0.13335  # m, Ubitrack's default l1 = l2 ("defaults to Phantom Omni: 133.35mm")
 GIMBAL = ("yaw", "pitch", "roll")
@@ -41,18 +42,18 @@ def ubitrack(a: np.ndarray) -> np.ndarray:
 
 
 def test_openhaptics_angles_put_the_touch_tip_where_ubitrack_computes_it(angles):
-    theta = drivers.theta_from_openhaptics(angles)
+    theta = conventions.theta_from_openhaptics(angles)
     tip = Phantom.from_model("touch").forward_kinematics(theta)[:, :3, 3]
     np.testing.assert_allclose(tip, ubitrack(angles), rtol=0, atol=1e-12)
     assert np.abs(ubitrack(angles)[:, 0]).max() > 0.05  # the sign of angle 1 matters here
 
 
 def test_joint_states_of_the_drivers_give_the_openhaptics_theta(angles):
-    expected = drivers.theta_from_openhaptics(angles)
+    expected = conventions.theta_from_openhaptics(angles)
     gimbal = np.random.default_rng(9).uniform(-2, 2, (len(angles), 3))
     # fsuarez6/phantom_omni: waist = -a1, shoulder = a2, elbow = a3 - a2, then the gimbal
     fsuarez6 = np.column_stack([-angles[:, 0], angles[:, 1], angles[:, 2] - angles[:, 1], gimbal])
-    theta = drivers.theta_from_joint_state(["waist", "shoulder", "elbow", *GIMBAL], fsuarez6)
+    theta = conventions.theta_from_joint_state(["waist", "shoulder", "elbow", *GIMBAL], fsuarez6)
     np.testing.assert_allclose(theta, expected, rtol=0, atol=1e-15)
     # sawSensablePhantom: q[0] = -q[0]; q[2] -= q[1], here published in another order with a prefix
     saw = angles.copy()
@@ -60,20 +61,20 @@ def test_joint_states_of_the_drivers_give_the_openhaptics_theta(angles):
     saw[:, 2] -= saw[:, 1]
     names = ["arm/roll", "arm/elbow", "arm/waist", "arm/shoulder"]
     published = np.column_stack([gimbal[:, 2], saw[:, 2], saw[:, 0], saw[:, 1]])
-    theta = drivers.theta_from_joint_state(names, published, prefix="arm/")
+    theta = conventions.theta_from_joint_state(names, published, prefix="arm/")
     np.testing.assert_allclose(theta, expected, rtol=0, atol=1e-15)
-    one = drivers.theta_from_joint_state(names, published[0], prefix="arm/")
+    one = conventions.theta_from_joint_state(names, published[0], prefix="arm/")
     np.testing.assert_allclose(one, expected[0], rtol=0, atol=1e-15)
 
 
 def test_the_conversions_invert_each_other(angles):
-    theta = drivers.theta_from_openhaptics(angles)
-    np.testing.assert_array_equal(drivers.openhaptics_from_theta(theta), angles)
-    names, position = drivers.joint_state_from_theta(theta, prefix="omni_")
+    theta = conventions.theta_from_openhaptics(angles)
+    np.testing.assert_array_equal(conventions.openhaptics_from_theta(theta), angles)
+    names, position = conventions.joint_state_from_theta(theta, prefix="omni_")
     assert names == ["omni_waist", "omni_shoulder", "omni_elbow"]
-    np.testing.assert_allclose(drivers.theta_from_joint_state(names, position, "omni_"), theta, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(conventions.theta_from_joint_state(names, position, "omni_"), theta, rtol=0, atol=1e-15)
     tau = np.random.default_rng(10).normal(0, 0.2, (len(angles), 3))
-    np.testing.assert_allclose(drivers.tau_from_openhaptics_torque(drivers.openhaptics_torque_from_tau(tau)),
+    np.testing.assert_allclose(conventions.tau_from_openhaptics_torque(conventions.openhaptics_torque_from_tau(tau)),
                                tau, rtol=1e-15, atol=0)
 
 
@@ -83,11 +84,11 @@ def test_openhaptics_torques_do_the_same_work_and_its_spring_restores_theta(angl
     rng = np.random.default_rng(11)
     rate = rng.normal(0, 1, angles.shape)                  # rad/s of the OpenHaptics angles
     torque = rng.normal(0, 300, angles.shape)              # mN m
-    dtheta = drivers.theta_from_openhaptics(rate)          # the map is linear: rates as angles
-    tau = drivers.tau_from_openhaptics_torque(torque)
+    dtheta = conventions.theta_from_openhaptics(rate)          # the map is linear: rates as angles
+    tau = conventions.tau_from_openhaptics_torque(torque)
     np.testing.assert_allclose((tau * dtheta).sum(axis=1), (torque * rate).sum(axis=1) / 1000, rtol=1e-12)
-    spring = drivers.tau_from_openhaptics_torque(1000.0 * (0 - angles))
-    np.testing.assert_allclose(spring, -1.0 * drivers.theta_from_openhaptics(angles), rtol=1e-15)
+    spring = conventions.tau_from_openhaptics_torque(1000.0 * (0 - angles))
+    np.testing.assert_allclose(spring, -1.0 * conventions.theta_from_openhaptics(angles), rtol=1e-15)
 
 
 def test_gravity_goes_to_openhaptics_in_mN_m():
@@ -95,7 +96,7 @@ def test_gravity_goes_to_openhaptics_in_mN_m():
     gravity; joints 2 and 3 keep their sign and are 1000 times the N m."""
     phantom = Phantom.from_model("touch")
     theta = np.array([0.4, 0.7, 0.9])
-    command = drivers.openhaptics_torque_from_tau(phantom.gravity(theta))
+    command = conventions.openhaptics_torque_from_tau(phantom.gravity(theta))
     np.testing.assert_allclose(command[1:], 1000 * phantom.gravity(theta)[1:], rtol=1e-15)
     assert command[0] == pytest.approx(0, abs=1e-12)
 
@@ -111,22 +112,23 @@ def test_gravity_goes_to_openhaptics_in_mN_m():
 ])
 def test_bad_joint_states_raise_naming_the_argument(names, position, argument):
     with pytest.raises(InvalidInputError, match=f"^{argument}: "):
-        drivers.theta_from_joint_state(names, position)
+        conventions.theta_from_joint_state(names, position)
 
 
-@pytest.mark.parametrize("function", [drivers.theta_from_openhaptics, drivers.openhaptics_from_theta,
-                                      drivers.tau_from_openhaptics_torque, drivers.openhaptics_torque_from_tau])
+@pytest.mark.parametrize("function", [conventions.theta_from_openhaptics, conventions.openhaptics_from_theta,
+                                      conventions.tau_from_openhaptics_torque, conventions.openhaptics_torque_from_tau])
 def test_bad_vectors_raise_naming_the_argument(function):
     with pytest.raises(InvalidInputError, match=r"^(angles|theta|torque|tau): "):
         function([1.0, 2.0])
 
 
 @pytest.mark.parametrize("call, argument", [
-    (lambda: drivers.openhaptics_torque_from_tau([1e306, 0.0, 0.0]), "tau"),
-    (lambda: drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 1e308, 1e308]), "position"),
-    (lambda: drivers.joint_state_from_theta([0.0, -1e308, 1e308]), "theta"),
-    (lambda: drivers.joint_state_from_theta([0.0, 0.0, 0.0], prefix=5), "prefix"),
-    (lambda: drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], prefix=None), "prefix"),
+    (lambda: conventions.openhaptics_torque_from_tau([1e306, 0.0, 0.0]), "tau"),
+    (lambda: conventions.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 1e308, 1e308]), "position"),
+    (lambda: conventions.joint_state_from_theta([0.0, -1e308, 1e308]), "theta"),
+    (lambda: conventions.joint_state_from_theta([0.0, 0.0, 0.0], prefix=5), "prefix"),
+    (lambda: conventions.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], prefix=None),
+     "prefix"),
 ])
 def test_overflow_and_a_non_string_prefix_are_named_errors(call, argument):
     """Before: -inf or inf came back from a finite input (1000 x 1e306 N m; 1e308 + 1e308 rad),
@@ -168,7 +170,7 @@ def test_openhaptics_transform_from_pose_refuses_what_is_not_a_finite_rigid_pose
     mirrored rotation, a translation whose mm overflow and a 3x4 matrix are each refused with
     InvalidInputError naming ``pose``."""
     with pytest.raises(InvalidInputError) as error:
-        drivers.openhaptics_transform_from_pose(pose)
+        conventions.openhaptics_transform_from_pose(pose)
     assert error.value.argument == "pose"
 
 
@@ -180,7 +182,7 @@ def test_a_mirrored_hd_current_transform_is_refused():
         assert np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-12) and np.linalg.det(rotation) < 0
         flat = transform(rotation, [12.0, -70.0, -50.0]).T.ravel()   # column-major
         with pytest.raises(InvalidInputError) as error:
-            drivers.pose_from_openhaptics_transform(flat)
+            conventions.pose_from_openhaptics_transform(flat)
         assert error.value.argument == "transform"
 
 
@@ -191,11 +193,11 @@ def test_a_row_major_hd_current_transform_is_refused():
     give the pose in m."""
     matrix = transform(ROTATION, [12.0, -70.0, -50.0])
     with pytest.raises(InvalidInputError) as error:
-        drivers.pose_from_openhaptics_transform(matrix.ravel())        # row-major
+        conventions.pose_from_openhaptics_transform(matrix.ravel())        # row-major
     assert error.value.argument == "transform"
     flat = matrix.T.ravel()
     assert np.array_equal(flat[12:15], [12.0, -70.0, -50.0])
-    assert np.abs(drivers.pose_from_openhaptics_transform(flat)[:3, :3] - ROTATION).max() < 1e-15
+    assert np.abs(conventions.pose_from_openhaptics_transform(flat)[:3, :3] - ROTATION).max() < 1e-15
 
 
 def test_omni_firewire_gimbal_rates_convert_without_the_offsets():
@@ -212,9 +214,9 @@ def test_omni_firewire_gimbal_rates_convert_without_the_offsets():
     published_rate = (published(g0 + rate * h) - published(g0)) / h
     names = ["roll", "yaw", "pitch"]
     order = [2, 0, 1]
-    back = drivers.gimbal_from_joint_state(names, published_rate[order], convention="omni_firewire", rates=True)
+    back = conventions.gimbal_from_joint_state(names, published_rate[order], convention="omni_firewire", rates=True)
     assert np.abs(back - rate).max() < 1e-6
-    positions = drivers.gimbal_from_joint_state(names, published(g0)[order], convention="omni_firewire")
+    positions = conventions.gimbal_from_joint_state(names, published(g0)[order], convention="omni_firewire")
     assert np.abs(positions - g0).max() < 1e-14
 
 
@@ -225,12 +227,12 @@ def test_gimbal_joint_states_with_a_prefix_read_their_own_names():
     is refused naming ``names``."""
     names = ["left_roll", "yaw", "left_yaw", "pitch", "left_pitch", "roll"]
     values = [0.3, -1.0, 0.1, -2.0, 0.2, -3.0]
-    assert np.array_equal(drivers.gimbal_from_joint_state(names, values, prefix="left_"), [0.1, 0.2, 0.3])
-    assert np.array_equal(drivers.gimbal_from_joint_state(names, values), [-1.0, -2.0, -3.0])
-    written, position = drivers.joint_state_from_gimbal([0.1, 0.2, 0.3], prefix="left_")
+    assert np.array_equal(conventions.gimbal_from_joint_state(names, values, prefix="left_"), [0.1, 0.2, 0.3])
+    assert np.array_equal(conventions.gimbal_from_joint_state(names, values), [-1.0, -2.0, -3.0])
+    written, position = conventions.joint_state_from_gimbal([0.1, 0.2, 0.3], prefix="left_")
     assert written == ["left_yaw", "left_pitch", "left_roll"] and np.array_equal(position, [0.1, 0.2, 0.3])
     with pytest.raises(InvalidInputError) as error:
-        drivers.gimbal_from_joint_state(["yaw", "pitch", "roll"], [0, 0, 0], prefix="left_")
+        conventions.gimbal_from_joint_state(["yaw", "pitch", "roll"], [0, 0, 0], prefix="left_")
     assert error.value.argument == "names"
 
 
@@ -291,9 +293,9 @@ def test_the_logged_positions_of_a_real_touch_are_reached_inside_its_stops_from_
         flat = np.eye(4)
         flat[:3, 3] = point
         flat = flat.T.ravel()                                 # column-major, mm
-        estimated = drivers.pose_from_openhaptics_transform(flat)[:3, 3]
+        estimated = conventions.pose_from_openhaptics_transform(flat)[:3, 3]
         assert reachable_inside_the_stops(estimated, report), point
-        equal = drivers.pose_from_openhaptics_transform(flat, origin=np.zeros(3))[:3, 3]
+        equal = conventions.pose_from_openhaptics_transform(flat, origin=np.zeros(3))[:3, 3]
         assert not reachable_inside_the_stops(equal, report), point
 
 
@@ -318,26 +320,26 @@ def test_the_origin_is_gimbal_yamls_shoulder_less_the_shoulder_in_frame_s():
         assert abs(np.linalg.norm(tip - shoulder) ** 2 - (report.l1**2 + report.l2**2
                                                           + 2 * report.l1 * report.l2 * math.sin(theta[2] - theta[1]))
                    ) < 1e-12
-    assert np.abs(drivers.openhaptics_origin() - (np.array(stated) - shoulder)).max() < 1e-15
-    assert np.array_equal(drivers.openhaptics_origin(Phantom.from_model("touch")), drivers.openhaptics_origin())
+    assert np.abs(conventions.openhaptics_origin() - (np.array(stated) - shoulder)).max() < 1e-15
+    assert np.array_equal(conventions.openhaptics_origin(Phantom.from_model("touch")), conventions.openhaptics_origin())
     moved = describe("touch", overrides={"openhaptics_shoulder.2": -0.2})
-    assert np.abs(drivers.openhaptics_origin(moved) - drivers.openhaptics_origin() - [0, 0, -0.2 - stated[2]]
+    assert np.abs(conventions.openhaptics_origin(moved) - conventions.openhaptics_origin() - [0, 0, -0.2 - stated[2]]
                   ).max() < 1e-15
-    back = drivers.pose_from_openhaptics_transform(drivers.openhaptics_transform_from_pose(
-        transform(ROTATION, [0.01, 0.02, 0.03]) / [[1], [1], [1], [1]], origin=drivers.openhaptics_origin(moved)),
-        origin=drivers.openhaptics_origin(moved))
+    back = conventions.pose_from_openhaptics_transform(conventions.openhaptics_transform_from_pose(
+        transform(ROTATION, [0.01, 0.02, 0.03]) / [[1], [1], [1], [1]], origin=conventions.openhaptics_origin(moved)),
+        origin=conventions.openhaptics_origin(moved))
     assert np.abs(back[:3, 3] - [0.01, 0.02, 0.03]).max() < 1e-15
     with pytest.raises(ParameterFileError, match="openhaptics_shoulder"):
         describe("touch", overrides={"openhaptics_shoulder.2": -157})
     with pytest.raises(InvalidInputError) as error:
-        drivers.openhaptics_origin(Phantom.from_model("premium_1_5"))
+        conventions.openhaptics_origin(Phantom.from_model("premium_1_5"))
     assert error.value.argument == "phantom"
     with pytest.raises(InvalidInputError) as error:
-        drivers.pose_from_openhaptics_transform(np.eye(4).ravel(), origin=[[0, 0, 0]])
+        conventions.pose_from_openhaptics_transform(np.eye(4).ravel(), origin=[[0, 0, 0]])
     assert error.value.argument == "origin"
 
 
-# -- one reader of joint_states per driver (drivers.JointConvention) ---------------------------------
+# -- one reader of joint_states per driver (conventions.JointConvention) ---------------------------------
 WAIST_NAMED = ("geomagic_touch_ros2", "sawsensablephantom", "phantom_touch_ros2", "touch_ros2_control")
 
 
@@ -369,8 +371,8 @@ def test_the_waist_signs_found_at_the_drivers_sources():
     assert {name: _waist_sign(name) for name in profiles.names()} == {
         "geomagic_touch_ros2": -1.0, "sawsensablephantom": -1.0, "phantom_touch_ros2": 1.0,
         "touch_ros2_control": 1.0, "geomagic_touch_x_ros2": 1.0}
-    assert profiles.load("sawsensablephantom").joint_states.convention == drivers.FIXED_CONVENTION
-    assert drivers.FIXED_CONVENTION.arm_signs[0] == _waist_sign("sawsensablephantom")
+    assert profiles.load("sawsensablephantom").joint_states.convention == conventions.FIXED_CONVENTION
+    assert conventions.FIXED_CONVENTION.arm_signs[0] == _waist_sign("sawsensablephantom")
 
 
 @pytest.mark.parametrize("name", WAIST_NAMED)
@@ -382,7 +384,7 @@ def test_the_plain_node_puts_the_tip_where_ubitrack_does_for_the_older_drivers_a
     mirrored about joint 1's plane (x of frame s negated), the mirror the docs warn of, while
     their profiles (DriverBridge, theta_from_joint_state with the profile's convention) read
     theta right."""
-    from phantom_pin.ros2 import Bridge, DriverBridge
+    from phantom_pin.interfaces.ros2.node import Bridge, DriverBridge
 
     touch = Phantom.from_model("touch")
     plain, profile = Bridge(touch), profiles.load(name)
@@ -395,7 +397,7 @@ def test_the_plain_node_puts_the_tip_where_ubitrack_does_for_the_older_drivers_a
         position = ubitrack(np.array([a]))[0]   # frame s, whose origin is (0, l2, -l1) from the shoulder's
         expected = driver_reference.BASE_FROM_S @ (mirror @ position - [0.0, driver_reference.L2, -driver_reference.L1])
         np.testing.assert_allclose(tip, expected, rtol=0, atol=1e-12)
-        theta_read = drivers.theta_from_joint_state(names, positions, convention=profile.joint_states.convention)
+        theta_read = conventions.theta_from_joint_state(names, positions, convention=profile.joint_states.convention)
         np.testing.assert_allclose(theta_read, t, rtol=0, atol=1e-15)
         np.testing.assert_allclose(DriverBridge(touch, profile).state(names, positions)[0], t, rtol=0, atol=1e-15)
     assert np.abs(position[0]) > 1e-3   # x matters: the mirror is seen
@@ -410,10 +412,10 @@ def test_the_plain_node_puts_the_tip_where_ubitrack_does_for_the_older_drivers_a
 ])
 def test_a_bad_joint_convention_is_refused_naming_its_field(arguments, argument):
     with pytest.raises(InvalidInputError) as error:
-        drivers.JointConvention(*arguments)
+        conventions.JointConvention(*arguments)
     assert isinstance(error.value, ValueError) and error.value.argument == argument
     with pytest.raises(InvalidInputError) as error:
-        drivers.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], convention="kinisi")
+        conventions.theta_from_joint_state(["waist", "shoulder", "elbow"], [0.0, 0.0, 0.0], convention="kinisi")
     assert error.value.argument == "convention"
 
 
@@ -429,7 +431,7 @@ def test_the_origin_puts_the_shoulder_where_the_arm_turns_about_it_with_unequal_
     config = read("touch")
     l1, l2 = 0.20, 0.11
     config = dataclasses.replace(config, kinematics=dataclasses.replace(config.kinematics, l1=l1, l2=l2))
-    shoulder = np.array(config.gimbal.openhaptics_shoulder) - drivers.openhaptics_origin(config)   # frame s
+    shoulder = np.array(config.gimbal.openhaptics_shoulder) - conventions.openhaptics_origin(config)   # frame s
     theta = sample_postures(config.limits, 50, np.random.default_rng(23), draws=200)
     a = theta * [-1.0, 1.0, 1.0]                        # OpenHaptics' angles (Ubitrack's)
     s1, c1, s2, c2, s3, c3 = np.sin(a[:, 0]), np.cos(a[:, 0]), np.sin(a[:, 1]), np.cos(a[:, 1]), \

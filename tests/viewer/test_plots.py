@@ -1,4 +1,4 @@
-"""simulate --plot and excite --plot: one self-contained HTML page each (phantom_pin.plots), opened
+"""simulate --plot and excite --plot: one self-contained HTML page each (phantom_pin.viewer.plots), opened
 in headless chromium (helpers.browse): it renders, its plots are not empty, no console message,
 no request from the page. The SVG paths carry the numbers: a curve's points are an affine image
 of (t, value) of the run's own output (JSON or CSV), and the limit lines sit at the stops and
@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from helpers import AFFINE_TOLERANCE, CONFIG_DIR, affine, check_page, svg_points
-from phantom_pin import plots
+from phantom_pin.viewer import plots
 
 #: A swing under gravity compensation: theta3 turns up to the coupled stop, and joint 3's gravity
 #: torque changes with it (-0.029 N m at 0.4 rad, -0.067 at 2 rad).

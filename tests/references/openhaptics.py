@@ -9,7 +9,7 @@
 - gravity_and_jacobian(name, theta, gimbal): each model's gravity torques (N m) and tip Jacobian
   in frame s (m/rad) from a reference independent of phantom_pin's Phantom: the report's closed
   form for premium_1_5 (eqs 93-94, and R_st J^b_v of eq. 24), the tests' SymPy re-derivation of
-  the CAD (tests/cad_reference.py) with its Jacobian by central differences of the report's
+  the CAD (tests/references/cad.py) with its Jacobian by central differences of the report's
   eq. 10 at the CAD's lengths, and Pinocchio alone on the Touch's committed six-joint URDF
   (tests/helpers.Six: the gimbal at its angles, the frame tip's Jacobian rotated into report_s).
 """
@@ -115,7 +115,7 @@ def gravity_and_jacobian(name: str, theta: np.ndarray, gimbal: np.ndarray | None
         report = config.report
         pose = closed_form.forward_kinematics(theta, report)
         return closed_form.gravity(theta, report), pose[:3, :3] @ closed_form.body_jacobian(theta, report)[:3]
-    import cad_reference
+    from references import cad as cad_reference
     k, h = config.kinematics, 1e-6
     jacobian = np.column_stack([(_tip(theta + h * e, k.l1, k.l2) - _tip(theta - h * e, k.l1, k.l2)) / (2 * h)
                                 for e in np.eye(3)])

@@ -1,4 +1,4 @@
-"""The one physical check of a link (phantom_pin.inertial), its tolerance against MuJoCo (the
+"""The one physical check of a link (phantom_pin.description.inertial), its tolerance against MuJoCo (the
 strictest consumer, loading the generated MJCF at the boundary), and links given in full
 against the report's adapter."""
 
@@ -12,7 +12,7 @@ import yaml
 from phantom_pin import ParameterFileError, config, describe
 from phantom_pin.cli import main
 from phantom_pin.config import MODELS
-from phantom_pin.inertial import TRIANGLE_SLACK, Inertial, problem, slack
+from phantom_pin.description.inertial import TRIANGLE_SLACK, Inertial, problem, slack
 
 SHIPPED = MODELS["premium_1_5"]
 

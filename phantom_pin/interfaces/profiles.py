@@ -7,18 +7,18 @@ force vector (a matrix A from the message's three numbers to OpenHaptics' HD_CUR
 F_OH = A F_msg), the clamp and damping the driver applies itself, and its rate.
 
 OpenHaptics' frame (OH) has the axes of the report's frame s (x to the user's right, y up, z
-towards the user; phantom_pin.drivers), so a force in OH is a force in frame s (N). Every
+towards the user; phantom_pin.interfaces.conventions), so a force in OH is a force in frame s (N). Every
 public driver takes a Cartesian force in newtons and sends it with hdSetDoublev(
 HD_CURRENT_FORCE); OpenHaptics renders it at the gimbal centre (the tool frame t, ``tip``):
 the joint torques are J_p(theta)^T F, J_p the tip's position Jacobian in frame s
 (Device.tip_jacobian). See docs/drivers.md.
 
-Joint states: each profile's phantom_pin.drivers.JointConvention (``published = sign * a`` for
+Joint states: each profile's phantom_pin.interfaces.conventions.JointConvention (``published = sign * a`` for
 OpenHaptics' raw arm angles a (HD_CURRENT_JOINT_ANGLES, rad), the elbow ``relative`` (sign3 *
 (a3 - a2)) or ``absolute`` (sign3 * a3); the gimbal ``published = sign * g + offset``
 (HD_CURRENT_GIMBAL_ANGLES, rad)), the one reader that the ``ros2`` node without a driver and
 urdf/phantom_touch_driver.urdf use too (drivers.FIXED_CONVENTION). The report's theta is (-a1,
-a2, a3) (phantom_pin.drivers).
+a2, a3) (phantom_pin.interfaces.conventions).
 """
 
 from __future__ import annotations
@@ -30,15 +30,13 @@ from functools import cache
 
 import numpy as np
 
-from phantom_pin._paths import DESCRIPTION_DIR
+from phantom_pin._paths import PROFILES_DIR
 from phantom_pin.config.files import read_yaml
-from phantom_pin.drivers import JointConvention
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
+from phantom_pin.interfaces.conventions import JointConvention, convention_of
 
 __all__ = ["Profile", "JointStates", "ForceCommand", "StateTopic", "Qos", "load", "names", "relayed"]
 
-#: Where the profiles live: one YAML file per driver, named after its repository.
-PROFILES_DIR = DESCRIPTION_DIR / "config" / "drivers"
 #: The force message types a driver takes (the fields read; omni_msgs is built in a ROS workspace).
 FORCE_TYPES = ("geometry_msgs/msg/Vector3", "geometry_msgs/msg/Wrench", "geometry_msgs/msg/WrenchStamped",
                "omni_msgs/msg/OmniFeedback")
@@ -55,7 +53,7 @@ class Qos:
 @dataclasses.dataclass(frozen=True)
 class JointStates:
     """What a driver publishes as sensor_msgs/JointState: ``topic``, ``names`` (the six, in
-    order: three of the arm, three of the gimbal), ``convention`` (drivers.JointConvention: the
+    order: three of the arm, three of the gimbal), ``convention`` (conventions.JointConvention: the
     arm's signs and elbow, the gimbal's signs and offsets), ``effort_unit`` ("mN m" where it
     publishes OpenHaptics' joint torques, else None), ``qos``, ``rate`` (Hz)."""
 
@@ -175,20 +173,8 @@ def _qos(node: dict, where: str) -> Qos:
     return Qos(reliability, depth)
 
 
-def _three(values: object, where: str) -> tuple[float, float, float]:
-    if not isinstance(values, list) or len(values) != 3 or not all(
-            isinstance(v, (int, float)) and math.isfinite(v) for v in values):
-        raise ParameterFileError(f"{where}: expected three finite numbers, got {values!r}")
-    return float(values[0]), float(values[1]), float(values[2])
-
-
 def _joint_states(node: dict, where: str) -> JointStates:
-    arm, gimbal = node["arm"], node["gimbal"]
-    if arm.get("elbow") not in ("relative", "absolute"):
-        raise ParameterFileError(f"{where}.arm.elbow: expected relative or absolute, got {arm.get('elbow')!r}")
-    signs = _three(arm["signs"], f"{where}.arm.signs") + _three(gimbal["signs"], f"{where}.gimbal.signs")
-    if any(s not in (-1.0, 1.0) for s in signs):
-        raise ParameterFileError(f"{where}: every sign must be 1 or -1, got {signs}")
+    convention = convention_of(node, where)
     names_ = node["names"]
     if not isinstance(names_, list) or len(names_) != 6 or len(set(names_)) != 6:
         raise ParameterFileError(f"{where}.names: expected six distinct joint names, got {names_!r}")
@@ -198,8 +184,6 @@ def _joint_states(node: dict, where: str) -> JointStates:
     rate = node["rate"]
     if not isinstance(rate, (int, float)) or not rate > 0:
         raise ParameterFileError(f"{where}.rate: expected a rate in Hz, got {rate!r}")
-    offsets = _three(gimbal["offsets"], f"{where}.gimbal.offsets")
-    convention = JointConvention(signs[:3], arm["elbow"], signs[3:], offsets)
     return JointStates(str(node["topic"]), tuple(map(str, names_)), convention, unit,
                        _qos(node["qos"], f"{where}.qos"), float(rate))
 

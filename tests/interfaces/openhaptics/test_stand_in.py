@@ -2,7 +2,7 @@
 OpenHaptics' samples (examples/openhaptics_gravity.c), built unchanged against it, floats the
 stylus with the three lines of docs/servo-loop.md on every model in force and in joint-torque
 mode and lets it fall without them; every tick's command satisfies J^T F = gravity against
-references independent of Phantom (tests/openhaptics_reference.py), in the tick whose state it
+references independent of Phantom (tests/references/openhaptics.py), in the tick whose state it
 was computed from; the headers' values are SensAble's and pyOpenHaptics'; bad calls give
 OpenHaptics' error codes and never reach the plant."""
 
@@ -14,10 +14,10 @@ import subprocess
 import numpy as np
 import pytest
 
-from openhaptics_reference import HDDEFINES, TOLERANCE, falling_posture, framed, residuals, tips
 from phantom_pin.config import MODELS, models, read
 from phantom_pin.interfaces.openhaptics import build, read_record
 from phantom_pin.interfaces.openhaptics.stand_in import headers
+from references.openhaptics import HDDEFINES, TOLERANCE, falling_posture, framed, residuals, tips
 
 EXAMPLE = MODELS["premium_1_5"].urdf.parents[3] / "examples" / "openhaptics_gravity.c"
 INCLUDE = MODELS["premium_1_5"].urdf.parents[1] / "include"

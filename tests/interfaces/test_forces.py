@@ -1,4 +1,4 @@
-"""The force path without ROS (phantom_pin.forces, profiles, ros2.DriverBridge): each driver's
+"""The force path without ROS (phantom_pin.interfaces.forces, profiles, ros2.DriverBridge): each driver's
 joint_states read as the driver writes them (its source lines, driver_reference), the force it
 is sent taken back to OpenHaptics' frame by its own formula, and J^T F compared with the Touch's
 gravity from the report's closed form and the gimbal's reference load (J from complex steps of
@@ -11,11 +11,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-import driver_reference as ref
-from phantom_pin import InvalidInputError, Phantom, profiles
+from helpers import message
+from phantom_pin import InvalidInputError, Phantom
 from phantom_pin.config.types import Friction
-from phantom_pin.forces import SINGULAR, Renderer
-from phantom_pin.ros2 import DriverBridge, fill_force
+from phantom_pin.interfaces import profiles
+from phantom_pin.interfaces.forces import SINGULAR, Renderer
+from phantom_pin.interfaces.ros2.node import DriverBridge, fill_force
+from references import driver as ref
 
 PROFILES = profiles.names()
 
@@ -23,17 +25,6 @@ PROFILES = profiles.names()
 @pytest.fixture(scope="module")
 def touch() -> Phantom:
     return Phantom.from_model("touch")
-
-
-def message(profile: profiles.Profile) -> SimpleNamespace:
-    """An empty force message of the profile's type, as attributes (the ROS classes' layout)."""
-    vector = SimpleNamespace(x=0.0, y=0.0, z=0.0)
-    kind = profile.force.type.rsplit("/", 1)[1]
-    if kind == "Vector3":
-        return vector
-    if kind == "WrenchStamped":
-        return SimpleNamespace(header=SimpleNamespace(stamp=None), wrench=SimpleNamespace(force=vector))
-    return SimpleNamespace(force=vector)
 
 
 def test_every_driver_of_drivers_md_has_a_profile_with_its_sources():

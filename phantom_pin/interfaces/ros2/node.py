@@ -3,7 +3,7 @@ poses out, per message, with the message's stamp (the ``ros2`` extra: rclpy and 
 packages from PyPI).
 
 Input, ``joint_states`` (sensor_msgs/JointState): the older drivers' names and fixed convention
-(drivers.FIXED_CONVENTION, the one urdf/phantom_touch_driver.urdf is jointed in: ``waist,
+(conventions.FIXED_CONVENTION, the one urdf/phantom_touch_driver.urdf is jointed in: ``waist,
 shoulder, elbow`` = theta1, theta2, theta3 - theta2, and, for a model with a stylus gimbal,
 ``yaw, pitch, roll``, OpenHaptics' raw gimbal angles; sawSensablePhantom publishes it; kinisi's,
 CalaW's and RViMLab's drivers do not: read them with ``--driver``, DriverBridge), or the
@@ -19,7 +19,7 @@ Output, every message carrying the input's header stamp:
   (Phantom.gravity); for the model's names tau itself. Position and velocity are empty.
 - ``gravity_torque_openhaptics`` (sensor_msgs/JointState): the same torques as
   HD_CURRENT_JOINT_TORQUE takes them (mN m, on OpenHaptics' angles and signs:
-  drivers.openhaptics_torque_from_tau), named ``turret, thigh, shin`` (OpenHaptics' guide).
+  conventions.openhaptics_torque_from_tau), named ``turret, thigh, shin`` (OpenHaptics' guide).
 - ``tip_pose`` (geometry_msgs/PoseStamped): the tool frame t (the gimbal centre) in
   ``base_link`` (REP-103: x forward, y left, z up; metres).
 - ``stylus_pose`` (geometry_msgs/PoseStamped, a model with a gimbal): the stylus tip, with the
@@ -34,7 +34,7 @@ finite or an angle more than a turn beyond the stops is dropped with one warning
 naming the field; the node keeps running. Quality of service: the subscription is best effort
 (a 1 kHz sensor stream: it matches reliable and best-effort publishers alike), keep last 10: a
 node slower than the stream answers the newest messages, not a growing backlog (rclpy's Python
-executor answers 690-840 messages per second on a 2-core machine, tests/test_ros2.py); the
+executor answers 690-840 messages per second on a 2-core machine, tests/interfaces/ros2/test_node.py); the
 publishers reliable, depth 100.
 """
 
@@ -52,12 +52,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from phantom_pin import drivers
 from phantom_pin.config.types import GIMBAL_JOINTS, JOINTS, Friction
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
-from phantom_pin.forces import Frames, Renderer, Vector
-from phantom_pin.profiles import Profile, Qos
+from phantom_pin.interfaces import conventions
+from phantom_pin.interfaces.forces import Frames, Renderer, Vector
+from phantom_pin.interfaces.profiles import Profile, Qos
 
 __all__ = ["Bridge", "DriverBridge", "Output", "make_node", "spin", "run", "message_type", "fill_force"]
 
@@ -66,7 +66,7 @@ TOPICS = {"joint_states": "joint_states", "wrench": "wrench", "gravity_torque": 
           "gravity_torque_openhaptics": "gravity_torque_openhaptics", "tip_pose": "tip_pose",
           "stylus_pose": "stylus_pose", "model_joint_states": "model_joint_states"}
 #: The joint_states convention read without a driver (the older drivers'; drivers' module doc).
-FIXED = drivers.FIXED_CONVENTION
+FIXED = conventions.FIXED_CONVENTION
 #: OpenHaptics' names of its three joints (its reference guide: "Turet Left +, Thigh Up +, Shin Up +").
 OPENHAPTICS_NAMES = ("turret", "thigh", "shin")
 #: A message is dropped when an angle lies more than this beyond its stop (rad): a turn.
@@ -177,8 +177,8 @@ class Bridge:
         self.phantom = phantom
         self.prefix = prefix = phantom.description.prefix
         self.gimbal = phantom.config.gimbal
-        self.driver_names = tuple(prefix + n for n in drivers.JOINT_STATE_NAMES)
-        self.driver_gimbal = tuple(prefix + n for n in drivers.GIMBAL_STATE_NAMES)
+        self.driver_names = tuple(prefix + n for n in conventions.JOINT_STATE_NAMES)
+        self.driver_gimbal = tuple(prefix + n for n in conventions.GIMBAL_STATE_NAMES)
         self.model_arm = tuple(prefix + n for n in JOINTS)
         self.model_gimbal = tuple(prefix + n for n in GIMBAL_JOINTS)
         # box of each input angle: the stops a turn wide on each side (theta; the gimbal's ranges)
@@ -247,7 +247,7 @@ class Bridge:
         tip = self.base_from_s @ phantom.forward_kinematics(theta)
         stylus = None if gimbal is None else self.base_from_s @ phantom.stylus_tip_pose(theta, gimbal)
         return Output(tuple(self.driver_names if driver else self.model_arm), effort,
-                      drivers.openhaptics_torque_from_tau(tau), tip, stylus, self.model_names,
+                      conventions.openhaptics_torque_from_tau(tau), tip, stylus, self.model_names,
                       self.full.configuration(state))
 
 

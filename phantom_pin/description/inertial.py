@@ -11,7 +11,7 @@ whose principal moments, as its own eigen-decomposition finds them, break a + b 
 with products of inertia, the rounding of that decomposition refuses links up to about
 1e-14 c inside the boundary (measured, DEVELOPERS.md). TRIANGLE_SLACK keeps a margin of
 100 over that, so every link this check accepts loads in MuJoCo, Pinocchio and Drake
-(tests/test_inertial.py loads the boundary in MuJoCo).
+(tests/description/test_inertial.py loads the boundary in MuJoCo).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The ROS 2 node (phantom_pin.ros2, `phantom-pin ros2`): its computation against the closed form,
+"""The ROS 2 node (phantom_pin.interfaces.ros2.node, `phantom-pin ros2`): its computation against the closed form,
 the gimbal's rigid-body reference and the URDF's mimic semantics written here; then the real
 node over loopback with the real rclpy (PyPI's wheels): a driver's joint_states replayed at
 1 kHz for 2 s, every message it publishes checked, counted and timed, bad messages dropped
@@ -6,22 +6,24 @@ with a warning, and a clean stop on SIGINT and SIGTERM."""
 
 from __future__ import annotations
 
-import os
 import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
-from gimbal_reference import gimbal_gravity, openhaptics, ubitrack
-from helpers import CONFIG_DIR
-from phantom_pin import InvalidInputError, Phantom, closed_form, drivers, ros2
+from helpers import CONFIG_DIR, in_process
+from helpers import ros_environment as _environment
+from helpers import stop_process as _stop
+from phantom_pin import InvalidInputError, Phantom, closed_form
 from phantom_pin.config import read
-from phantom_pin.ros2 import Bridge
+from phantom_pin.interfaces import conventions
+from phantom_pin.interfaces.ros2 import node as ros2
+from phantom_pin.interfaces.ros2.node import Bridge
+from references.gimbal import gimbal_gravity, openhaptics, ubitrack
 
 TOUCH = CONFIG_DIR.parent / "touch"
 KINEMATICS = yaml.safe_load((TOUCH / "kinematics.yaml").read_text())
@@ -125,36 +127,11 @@ def test_a_bad_message_is_refused_naming_its_field(touch, names, position, field
 RATE, SECONDS = 1000.0, 2.0
 
 
-#: Fast DDS's discovery announcements for processes on loopback (the file says why).
-DISCOVERY = str(Path(__file__).with_name("fastdds_loopback.xml"))
-
-
-def _environment(domain: int | None = None) -> dict[str, str]:
-    """Loopback only, Fast DDS's discovery of DISCOVERY, and a ROS domain of this test run alone
-    (``domain``, else one from the process id)."""
-    return {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "FASTDDS_DEFAULT_PROFILES_FILE": DISCOVERY,
-            "ROS_DOMAIN_ID": str(1 + os.getpid() % 100 if domain is None else domain), "PYTHONUNBUFFERED": "1"}
-
-
-def in_process(environment: dict[str, str]) -> None:
-    """This process's own nodes (rclpy in the test) in ``environment``'s domain and discovery."""
-    os.environ.update({k: v for k, v in environment.items() if k.startswith(("ROS_", "FASTDDS_"))})
 
 
 def _start_node() -> subprocess.Popen:
     return subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "--model", "touch", "ros2"],
                             env=_environment(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-
-
-def _stop(process: subprocess.Popen, sig: int) -> tuple[int, str]:
-    process.send_signal(sig)
-    try:
-        _, err = process.communicate(timeout=20)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        _, err = process.communicate()
-        raise AssertionError(f"the node did not stop on signal {sig}: {err}") from None
-    return process.returncode, err
 
 
 @pytest.mark.slow
@@ -305,13 +282,13 @@ def test_the_node_stops_cleanly_on_sigint_and_refuses_bad_arguments_in_one_line(
 ])
 def test_a_name_given_twice_is_refused_as_the_drivers_conversions_refuse_it(touch, names):
     """The node drops a message giving a joint name twice, InvalidInputError naming ``name``, as
-    drivers.theta_from_joint_state and gimbal_from_joint_state refuse it, naming ``names``."""
+    conventions.theta_from_joint_state and gimbal_from_joint_state refuse it, naming ``names``."""
     position = [0.1] * len(names)
     with pytest.raises(InvalidInputError) as error:
         ros2.Bridge(touch)(names, position)
     assert error.value.argument == "name"
     if names[0] == "waist":
-        convert = drivers.theta_from_joint_state if len(names) == 4 else drivers.gimbal_from_joint_state
+        convert = conventions.theta_from_joint_state if len(names) == 4 else conventions.gimbal_from_joint_state
         with pytest.raises(InvalidInputError) as error:
             convert(names, position)
         assert error.value.argument == "names"
@@ -449,8 +426,8 @@ def test_a_users_wrench_in_base_link_reaches_the_driver_as_the_same_force_and_th
     stamps needs it), exactly."""
     from geometry_msgs.msg import WrenchStamped
 
-    import driver_reference as ref
-    from phantom_pin import profiles
+    from phantom_pin.interfaces import profiles
+    from references import driver as ref
 
     profile = profiles.load(name)
     driver = ros2.DriverBridge(touch, profile)
@@ -478,8 +455,8 @@ def test_friction_compensation_runs_on_the_states_stamps_when_they_arrive_in_a_b
     the stamps' (the wall clock's would be microseconds apart), so after them J^T F = G +
     viscous w + Coulomb sign(w) (config/touch/actuation.yaml: 5e-4 N m s/rad, 0.01 N m; the
     references' J and G), 1e-9 N m."""
-    import driver_reference as ref
-    from phantom_pin import profiles
+    from phantom_pin.interfaces import profiles
+    from references import driver as ref
 
     profile = profiles.load("geomagic_touch_x_ros2")
     driver = ros2.DriverBridge(touch, profile, compensate=("gravity", "friction"))
@@ -504,7 +481,7 @@ def test_with_a_driver_the_outputs_follow_at_a_hundred_hertz(touch, monkeypatch)
 
     import rclpy
 
-    from phantom_pin import profiles
+    from phantom_pin.interfaces import profiles
 
     in_process(_environment())
     clock = types.SimpleNamespace(now=0.0)
