@@ -3,7 +3,7 @@
  * between hdBeginFrame and hdEndFrame), with the three lines of docs/servo-loop.md added.
  *
  * Against a real device: gcc -I $OH/include examples/openhaptics_gravity.c -L $OH/lib -lHD -lm
- *   -I robots/phantom_description/include -DPHANTOM_HEADER='"phantom_touch.h"'
+ *   -I robots/phantom_description/include -DPHANTOM_HEADER='"touch.h"'
  * Without one: phantom-pin --model touch openhaptics-sim build sim, then the same with
  *   -I sim/include -L sim/lib, and run with LD_LIBRARY_PATH=sim/lib (tests/interfaces/openhaptics/test_stand_in.py).
  *
@@ -17,7 +17,7 @@
 #include <HD/hd.h>
 
 #ifndef PHANTOM_HEADER
-#define PHANTOM_HEADER "phantom_1_5.h"
+#define PHANTOM_HEADER "premium_1_5.h"
 #endif
 #include PHANTOM_HEADER
 

@@ -9,13 +9,13 @@
  * Build and run (C99, only the header and <math.h>; the Premium 1.5 by default):
  *     gcc -std=c99 -O2 -I robots/phantom_description/include examples/servo_loop.c -o servo_loop -lm
  *     ./servo_loop            # prints "t theta1 theta2 theta3 tau1 tau2 tau3" per period (s, rad, N m)
- * Another model: -DPHANTOM_HEADER='"phantom_touch.h"'. On a device, the controller() below is
+ * Another model: -DPHANTOM_HEADER='"touch.h"'. On a device, the controller() below is
  * the whole callback: read theta and dtheta, call it, send tau (docs/servo-loop.md: the three lines). */
 
 #include <stdio.h>
 
 #ifndef PHANTOM_HEADER
-#define PHANTOM_HEADER "phantom_1_5.h"
+#define PHANTOM_HEADER "premium_1_5.h"
 #endif
 #include PHANTOM_HEADER
 

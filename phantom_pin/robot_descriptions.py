@@ -9,10 +9,11 @@ Each model (``premium_1_5``, ``premium_1_5_cad``, ``touch``, and the module itse
 default) has PACKAGE_PATH (robots/phantom_description, the ROS package), REPOSITORY_PATH (the
 folder holding robots/), URDF_PATH, SRDF_PATH, MJCF_PATH (the arm), SCENE_PATH (the MJCF
 scene: floor, light, table), XACRO_PATH (the top-level xacro, one for every model) with
-XACRO_ARGS (the xacro arguments that select the model: ``xacro XACRO_PATH *XACRO_ARGS``) and
+XACRO_ARGS (the xacro arguments that select the model, a dict as robot_descriptions.py's:
+``xacro.process_file(XACRO_PATH, mappings=XACRO_ARGS)``, or ``xacro XACRO_PATH model:=NAME``) and
 CONFIG_PATH (its YAML). The
 Touch, whose ROS drivers publish joint_states in their own convention, also has
-DRIVER_URDF_PATH (urdf/phantom_touch_driver.urdf: the same arm jointed as the older drivers' waist,
+DRIVER_URDF_PATH (urdf/touch_driver.urdf: the same arm jointed as the older drivers' waist,
 shoulder, elbow, yaw, pitch, roll, phantom_pin.interfaces.conventions.FIXED_CONVENTION, for
 robot_state_publisher; phantom-pin urdf --convention driver; kinisi's and CalaW's drivers publish
 the waist with the other sign: docs/ros2.md).
@@ -39,9 +40,9 @@ def _files(name: str, driver: bool = False) -> types.SimpleNamespace:
     files = types.SimpleNamespace(
         PACKAGE_PATH=PACKAGE_PATH, REPOSITORY_PATH=REPOSITORY_PATH, URDF_PATH=str(model.urdf),
         SRDF_PATH=str(model.srdf), MJCF_PATH=str(model.mjcf), SCENE_PATH=str(model.scene),
-        XACRO_PATH=str(model.urdf_xacro), XACRO_ARGS=list(model.xacro_args), CONFIG_PATH=str(model.config))
+        XACRO_PATH=str(model.urdf_xacro), XACRO_ARGS=model.xacro_mappings, CONFIG_PATH=str(model.config))
     if driver:  # the drivers' convention (description.build.driver_urdf), committed beside the URDF
-        files.DRIVER_URDF_PATH = str(model.urdf.with_name(f"{model.robot_name}_driver.urdf"))
+        files.DRIVER_URDF_PATH = str(model.urdf.with_name(f"{model.name}_driver.urdf"))
     return files
 
 

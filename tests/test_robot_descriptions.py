@@ -30,8 +30,9 @@ def test_every_model_has_the_attributes_naming_its_committed_files(name):
     assert Path(files.URDF_PATH).is_relative_to(files.PACKAGE_PATH)
     # xacro XACRO_PATH *XACRO_ARGS is this model: the robot its URDF names
     import xacro
-    document = xacro.process_file(files.XACRO_PATH, mappings=dict(a.split(":=") for a in files.XACRO_ARGS))
-    assert document.documentElement.getAttribute("name") == model.robot_name
+    # (a copy: xacro adds its arguments' defaults to the dict it is given)
+    document = xacro.process_file(files.XACRO_PATH, mappings=dict(files.XACRO_ARGS))
+    assert document.documentElement.getAttribute("name") == model.name == name
 
 
 def test_the_module_itself_is_the_default_model():
@@ -57,7 +58,7 @@ def test_a_loader_without_mimic_opens_the_parallelogram():
 
 
 def test_the_touch_has_the_path_of_its_drivers_convention_urdf():
-    """L16: no path named urdf/phantom_touch_driver.urdf. The Touch's DRIVER_URDF_PATH is that
+    """L16: no path named urdf/touch_driver.urdf. The Touch's DRIVER_URDF_PATH is that
     committed file, whose joints are the drivers' published joint_states names (waist, shoulder,
     elbow, yaw, pitch, roll: fsuarez6/phantom_omni omni_state.cpp, jhu-saw/sawSensablePhantom);
     the models without drivers' convention have none."""
@@ -65,7 +66,7 @@ def test_the_touch_has_the_path_of_its_drivers_convention_urdf():
 
     path = Path(robot_descriptions.touch.DRIVER_URDF_PATH)
     assert path.is_absolute() and path == Path(robot_descriptions.touch.PACKAGE_PATH, "urdf",
-                                                "phantom_touch_driver.urdf")
+                                                "touch_driver.urdf")
     joints = {joint.get("name") for joint in ET.parse(path).getroot().iter("joint")}
     assert {"waist", "shoulder", "elbow", "yaw", "pitch", "roll"} <= joints
     for name in models():

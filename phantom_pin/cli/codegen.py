@@ -28,7 +28,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     """codegen."""
     command = sub.add_parser("codegen", help="write a self-contained C99 header (gravity, inverse dynamics, "
                                              "M, Coriolis, tip position, Jacobian, J^T F) for a servo loop")
-    command.add_argument("--output", "-o", required=True, action=Once, help="the header to write, e.g. phantom_touch.h")
+    command.add_argument("--output", "-o", required=True, action=Once, help="the header to write, e.g. touch.h")
     command.add_argument("--prefix", default="phantom", help="the C name of every function (default phantom)")
     command.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
     command.set_defaults(run=codegen, options={"prefix": "--prefix"})

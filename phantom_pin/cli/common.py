@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from phantom_pin._validation import output_path, within_box
-from phantom_pin.config import DEFAULT, models, read_overrides
+from phantom_pin.config import DEFAULT, models, read_overrides, renamed
 from phantom_pin.description.build import Description, describe, description_of
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
@@ -92,6 +92,7 @@ def source(args: argparse.Namespace) -> str | Path:
     if args.config is not None and args.model != DEFAULT:
         raise PhantomPinError("give --model or --config, not both", argument="--config")
     if args.config is None and args.model not in models():
+        renamed(args.model, "--model")
         raise PhantomPinError(f"{args.model!r} is not a model ({', '.join(models())}); "
                               "use --config for a folder", argument="--model")
     return args.config if args.config is not None else args.model

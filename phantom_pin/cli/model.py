@@ -31,7 +31,7 @@ from phantom_pin.cli.common import (
     write_texts,
 )
 from phantom_pin.config.types import Gimbal
-from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml, xacro_model
+from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml
 from phantom_pin.dynamics import verification
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.model import Phantom
@@ -163,13 +163,12 @@ def write(args: argparse.Namespace) -> int:
     # the scene includes the model by a path relative to the scene's own folder (MuJoCo resolves it there)
     robot_file = target.name if scene is None else os.path.relpath(target.resolve(), scene.resolve().parent)
     made = description(args, prefix=args.prefix, robot_file=robot_file)
-    robot = xacro_model(made.config).robot_name
     if args.kind == "urdf" and args.convention == "driver":
         write_text(target, driver_urdf(made.config.folder if made.model is None else made.config.name,
                                        prefix=args.prefix, overrides=overrides(args)))
         print(f"wrote {target}")
         return 0
-    texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config, robot)}
+    texts = {"urdf": made.urdf, "srdf": made.srdf, "mjcf": made.mjcf, "links": links_yaml(made.config)}
     # both files or neither (a scene that cannot be written leaves no model behind)
     write_texts([(target, texts[args.kind], "--output")] + ([] if scene is None else [(scene, made.scene, "--scene")]))
     print(f"wrote {target}")

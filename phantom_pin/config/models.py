@@ -21,7 +21,6 @@ class Model:
 
     name: str
     title: str
-    robot_name: str
     urdf_xacro: Path
     srdf_xacro: Path
     urdf: Path
@@ -35,33 +34,50 @@ class Model:
         return DESCRIPTION_DIR / "config" / self.name
 
     @property
+    def xacro_mappings(self) -> dict[str, str]:
+        """The xacro arguments that select this model, as xacro.process_file's ``mappings``
+        (and robot_descriptions.py's XACRO_ARGS): {"model": NAME}."""
+        return {"model": self.name}
+
+    @property
     def xacro_args(self) -> tuple[str, ...]:
         """The command-line arguments of ``xacro`` that select this model in ``urdf_xacro`` and
         ``srdf_xacro`` (the other arguments keep their defaults: the model's own files)."""
-        return (f"model:={self.name}",)
+        return tuple(f"{arg}:={value}" for arg, value in self.xacro_mappings.items())
 
 
-def _model(name: str, title: str, robot: str) -> Model:
+def _model(name: str, title: str) -> Model:
+    """The model ``name``: its robot and every file of it are named ``name`` (urdf/NAME.urdf, ...)."""
     d = DESCRIPTION_DIR
-    return Model(name, title, robot, d / "urdf" / "phantom.urdf.xacro", d / "srdf" / "phantom.srdf.xacro",
-                 d / "urdf" / f"{robot}.urdf", d / "srdf" / f"{robot}.srdf", d / "mjcf" / f"{robot}.xml",
-                 d / "mjcf" / f"scene_{robot}.xml", d / "config" / name / "links.yaml")
+    return Model(name, title, d / "urdf" / "phantom.urdf.xacro", d / "srdf" / "phantom.srdf.xacro",
+                 d / "urdf" / f"{name}.urdf", d / "srdf" / f"{name}.srdf", d / "mjcf" / f"{name}.xml",
+                 d / "mjcf" / f"scene_{name}.xml", d / "config" / name / "links.yaml")
 
 
 #: The shipped configurations, by name; the first is the default everywhere.
 MODELS = {model.name: model for model in (
-    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers", "phantom_1_5"),
-    _model("premium_1_5_cad", "PHANToM Premium 1.5, mahilab/Phantom's CAD mass properties and lengths",
-           "phantom_1_5_cad"),
+    _model("premium_1_5", "PHANToM Premium 1.5, the report's numbers"),
+    _model("premium_1_5_cad", "PHANToM Premium 1.5, mahilab/Phantom's CAD mass properties and lengths"),
     _model("touch", "Geomagic Touch / PHANToM Omni: the report's arm at its size, ESTIMATED inertias, "
-                    "no public motor data", "phantom_touch"),
+                    "no public motor data"),
 )}
 DEFAULT = "premium_1_5"
+#: The robot names of 0.x before each model's files and robot took its name (CHANGELOG.md):
+#: refused for one release, naming the model.
+RENAMED = {"phantom_1_5": "premium_1_5", "phantom_1_5_cad": "premium_1_5_cad", "phantom_touch": "touch"}
 
 
 def models() -> list[str]:
     """The names of the shipped configurations (phantom_pin.describe(name) and --model NAME)."""
     return list(MODELS)
+
+
+def renamed(name: object, argument: str = "model") -> None:
+    """InvalidInputError naming ``argument`` if ``name`` is an old name of a model (RENAMED)."""
+    if isinstance(name, str) and name in RENAMED:
+        new = RENAMED[name]
+        raise InvalidInputError(f"{name!r} is the old name of the model {new!r} (its files are {new}.urdf, "
+                                f"{new}.srdf, {new}.xml now): use {new!r}", argument=argument)
 
 
 def resolve(source: object, argument: str = "model") -> tuple[str, Path, Model | None]:
@@ -75,6 +91,7 @@ def resolve(source: object, argument: str = "model") -> tuple[str, Path, Model |
     if isinstance(source, str) and source in MODELS:
         model = MODELS[source]
         return model.name, model.config, model
+    renamed(source, argument)
     folder = Path(source)
     if not folder.is_dir():
         if isinstance(source, str) and os.sep not in source and "/" not in source:

@@ -53,7 +53,7 @@ def _process(source: Path, mappings: dict[str, str]) -> str:
     return doc.toprettyxml(indent="  ")
 
 
-def links_yaml(config: Config, robot: str = "phantom_1_5") -> str:
+def links_yaml(config: Config) -> str:
     """The YAML text of ``config.links`` and of base_link's ``config.housing`` (links_file of
     the xacro), with its header. Numbers
     keep their type, so that xacro prints an exact zero given as an integer as ``0``."""
@@ -61,7 +61,7 @@ def links_yaml(config: Config, robot: str = "phantom_1_5") -> str:
     document = {"links": {name: {"mass": link.mass, "com": list(link.com),
                                  "inertia": dict(zip(INERTIA_KEYS, link.inertia))}
                           for name, link in every.items()}}
-    return (_LINKS_HEADER.format(name=config.name, robot=robot)
+    return (_LINKS_HEADER.format(name=config.name)
             + yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=110))
 
 
@@ -175,7 +175,7 @@ def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
     """
     config, model, urdf, srdf = _generate(source, prefix, overrides)
     robot_file = model.mjcf.name if robot_file is None else robot_file
-    mjcf, scene = mjcf_texts(urdf, srdf, config, prefix, robot_file, model.robot_name)
+    mjcf, scene = mjcf_texts(urdf, srdf, config, prefix, robot_file, model.name)
     return Description(config, configuration.MODELS.get(config.name), prefix, urdf, srdf, mjcf, scene, robot_file)
 
 
@@ -200,6 +200,7 @@ def shipped(name: str = configuration.DEFAULT) -> Description:
     """A named model with its committed URDF, SRDF and MJCF files (which
     tests/description/test_description.py shows equal to describe(name)), read once per process."""
     if name not in configuration.MODELS:
+        configuration.renamed(name)
         raise InvalidInputError(f"{name!r} is not a model ({', '.join(configuration.MODELS)})", argument="model")
     model = configuration.MODELS[name]
     config = configuration.read(name)
@@ -226,7 +227,7 @@ def held(description: Description, gimbal: object) -> Description:
                                     argument="gimbal")
     config = dataclasses.replace(config, gimbal=dataclasses.replace(config.gimbal, locked_at=tuple(angles)))
     mjcf, scene = mjcf_texts(description.urdf, description.srdf, config, description.prefix, description.robot_file,
-                             xacro_model(config).robot_name)
+                             xacro_model(config).name)
     return dataclasses.replace(description, config=config, mjcf=mjcf, scene=scene)
 
 

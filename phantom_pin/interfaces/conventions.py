@@ -34,7 +34,7 @@ table):
   WPI-AIM/ros_geomagic 441542c geomagic_control/src/device_node.cpp line 200 with 260 and 301-303,
   and jhu-saw/sawSensablePhantom 7ddd575 core/components/code/mtsSensableHD.cpp lines 312-313 and
   418-419 (``q[0] = -q[0]; q[2] -= q[1]``). Their convention, FIXED_CONVENTION, is the one
-  urdf/phantom_touch_driver.urdf, the ``ros2`` node without ``--driver`` and the
+  urdf/touch_driver.urdf, the ``ros2`` node without ``--driver`` and the
   ``joint_state_*`` functions here read.
 - waist = +a1 = -theta1: kinisi-robotics/phantom_touch_ros2 2bf5b20
   phantom_touch_control/src/hd++.cpp lines 257-268 (no sign, ``angles[2] -= angles[1]``),
@@ -126,7 +126,7 @@ class JointConvention:
     the arm ``published = arm_signs * (a1, a2, a3 - a2)`` (``elbow`` "relative") or ``arm_signs
     * (a1, a2, a3)`` ("absolute"), the gimbal ``published = gimbal_signs * g + gimbal_offsets``.
     The one reader of every driver's joint states: each profile's (Profile.joint_states.convention)
-    and FIXED_CONVENTION (urdf/phantom_touch_driver.urdf, the ``ros2`` node without a driver).
+    and FIXED_CONVENTION (urdf/touch_driver.urdf, the ``ros2`` node without a driver).
     InvalidInputError naming the field for a sign other than 1 or -1, an unknown elbow or an
     offset that is not finite. Each method takes (3,) or (..., 3) and is exact (signs, one sum)."""
 
@@ -207,7 +207,7 @@ def convention_of(node: dict, where: str) -> JointConvention:
 #: shares the arm; its gimbal is GIMBAL_CONVENTIONS["omni_firewire"]).
 FIXED_PROFILE = "sawsensablephantom"
 #: That profile's joint-state convention, read from config/drivers/FIXED_PROFILE.yaml: the one
-#: urdf/phantom_touch_driver.urdf is jointed in, and the ``ros2`` node's without a driver.
+#: urdf/touch_driver.urdf is jointed in, and the ``ros2`` node's without a driver.
 FIXED_CONVENTION = convention_of(read_yaml(PROFILES_DIR / f"{FIXED_PROFILE}.yaml")["joint_states"],
                                  f"{FIXED_PROFILE}.yaml: joint_states")
 

@@ -17,7 +17,7 @@ Joint states: each profile's phantom_pin.interfaces.conventions.JointConvention 
 OpenHaptics' raw arm angles a (HD_CURRENT_JOINT_ANGLES, rad), the elbow ``relative`` (sign3 *
 (a3 - a2)) or ``absolute`` (sign3 * a3); the gimbal ``published = sign * g + offset``
 (HD_CURRENT_GIMBAL_ANGLES, rad)), the one reader that the ``ros2`` node without a driver and
-urdf/phantom_touch_driver.urdf use too (drivers.FIXED_CONVENTION). The report's theta is (-a1,
+urdf/touch_driver.urdf use too (drivers.FIXED_CONVENTION). The report's theta is (-a1,
 a2, a3) (phantom_pin.interfaces.conventions).
 """
 

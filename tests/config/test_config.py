@@ -277,7 +277,7 @@ def test_shipped_checks_the_committed_urdf(tmp_path, monkeypatch):
 
     model = config.MODELS["premium_1_5"]
     text = model.urdf.read_text()
-    bad = tmp_path / "phantom_1_5.urdf"
+    bad = tmp_path / "premium_1_5.urdf"
     bad.write_text(text.replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>', 1))
     assert bad.read_text() != text
     monkeypatch.setitem(config.MODELS, "premium_1_5", dataclasses.replace(model, urdf=bad))

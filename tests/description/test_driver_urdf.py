@@ -1,4 +1,4 @@
-"""The Touch's URDF in the older ROS drivers' fixed convention (urdf/phantom_touch_driver.urdf,
+"""The Touch's URDF in the older ROS drivers' fixed convention (urdf/touch_driver.urdf,
 drivers.FIXED_CONVENTION): their six joint_states drive it unchanged. Its link poses, in Pinocchio (mimic) and yourdfpy,
 from joint_states written by the drivers' published formulas (waist = -angle1, shoulder =
 angle2, elbow = angle3 - angle2, raw gimbal angles), equal ours in the report's convention
@@ -20,7 +20,7 @@ from phantom_pin.config import MODELS
 from phantom_pin.description.build import driver_urdf
 from references import driver as driver_reference
 
-DRIVER_URDF = MODELS["touch"].urdf.with_name("phantom_touch_driver.urdf")
+DRIVER_URDF = MODELS["touch"].urdf.with_name("touch_driver.urdf")
 TOUCH = MODELS["touch"].config
 DRIVER_JOINTS = ("waist", "shoulder", "elbow", "yaw", "pitch", "roll")
 OURS = ("joint1", "joint2", "joint3", "joint4", "joint5", "joint6")

@@ -92,20 +92,20 @@ def test_launch_file_shows_each_committed_robot(monkeypatch):
                                                      "node": "false"})
         assert publisher.package == "robot_state_publisher" and gui_node.package == "joint_state_publisher_gui"
         assert publisher.parameters == [{"robot_description": (DESCRIPTION_DIR / "urdf" / f"{robot}.urdf").read_text()}]
-    assert argument.default_value == "phantom_1_5"
+    assert argument.default_value == "premium_1_5"
     # the Touch in the drivers' convention, its joint_states from a running driver (no GUI)
     assert convention.choices == ["report", "driver"] and gui.default_value == "true"
-    publisher, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false",
+    publisher, rviz = opaque.function({"robot": "touch", "convention": "driver", "gui": "false",
                                        "node": "false"})
     assert publisher.parameters == [{"robot_description": (DESCRIPTION_DIR / "urdf" /
-                                                           "phantom_touch_driver.urdf").read_text()}]
+                                                           "touch_driver.urdf").read_text()}]
     assert rviz.package == "rviz2"
-    with pytest.raises(RuntimeError, match="convention:=driver: no phantom_1_5_driver.urdf"):
-        opaque.function({"robot": "phantom_1_5", "convention": "driver", "gui": "true", "node": "false"})
+    with pytest.raises(RuntimeError, match="convention:=driver: no premium_1_5_driver.urdf"):
+        opaque.function({"robot": "premium_1_5", "convention": "driver", "gui": "true", "node": "false"})
     # phantom_pin's node beside robot_state_publisher: the command line docs/ros2.md gives, which
     # parses (the model is the robot's)
     assert node.default_value == "false"
-    publisher, ours, rviz = opaque.function({"robot": "phantom_touch", "convention": "driver", "gui": "false",
+    publisher, ours, rviz = opaque.function({"robot": "touch", "convention": "driver", "gui": "false",
                                              "node": "true"})
     assert ours.cmd == ["phantom-pin", "--model", "touch", "ros2"]
     from phantom_pin.cli.app import parser
@@ -157,4 +157,4 @@ def test_colcon_builds_and_installs_the_package_and_xacro_reproduces_the_urdfs(t
                             text=True, cwd=top.parent)
     assert result.returncode == 0, result.stderr
     assert ET.canonicalize(result.stdout, strip_text=True) == \
-        ET.canonicalize((share / "urdf" / "phantom_touch_driver.urdf").read_text(), strip_text=True)
+        ET.canonicalize((share / "urdf" / "touch_driver.urdf").read_text(), strip_text=True)

@@ -3,7 +3,7 @@ poses out, per message, with the message's stamp (the ``ros2`` extra: rclpy and 
 packages from PyPI).
 
 Input, ``joint_states`` (sensor_msgs/JointState): the older drivers' names and fixed convention
-(conventions.FIXED_CONVENTION, the one urdf/phantom_touch_driver.urdf is jointed in: ``waist,
+(conventions.FIXED_CONVENTION, the one urdf/touch_driver.urdf is jointed in: ``waist,
 shoulder, elbow`` = theta1, theta2, theta3 - theta2, and, for a model with a stylus gimbal,
 ``yaw, pitch, roll``, OpenHaptics' raw gimbal angles; sawSensablePhantom publishes it; kinisi's,
 CalaW's and RViMLab's drivers do not: read them with ``--driver``, DriverBridge), or the

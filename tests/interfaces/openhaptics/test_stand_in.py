@@ -25,7 +25,7 @@ MODES = ("force", "joint_torque")
 
 
 def header_of(name):
-    return {"premium_1_5": "phantom_1_5.h", "premium_1_5_cad": "phantom_1_5_cad.h", "touch": "phantom_touch.h"}[name]
+    return {"premium_1_5": "premium_1_5.h", "premium_1_5_cad": "premium_1_5_cad.h", "touch": "touch.h"}[name]
 
 
 @pytest.fixture(scope="module")
