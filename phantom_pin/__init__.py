@@ -2,8 +2,8 @@
 report's equations, from one typed configuration per device (phantom_pin.models()).
 
 One way to make each object: ``Phantom(description)`` (``Phantom()`` the default model;
-``Phantom.from_model(name)``, ``Phantom.from_folder(path)``), ``Device(phantom)``
-(``Device.from_model(name)``), ``load(description)`` (``load_files(loader)`` for a PhantomLoader's
+``Phantom.from_model(model)``, ``Phantom.from_folder(path)``), ``Device(phantom)``
+(``Device.from_model(model)``), ``load(description)`` (``load_files(loader)`` for a PhantomLoader's
 files), each Description from ``describe(name or folder, overrides=...)``. A Phantom is passed as
 ``phantom`` and a Device as ``device`` wherever a function takes one (``check(phantom)``,
 ``simulate(..., device=)``, ``identification.optimise(phantom)``)."""

@@ -66,7 +66,7 @@ def test_the_entry_points_have_top_level_names():
 
 
 @pytest.mark.parametrize("bad, call", [("touch", "Phantom.from_model('touch')"),
-                                       (phantom_pin.Description, "Phantom.from_model(name)")])
+                                       (phantom_pin.Description, "Phantom.from_model(model)")])
 def test_check_refuses_what_is_not_a_phantom(bad, call):
     with pytest.raises(InvalidInputError) as error:
         phantom_pin.check(bad, states=1)

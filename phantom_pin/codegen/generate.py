@@ -235,28 +235,28 @@ def _leaner(exprs: list[Any]) -> list[Any]:
     return expanded if cost(expanded) < cost(exprs) else exprs
 
 
-def header(source: str | Path | Description, prefix: str = "phantom",
+def header(model: str | Path | Description, prefix: str = "phantom",
            overrides: Mapping[str, object] | None = None,
-           progress: Callable[[float], None] | None = None, *, argument: str = "source") -> str:
+           progress: Callable[[float], None] | None = None, *, argument: str = "model") -> str:
     """The C99 header of a model name (phantom_pin.models()) or a configuration folder with
     ``overrides`` (as describe()'s), its functions named ``prefix``_...; its banner names
-    the model, the configuration's source and the overrides. describe()'s errors as they are;
+    the model, the configuration's model and the overrides. describe()'s errors as they are;
     InvalidInputError naming ``prefix`` unless it is a C identifier. A Description is taken
     as it is (its banner then says so: the overrides it was built with are not known).
     ``progress``: called with the share done (0..1), for a progress bar; generation takes
-    seconds (SymPy). ``argument``: the name that errors about ``source`` give it."""
+    seconds (SymPy). ``argument``: the name that errors about ``model`` give it."""
     _require_sympy()
     if not is_identifier(prefix):
         raise InvalidInputError(f"must be a C identifier (letters, digits, _), got {prefix!r}",
                                 argument="prefix")
     overlay = dict(overrides or {})
-    if isinstance(source, Description):
-        description, origin = source, f"a Description of {source.config.name}"
+    if isinstance(model, Description):
+        description, origin = model, f"a Description of {model.config.name}"
         overlay_text = "as built into that Description"
     else:
-        description = describe(source, overrides=overlay) if overlay else description_of(source, argument)
-        origin = (f"robots/phantom_description/config/{source}" if description.model is not None
-                  and str(source) == description.config.name else str(source))
+        description = describe(model, overrides=overlay) if overlay else description_of(model, argument)
+        origin = (f"robots/phantom_description/config/{model}" if description.model is not None
+                  and str(model) == description.config.name else str(model))
         overlay_text = "; ".join(f"{k} = {v!r}" for k, v in sorted(overlay.items())) or "none"
     return _header(description, prefix, origin, overlay_text, progress or (lambda share: None))
 

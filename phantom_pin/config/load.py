@@ -12,13 +12,13 @@ from phantom_pin.config.types import Config
 from phantom_pin.exceptions import ParameterFileError
 
 
-def read(source: str | Path = DEFAULT, overrides: dict[str, object] | None = None) -> Config:
+def read(model: str | Path = DEFAULT, overrides: dict[str, object] | None = None) -> Config:
     """The Config of a model name (phantom_pin.models()) or a configuration folder, its
     files read once each, with ``overrides`` (dotted keys, files.apply_overrides) applied.
     An override ``model`` (files.MODEL_KEY, as identify's overlay writes it) must name this
     model. Raises ParameterFileError naming the file and the key (or ``model`` for overrides
     made for another model), InvalidInputError naming ``model`` for an unknown name or folder."""
-    name, folder, _ = resolve(source)
+    name, folder, _ = resolve(model)
     overrides = dict(overrides or {})
     made_for = overrides.pop(MODEL_KEY, None)
     if made_for is not None and made_for != name:

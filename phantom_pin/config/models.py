@@ -80,22 +80,22 @@ def renamed(name: object, argument: str = "model") -> None:
                                 f"{new}.srdf, {new}.xml now): use {new!r}", argument=argument)
 
 
-def resolve(source: object, argument: str = "model") -> tuple[str, Path, Model | None]:
+def resolve(model: object, argument: str = "model") -> tuple[str, Path, Model | None]:
     """(name, config folder, Model or None) of a model name or a configuration folder.
 
     A string without a path separator that names no folder must be a model's name;
     InvalidInputError naming ``argument`` otherwise."""
-    if not isinstance(source, (str, os.PathLike)):
+    if not isinstance(model, (str, os.PathLike)):
         raise InvalidInputError(f"expected a model name ({', '.join(MODELS)}) or a "
-                                f"configuration folder, got {source!r}", argument=argument)
-    if isinstance(source, str) and source in MODELS:
-        model = MODELS[source]
-        return model.name, model.config, model
-    renamed(source, argument)
-    folder = Path(source)
+                                f"configuration folder, got {model!r}", argument=argument)
+    if isinstance(model, str) and model in MODELS:
+        named = MODELS[model]
+        return named.name, named.config, named
+    renamed(model, argument)
+    folder = Path(model)
     if not folder.is_dir():
-        if isinstance(source, str) and os.sep not in source and "/" not in source:
-            raise InvalidInputError(f"{source!r} is neither a model ({', '.join(MODELS)}) nor a folder",
+        if isinstance(model, str) and os.sep not in model and "/" not in model:
+            raise InvalidInputError(f"{model!r} is neither a model ({', '.join(MODELS)}) nor a folder",
                                     argument=argument)
         raise InvalidInputError(f"{folder} is not a folder", argument=argument)
     shipped = next((m for m in MODELS.values() if m.config.resolve() == folder.resolve()), None)

@@ -136,32 +136,32 @@ def xacro_model(config: Config) -> Model:
 PREFIX = re.compile(r"(?:[A-Za-z_][A-Za-z0-9_]*/?)*")
 
 
-def _generate(source: str | Path, prefix: str, overrides: dict[str, object] | None,
+def _generate(model: str | Path, prefix: str, overrides: dict[str, object] | None,
               convention: str = "report") -> tuple[Config, Model, str, str]:
-    """(config, model, URDF, SRDF) of a model name or folder: each file read once, xacro run on
-    the checked Config (``convention`` passed to the URDF's top-level xacro)."""
+    """(config, the Model whose xacros ran, URDF, SRDF) of a model name or folder: each file read
+    once, xacro run on the checked Config (``convention`` passed to the URDF's top-level xacro)."""
     if not isinstance(prefix, str):
         raise InvalidInputError(f"expected a string, got {prefix!r}", argument="prefix")
     if not PREFIX.fullmatch(prefix):
         raise InvalidInputError(f"expected a ROS name's start (letters, digits, _ and /, not starting with a digit), "
                                 f"got {prefix!r}", argument="prefix")
-    config = configuration.read(source, overrides)
+    config = configuration.read(model, overrides)
     if convention != "report" and config.gimbal is None:
         raise InvalidInputError(f"the drivers' convention is written for the Touch (model touch), whose drivers "
                                 f"publish it; {config.name} has none", argument="model")
-    model = xacro_model(config)
-    arguments = {"model": model.name, "prefix": prefix}
+    xacros = xacro_model(config)
+    arguments = {"model": xacros.name, "prefix": prefix}
     with tempfile.TemporaryDirectory() as folder:
         inputs = _xacro_inputs(config, Path(folder))
-        urdf = _process(model.urdf_xacro, {**arguments, **inputs, "convention": convention})
-        srdf = _process(model.srdf_xacro, {**arguments,
+        urdf = _process(xacros.urdf_xacro, {**arguments, **inputs, "convention": convention})
+        srdf = _process(xacros.srdf_xacro, {**arguments,
                                            "actuation_file": inputs["actuation_file"],
                                            "joint_limits_file": inputs["joint_limits_file"]})
     check_urdf(urdf, "the generated URDF")
-    return config, model, urdf, srdf
+    return config, xacros, urdf, srdf
 
 
-def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
+def describe(model: str | Path = configuration.DEFAULT, *, prefix: str = "",
              overrides: dict[str, object] | None = None, robot_file: str | None = None) -> Description:
     """The Description of a model name (phantom_pin.models()) or a configuration folder,
     with ``overrides`` applied (dotted keys into the files, SI units and radians, e.g.
@@ -173,9 +173,9 @@ def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
     ``robot_file``: the name under which the scene includes the robot MJCF (default: the
     model's). InvalidInputError naming ``model`` or ``prefix`` for a bad argument.
     """
-    config, model, urdf, srdf = _generate(source, prefix, overrides)
-    robot_file = model.mjcf.name if robot_file is None else robot_file
-    mjcf, scene = mjcf_texts(urdf, srdf, config, prefix, robot_file, model.name)
+    config, xacros, urdf, srdf = _generate(model, prefix, overrides)
+    robot_file = xacros.mjcf.name if robot_file is None else robot_file
+    mjcf, scene = mjcf_texts(urdf, srdf, config, prefix, robot_file, xacros.name)
     return Description(config, configuration.MODELS.get(config.name), prefix, urdf, srdf, mjcf, scene, robot_file)
 
 
@@ -185,23 +185,31 @@ def describe(source: str | Path = configuration.DEFAULT, *, prefix: str = "",
 CONVENTIONS = ("report", "driver")
 
 
-def driver_urdf(source: str | Path, *, prefix: str = "",
+def driver_urdf(model: str | Path, *, prefix: str = "",
                 overrides: dict[str, object] | None = None) -> str:
     """The URDF of a model name or configuration folder in the drivers' convention
     (CONVENTIONS): the same links, inertials, frames and limits as describe()'s, jointed so that
     a driver's joint_states move it unchanged (urdf/phantom_macro.xacro). For the tools that
     take joint_states by name (robot_state_publisher, RViz, MoveIt); phantom_pin computes on
     describe()'s URDF."""
-    return _generate(source, prefix, overrides, "driver")[2]
+    return _generate(model, prefix, overrides, "driver")[2]
+
+
+def shipped(model: str = configuration.DEFAULT) -> Description:
+    """A named model with its committed URDF, SRDF and MJCF files (which
+    tests/description/test_description.py shows equal to describe(model)), read once per process:
+    every road to a named model (Phantom(), Phantom.from_model, shipped(), a CLI command) gets
+    this one Description, so what is cached beside it (identification.cache) is computed once.
+    InvalidInputError naming ``model`` for anything but a model's name."""
+    if not (isinstance(model, str) and model in configuration.MODELS):
+        configuration.renamed(model)
+        raise InvalidInputError(f"{model!r} is not a model ({', '.join(configuration.MODELS)})", argument="model")
+    return _shipped(model)
 
 
 @functools.cache
-def shipped(name: str = configuration.DEFAULT) -> Description:
-    """A named model with its committed URDF, SRDF and MJCF files (which
-    tests/description/test_description.py shows equal to describe(name)), read once per process."""
-    if name not in configuration.MODELS:
-        configuration.renamed(name)
-        raise InvalidInputError(f"{name!r} is not a model ({', '.join(configuration.MODELS)})", argument="model")
+def _shipped(name: str) -> Description:
+    """shipped()'s one cache, keyed by the model's name alone."""
     model = configuration.MODELS[name]
     config = configuration.read(name)
     urdf = model.urdf.read_text(encoding="utf-8")
@@ -231,15 +239,15 @@ def held(description: Description, gimbal: object) -> Description:
     return dataclasses.replace(description, config=config, mjcf=mjcf, scene=scene)
 
 
-def description_of(source: object = None, argument: str = "model") -> Description:
+def description_of(model: object = None, argument: str = "model") -> Description:
     """The Description a public entry point was given: a Description as it is, a model
     name or a folder (the shipped files of a named model, describe() of a folder), or None
     for the default model. InvalidInputError naming ``argument`` otherwise."""
-    if isinstance(source, Description):
-        return source
-    if source is None:
+    if isinstance(model, Description):
+        return model
+    if model is None:
         return shipped()
-    if isinstance(source, str) and source in configuration.MODELS:
-        return shipped(source)
-    configuration.resolve(source, argument)  # InvalidInputError unless a model name or a folder
-    return describe(cast("str | Path", source))
+    if isinstance(model, str) and model in configuration.MODELS:
+        return shipped(model)
+    configuration.resolve(model, argument)  # InvalidInputError unless a model name or a folder
+    return describe(cast("str | Path", model))

@@ -21,7 +21,7 @@ class Device:
     """The PHANToM as a device: a Phantom plus its stops, friction, motors, encoders.
 
     ``Device(phantom)`` wraps a Phantom (``Device()`` the default one, ``Phantom()``);
-    ``Device.from_model(name)`` a named model's (``Device(Phantom.from_model(name))``). A
+    ``Device.from_model(model)`` a named model's (``Device(Phantom.from_model(model))``). A
     Description or a folder of one's own goes through its Phantom:
     ``Device(Phantom(description))``, ``Device(Phantom.from_folder(path))``; anything else given
     to the plain call is refused with InvalidInputError naming ``phantom`` and that call. The device numbers
@@ -62,10 +62,10 @@ class Device:
             self.ratios * encoder.cycles_per_revolution * encoder.counts_per_cycle / (2 * math.pi)
 
     @classmethod
-    def from_model(cls, name: str) -> Device:
-        """The named model ``name``'s device (phantom_pin.models()): ``Device(Phantom.from_model(name))``.
-        InvalidInputError naming ``name`` for anything else."""
-        return cls(Phantom.from_model(name))
+    def from_model(cls, model: str) -> Device:
+        """The named model ``model``'s device (phantom_pin.models()): ``Device(Phantom.from_model(model))``.
+        InvalidInputError naming ``model`` for anything else."""
+        return cls(Phantom.from_model(model))
 
     def require(self, section: str, needed_by: str) -> None:
         """MissingDataError naming ``needed_by`` unless the configuration has its ``section`` of

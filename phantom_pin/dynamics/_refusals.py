@@ -30,7 +30,8 @@ def constructor(cls: str, given: object) -> str:
         return f"a configuration folder is {wrap('Phantom.from_folder(path)')}"
     if isinstance(given, Description):
         return f"a Description is {wrap('Phantom(description)')}"
-    return f"a model name ({', '.join(MODELS)}) is {cls}.from_model(name), a folder {wrap('Phantom.from_folder(path)')}"
+    folder = wrap("Phantom.from_folder(path)")
+    return f"a model name ({', '.join(MODELS)}) is {cls}.from_model(model), a folder {folder}"
 
 
 def refusal(cls: str, expected: str, given: object, argument: str) -> InvalidInputError:

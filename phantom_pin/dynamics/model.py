@@ -12,7 +12,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin._validation import as_states, finite_result, same_batch, within_box
-from phantom_pin.config import MODELS, Config, resolve
+from phantom_pin.config import MODELS, Config, renamed, resolve
 from phantom_pin.config.types import GIMBAL_JOINTS
 from phantom_pin.description.build import Description, describe, shipped
 from phantom_pin.dynamics._refusals import refusal
@@ -42,7 +42,7 @@ class Phantom:
     configuration (phantom_pin.describe(name or folder, overrides=..., prefix=...)), or
     ``Phantom()`` for the default model (premium_1_5, its committed URDF and SRDF); the named
     constructors for the rest, as Pinocchio's ``RobotWrapper(model, ...)`` beside
-    ``RobotWrapper.BuildFromURDF``: ``Phantom.from_model(name)`` a named model
+    ``RobotWrapper.BuildFromURDF``: ``Phantom.from_model(model)`` a named model
     (phantom_pin.models(), its committed files) and ``Phantom.from_folder(path)`` a
     configuration folder of one's own. Anything else given to the plain call (a name, a folder)
     is refused with InvalidInputError naming ``description`` and the constructor to use.
@@ -111,15 +111,17 @@ class Phantom:
             self._frame_stylus_tip = built.stylus.getFrameId(f"{prefix}stylus_tip")
 
     @classmethod
-    def from_model(cls, name: str) -> Phantom:
-        """The named model ``name`` (phantom_pin.models()), from its committed URDF and SRDF
-        (equal to describe(name)'s, tests/description/test_description.py). InvalidInputError naming
-        ``name`` for anything else."""
-        if not (isinstance(name, str) and name in MODELS):
-            raise InvalidInputError(f"expected one of {', '.join(MODELS)}, got {name!r}"
+    def from_model(cls, model: str) -> Phantom:
+        """The named model ``model`` (phantom_pin.models()), from its committed URDF and SRDF
+        (equal to describe(model)'s, tests/description/test_description.py; the one Description
+        of shipped(model), Phantom()'s for the default). InvalidInputError naming ``model`` for
+        anything else."""
+        if not (isinstance(model, str) and model in MODELS):
+            renamed(model)
+            raise InvalidInputError(f"expected one of {', '.join(MODELS)}, got {model!r}"
                                     + ("; for a configuration folder use Phantom.from_folder(path)"
-                                       if isinstance(name, (str, Path)) else ""), argument="name")
-        return cls(shipped(name))
+                                       if isinstance(model, (str, Path)) else ""), argument="model")
+        return cls(shipped(model))
 
     @classmethod
     def from_folder(cls, folder: str | Path) -> Phantom:

@@ -91,7 +91,7 @@ def check(phantom: Phantom, states: int = 1000, seed: int = 0,
     the report has none; tests/description/test_gimbal.py checks the gimbal's load against its own laws.
 
     Raises InvalidInputError naming ``states`` outside 1..MAX_STATES, and naming ``phantom``
-    for anything but a Phantom (a model name: check(Phantom.from_model(name))) or a model not
+    for anything but a Phantom (a model name: check(Phantom.from_model(model))) or a model not
     written in the report's terms (no closed form applies).
     """
     phantom, p = _checked(phantom, states)

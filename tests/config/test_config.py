@@ -273,7 +273,7 @@ def test_a_joint_limit_is_within_one_turn(value, accepted):
 def test_shipped_checks_the_committed_urdf(tmp_path, monkeypatch):
     """shipped() reads the committed files: a committed URDF with a non-physical link is
     refused, naming the file."""
-    from phantom_pin.description.build import shipped
+    from phantom_pin.description.build import _shipped, shipped
 
     model = config.MODELS["premium_1_5"]
     text = model.urdf.read_text()
@@ -281,12 +281,12 @@ def test_shipped_checks_the_committed_urdf(tmp_path, monkeypatch):
     bad.write_text(text.replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>', 1))
     assert bad.read_text() != text
     monkeypatch.setitem(config.MODELS, "premium_1_5", dataclasses.replace(model, urdf=bad))
-    shipped.cache_clear()
+    _shipped.cache_clear()
     try:
         with pytest.raises(ParameterFileError, match=str(bad)):
             shipped("premium_1_5")
     finally:
-        shipped.cache_clear()
+        _shipped.cache_clear()
 
 
 @pytest.mark.parametrize("overrides, message", [

@@ -37,7 +37,7 @@ def test_device_wraps_the_phantom_and_builds_one_by_default(phantom):
     assert touch.config.name == "touch" and touch.phantom.description is Phantom.from_model("touch").description
     with pytest.raises(InvalidInputError) as error:
         Device.from_model("nope")
-    assert error.value.argument == "name"
+    assert error.value.argument == "model"
 
 
 def test_the_plain_call_refuses_what_is_not_a_phantom(tmp_path):
@@ -49,7 +49,7 @@ def test_the_plain_call_refuses_what_is_not_a_phantom(tmp_path):
     for bad, call in (("touch", "Device.from_model('touch')"), (description, "Device(Phantom(description))"),
                       (tmp_path, "Device(Phantom.from_folder(path))"),
                       (str(tmp_path), "Device(Phantom.from_folder(path))"),
-                      (42, "Device.from_model(name)"), ("not a phantom", "Device.from_model(name)")):
+                      (42, "Device.from_model(model)"), ("not a phantom", "Device.from_model(model)")):
         with pytest.raises(InvalidInputError) as error:
             Device(bad)
         assert error.value.argument == "phantom" and call in error.value.detail, (bad, error.value.detail)

@@ -268,14 +268,14 @@ def test_the_plain_call_refuses_what_a_named_constructor_makes(tmp_path):
     folder.mkdir()
     for bad, call in (("touch", "Phantom.from_model('touch')"), ("premium_1_5", "Phantom.from_model('premium_1_5')"),
                       (folder, "Phantom.from_folder(path)"), (str(folder), "Phantom.from_folder(path)"),
-                      (42, "Phantom.from_model(name)"), (describe, "Phantom.from_folder(path)")):
+                      (42, "Phantom.from_model(model)"), (describe, "Phantom.from_folder(path)")):
         with pytest.raises(InvalidInputError) as error:
             Phantom(bad)
         assert error.value.argument == "description" and call in error.value.detail, (bad, error.value.detail)
     for bad in ("nope", 3, None, folder):
         with pytest.raises(InvalidInputError) as error:
             Phantom.from_model(bad)
-        assert error.value.argument == "name"
+        assert error.value.argument == "model"
     with pytest.raises(InvalidInputError, match=r"Phantom\.from_model\('touch'\)") as error:
         Phantom.from_folder("touch")
     assert error.value.argument == "folder"
@@ -412,3 +412,23 @@ def test_a_model_without_a_gimbal_refuses_gimbal_angles_by_name(method, count):
     naming gimbal and the model."""
     with pytest.raises(InvalidInputError, match="^gimbal: the model 'premium_1_5' has no stylus gimbal"):
         getattr(Phantom(), method)(*[np.full(3, 0.2)] * count, gimbal=[0.1, 0.2, 0.3])
+
+
+def test_every_road_to_a_named_model_is_one_description():
+    """Phantom(), Phantom.from_model, Device, shipped() with and without the default's name and
+    the CLI's description_of give one Description object per model (functools.cache had two
+    for shipped() and shipped("premium_1_5")), so what identification.cache keeps beside it is
+    computed once."""
+    from phantom_pin import Device
+    from phantom_pin.config import DEFAULT
+    from phantom_pin.description.build import description_of, shipped
+    from phantom_pin.identification import cache
+
+    first = Phantom().description
+    assert all(d is first for d in (Phantom.from_model(DEFAULT).description, shipped(), shipped(DEFAULT),
+                                    description_of(None), description_of(DEFAULT), Device().phantom.description))
+    calls = []
+    for road in (Phantom(), Phantom.from_model(DEFAULT)):
+        cache.cached(road.description, "test_every_road", lambda: calls.append(1))
+    assert calls == [1]
+    assert Phantom.from_model("touch").description is shipped("touch") is not first
