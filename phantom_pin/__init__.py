@@ -16,7 +16,7 @@ from phantom_pin.description.build import Description, describe
 from phantom_pin.device import Device, Feel, SimulationResult, feel, simulate
 from phantom_pin.device.mujoco_plant import simulate_mujoco
 from phantom_pin.dynamics.loader import PhantomLoader, load, load_files
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.dynamics.verification import check
 from phantom_pin.exceptions import (
     InvalidInputError,

@@ -26,6 +26,7 @@ MOVED = {
     "phantom_pin.inertial": "phantom_pin.description.inertial",
     "phantom_pin.plots": "phantom_pin.viewer.plots",
     "phantom_pin.verification": "phantom_pin.dynamics.verification",
+    "phantom_pin.dynamics.model": "phantom_pin.dynamics.phantom",
 }
 
 

@@ -18,7 +18,7 @@ from typing import Any
 from phantom_pin._validation import output_path, within_box
 from phantom_pin.config import DEFAULT, models, read_overrides, renamed
 from phantom_pin.description.build import Description, describe, description_of
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.viewer import plots
 

@@ -31,7 +31,7 @@ from phantom_pin.cli.common import (
 from phantom_pin.device.controllers import KD, KP, tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import io
 from phantom_pin.viewer import plots

@@ -23,7 +23,7 @@ from phantom_pin.cli.common import (
 )
 from phantom_pin.config import DEFAULT
 from phantom_pin.description.build import Description
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import PhantomPinError
 from phantom_pin.identification import bags, excitation, io, prior, selection, static, timing
 from phantom_pin.identification import page as identification_page

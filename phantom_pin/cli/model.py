@@ -34,7 +34,7 @@ from phantom_pin.config.types import Gimbal
 from phantom_pin.description.build import CONVENTIONS, driver_urdf, links_yaml
 from phantom_pin.dynamics import verification
 from phantom_pin.dynamics.loader import load
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import LogError, PhantomPinError
 from phantom_pin.identification import io
 

@@ -8,7 +8,7 @@ import dataclasses
 import math
 
 from phantom_pin.cli.common import description, overrides
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import MissingDataError, PhantomPinError
 from phantom_pin.interfaces import profiles
 

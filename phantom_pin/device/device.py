@@ -12,7 +12,7 @@ from phantom_pin._validation import as_states, finite_result, same_batch
 from phantom_pin.config import Config
 from phantom_pin.config.types import STOP_COORDINATES, Motor
 from phantom_pin.dynamics._refusals import refusal
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.report import closed_form
 

@@ -24,7 +24,7 @@ import pinocchio as pin
 from phantom_pin._integration import rk4_step
 from phantom_pin.device.device import Device
 from phantom_pin.device.run import MAX_STEPS
-from phantom_pin.dynamics.model import solve_spd
+from phantom_pin.dynamics.phantom import solve_spd
 
 #: RK4 substep h (while a stop is engaged) is chosen so that h * OMEGA <= OSCILLATION_SCALE and
 #: h * RATE <= DAMPING_SCALE, OMEGA and RATE the fastest natural frequency (rad/s) and damping

@@ -15,7 +15,7 @@ from phantom_pin.description.build import held
 from phantom_pin.device.device import Device
 from phantom_pin.device.plant import MAX_STEP, Diverged, Plant, contact_substeps
 from phantom_pin.device.run import MAX_STEPS, Controller, SimulationResult, arguments, command, default_device
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError
 
 __all__ = ["SimulationResult", "default_device", "simulate"]

@@ -2,7 +2,7 @@
 ``shortcuts.buildModelsFromUrdf`` is the one behind ``RobotWrapper.BuildFromURDF``.
 
 ``build_model`` turns a URDF text into a pinocchio.Model with the configuration's gravity: the
-Coupling's two models, load()'s, and through them every model of phantom_pin.dynamics.models
+Coupling's two models, load()'s, and through them every model of phantom_pin.dynamics.pinocchio_models
 (a Phantom's, which the ROS 2 node reuses) come from it; the SRDF's rotors are applied by
 ``load_rotor_parameters`` where ``has_rotors`` says so.
 """

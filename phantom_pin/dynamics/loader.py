@@ -14,7 +14,7 @@ from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics._refusals import shown
 from phantom_pin.dynamics.build import build_model, has_rotors, load_rotor_parameters
 from phantom_pin.dynamics.build import gravity_of as gravity_of  # (where it lived before)
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from phantom_pin.config.sampling import random_states
 from phantom_pin.description.gimbal import arm_only
 from phantom_pin.dynamics._refusals import refusal
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.report import appendix, closed_form
 from phantom_pin.report.parameters import ReportParameters

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import LogError
 from phantom_pin.identification.filtering import EDGE
 from phantom_pin.identification.fit import Fit

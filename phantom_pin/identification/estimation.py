@@ -27,7 +27,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
 from phantom_pin.identification import checks
 from phantom_pin.identification import prior as priors

@@ -15,7 +15,7 @@ import numpy as np
 
 from phantom_pin import _blas
 from phantom_pin.description.build import Description
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification.least_squares import condition_number as condition_number  # (lived here)
 from phantom_pin.identification.structures import General, Report, friction_block

@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin._validation import as_states, same_batch
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError
 
 #: Pinocchio's order of the standard parameters of one body (pin.Inertia.toDynamicParameters).

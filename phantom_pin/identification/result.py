@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.checks import GAIN_BOUNDS, RefusedError, refusal
 from phantom_pin.identification.estimation import GAIN_EVIDENCE, GAIN_NOTED, NEEDS_GENERAL, Fit, estimate

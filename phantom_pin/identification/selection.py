@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import LogError
 from phantom_pin.identification import checks
 from phantom_pin.identification.filtering import Samples, filtered

@@ -27,7 +27,7 @@ import dataclasses
 import numpy as np
 
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
 from phantom_pin.identification import prior as priors
 from phantom_pin.identification.io import Log

@@ -27,7 +27,7 @@ import numpy as np
 
 from phantom_pin.config.types import BODIES
 from phantom_pin.description.inertial import INERTIA_KEYS, Inertial, carve, problem, uncarve
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.identification import constants, parameterization, physical
 from phantom_pin.identification.base import base_parameters, sample, words

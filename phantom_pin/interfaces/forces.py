@@ -34,7 +34,7 @@ from phantom_pin.device import estimator
 from phantom_pin.device.device import Device
 from phantom_pin.device.estimator import Estimator
 from phantom_pin.device.thermal import TorqueBudget
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError
 from phantom_pin.interfaces.profiles import Profile
 

@@ -11,7 +11,7 @@ from helpers import REPORT, URDF_PATH, relative_error
 from phantom_pin import Device, InvalidInputError
 from phantom_pin import closed_form as cf
 from phantom_pin.dynamics.coupling import Coupling
-from phantom_pin.dynamics.model import solve_spd
+from phantom_pin.dynamics.phantom import solve_spd
 from phantom_pin.interfaces import conventions
 
 # method, number of (3,) arguments; inverse_kinematics takes positions (below)
@@ -37,7 +37,7 @@ def test_crba_binding_returns_the_full_symmetric_matrix(phantom, states, convent
     the WORLD convention (the faster one, DEVELOPERS.md) as it is: the binding fills the lower
     triangle (data.M holds only the upper one). Bit-identical to the symmetrised matrix over
     every state and within 1e-13 of the closed form (eqs 81-85); a Pinocchio returning the
-    upper triangle alone fails here (and against closed_form in test_model.py)."""
+    upper triangle alone fails here (and against closed_form in test_phantom.py)."""
     data = phantom.model.createData()
     extra = () if convention == "default" else (pin.Convention.WORLD,)
     for theta in states[0]:

@@ -93,7 +93,7 @@ class Compensator:
         from phantom_pin.device.device import Device
         from phantom_pin.device.estimator import CUTOFF, Estimator
         from phantom_pin.device.thermal import TorqueBudget
-        from phantom_pin.dynamics.model import Phantom
+        from phantom_pin.dynamics.phantom import Phantom
         from phantom_pin.interfaces.conventions import openhaptics_from_theta
 
         if mode not in MODES:

@@ -73,7 +73,7 @@ class Server:
         from phantom_pin.description.build import description_of, held
         from phantom_pin.device.device import Device
         from phantom_pin.device.plant import servo_plant
-        from phantom_pin.dynamics.model import Phantom
+        from phantom_pin.dynamics.phantom import Phantom
         from phantom_pin.interfaces.conventions import openhaptics_from_theta, openhaptics_origin
 
         env = os.environ if environ is None else environ

@@ -53,7 +53,7 @@ import numpy as np
 import pinocchio as pin
 
 from phantom_pin.config.types import GIMBAL_JOINTS, JOINTS, Friction
-from phantom_pin.dynamics.model import Phantom
+from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import InvalidInputError, MissingDataError
 from phantom_pin.interfaces import conventions
 from phantom_pin.interfaces.forces import Frames, Renderer, Vector

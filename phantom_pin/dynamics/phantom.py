@@ -31,7 +31,7 @@ from phantom_pin.dynamics.fast import (
 )
 from phantom_pin.dynamics.fast import solve_spd as solve_spd  # (where it lived before)
 from phantom_pin.dynamics.ik import SEEDS, solve_ik
-from phantom_pin.dynamics.models import models
+from phantom_pin.dynamics.pinocchio_models import pinocchio_models
 from phantom_pin.exceptions import InvalidInputError
 
 
@@ -80,7 +80,7 @@ class Phantom:
         self.config: Config = description.config
         gimbal, prefix = self.config.gimbal, description.prefix
         self.gimbal_joints: tuple[str, ...] = () if gimbal is None else tuple(prefix + j for j in GIMBAL_JOINTS)
-        built = models(description)
+        built = pinocchio_models(description)
         #: every joint of the URDF free (the coupling itself without a gimbal): the ROS 2 node's frames
         self.full_coupling = built.full
         self.coupling = built.coupling

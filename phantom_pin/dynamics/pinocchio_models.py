@@ -16,7 +16,7 @@ from phantom_pin.dynamics.coupling import Coupling
 
 
 @dataclasses.dataclass(frozen=True)
-class Models:
+class PinocchioModels:
     """Every model of a description: ``coupling`` (the arm's mimic model, ``coupling.reduced``,
     with the rotors' armature, and its tree; a gimbal locked at ``locked_at``), ``full`` (every
     joint of the URDF free: ``coupling`` itself without a gimbal), ``stylus`` (the six-joint mimic
@@ -29,8 +29,8 @@ class Models:
     order: np.ndarray | None
 
 
-def models(description: Description) -> Models:
-    """The models of ``description`` (Models), gravity and rotors applied once."""
+def pinocchio_models(description: Description) -> PinocchioModels:
+    """The Pinocchio models of ``description``, gravity and rotors applied once."""
     config, prefix = description.config, description.prefix
     gimbal = config.gimbal
     coupling = Coupling(description.urdf if gimbal is None else locked(description.urdf, prefix, gimbal.locked_at),
@@ -38,7 +38,7 @@ def models(description: Description) -> Models:
     if has_rotors(config):  # else no rotor_params, armature 0 (Actuation.rotor)
         load_rotor_parameters(coupling.reduced, description.srdf)
     if gimbal is None:
-        return Models(coupling, coupling, None, None)
+        return PinocchioModels(coupling, coupling, None, None)
     full = Coupling(description.urdf, config=config)
     stylus = rooted_at_frame(full.reduced, prefix + "report_s")
     names = (*(f"{prefix}joint{j}" for j in (1, 2, 3)), *(prefix + j for j in GIMBAL_JOINTS))
@@ -46,4 +46,4 @@ def models(description: Description) -> Models:
     armature = stylus.armature.copy()
     armature[order[:3]] = coupling.reduced.armature  # the rotors, as the arm's model has them
     stylus.armature = armature
-    return Models(coupling, full, stylus, order)
+    return PinocchioModels(coupling, full, stylus, order)
