@@ -107,6 +107,18 @@ def _box(phantom: Phantom) -> tuple[np.ndarray, np.ndarray]:
     return lower, upper
 
 
+def _names(names: Sequence[str], positions: Sequence[float], velocity: Sequence[float]) -> list[str]:
+    """A joint_states message's names, its position one value per name and its velocity empty
+    or one value per name; InvalidInputError naming the field otherwise."""
+    given = list(names)
+    if len(positions) != len(given):
+        raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
+    if len(velocity) not in (0, len(given)):
+        raise InvalidInputError(f"{len(velocity)} values for {len(given)} names (one per name, or none)",
+                                argument="velocity")
+    return given
+
+
 class DriverBridge:
     """The force path's computation, without ROS: a driver's joint_states (its profile's names,
     each with the description's prefix, exactly once; its conventions) to theta and g, a user's
@@ -127,11 +139,7 @@ class DriverBridge:
               velocity: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray | None]:
         """(theta, g) (rad) of one joint_states message; g None for a model without a gimbal.
         ``velocity`` (its velocity field) is checked only: empty or one value per name."""
-        given = list(names)
-        if len(positions) != len(given):
-            raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
-        if len(velocity) not in (0, len(given)):
-            raise InvalidInputError(f"{len(velocity)} values for {len(given)} names", argument="velocity")
+        given = _names(names, positions, velocity)
         wanted = self.names if self.gimbal is not None else self.names[:3]
         wrong = [n for n in wanted if given.count(n) != 1]
         if wrong:
@@ -190,12 +198,7 @@ class Bridge:
     def _values(self, names: Sequence[str], positions: Sequence[float],
                 velocity: Sequence[float]) -> tuple[dict[str, float], bool]:
         """The input by name, and whether it uses the drivers' names (else the model's)."""
-        given = list(names)
-        if len(positions) != len(given):
-            raise InvalidInputError(f"{len(positions)} values for {len(given)} names", argument="position")
-        if len(velocity) not in (0, len(given)):
-            raise InvalidInputError(f"{len(velocity)} values for {len(given)} names (one per name, or none)",
-                                    argument="velocity")
+        given = _names(names, positions, velocity)
         read = (*self.driver_names, *self.model_arm, *self.driver_gimbal, *self.model_gimbal)
         twice = [n for n in read if given.count(n) > 1]
         if twice:
