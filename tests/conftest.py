@@ -60,6 +60,15 @@ def states():
     return random_states(CONFIG.limits, N_STATES, seed=20261121)
 
 
+@pytest.fixture()
+def folder(tmp_path):
+    """A copy of premium_1_5's configuration folder (tmp_path/config), to edit."""
+    from phantom_pin.config import MODELS
+
+    shutil.copytree(MODELS["premium_1_5"].config, tmp_path / "config")
+    return tmp_path / "config"
+
+
 @pytest.fixture(scope="module")
 def six():
     """The Touch's six-joint model built from its committed URDF by Pinocchio alone (helpers.Six):

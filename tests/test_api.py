@@ -7,11 +7,12 @@ import importlib
 import inspect
 import pkgutil
 import re
+from pathlib import Path
 
 import pytest
 
 import phantom_pin
-from phantom_pin import InvalidInputError, Phantom
+from phantom_pin import InvalidInputError, Phantom, config
 
 #: The object each role's parameter holds (its annotation names the class), and that name.
 ROLES = {"Phantom": "phantom", "Device": "device", "Description": "description"}
@@ -90,3 +91,34 @@ def test_a_device_of_a_named_model_is_that_models_phantom():
         device, phantom = phantom_pin.Device.from_model(name), Phantom.from_model(name)
         assert device.config is phantom.config
         assert (device.phantom.gravity(theta) == phantom.gravity(theta)).all()
+
+
+def _defaults(function):
+    try:
+        return [p.default for p in inspect.signature(function).parameters.values()]
+    except (TypeError, ValueError):
+        return []
+
+
+def test_no_function_below_the_entry_points_defaults_to_a_configuration():
+    """Every function takes the Description (or Config) it works on: no parameter below the
+    public entry points defaults to a model name, a configuration folder or a Config."""
+    entry_points = {"describe", "shipped", "description_of", "read", "resolve", "load", "__init__", "simulate",
+                    "default_device", "main"}
+    found = []
+    for module_info in pkgutil.walk_packages(phantom_pin.__path__, "phantom_pin."):
+        module = importlib.import_module(module_info.name)
+        for name, item in vars(module).items():
+            if getattr(item, "__module__", None) != module.__name__:
+                continue
+            functions = [(name, item)] if inspect.isfunction(item) else []
+            if inspect.isclass(item):
+                functions += [(f"{name}.{n}", f) for n, f in vars(item).items() if inspect.isfunction(f)]
+            for qualified, function in functions:
+                if qualified.split(".")[-1] in entry_points and not qualified.startswith(("Regressor", "Structured")):
+                    continue
+                for default in _defaults(function):
+                    if (isinstance(default, (Path, config.Config)) or default in config.models()
+                            or default is config.DEFAULT):
+                        found.append(f"{module.__name__}.{qualified}")
+    assert not found

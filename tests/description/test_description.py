@@ -9,6 +9,7 @@ import pytest
 import yourdfpy
 
 from helpers import CONFIG, REPORT, relative_error
+from phantom_pin import ParameterFileError, config
 from phantom_pin.config import MODELS, files, models
 from phantom_pin.description.build import describe, links_yaml, shipped
 from phantom_pin.report import appendix, closed_form
@@ -268,3 +269,22 @@ def test_srdf_postures_are_inside_the_limits(limits):
     assert postures["zero"] == [0.0, 0.0, 0.0]
     for values in postures.values():
         assert np.all(limits[0] <= values) and np.all(np.array(values) <= limits[1])
+
+
+def test_shipped_checks_the_committed_urdf(tmp_path, monkeypatch):
+    """shipped() reads the committed files: a committed URDF with a non-physical link is
+    refused, naming the file."""
+    from phantom_pin.description.build import _shipped, shipped
+
+    model = config.MODELS["premium_1_5"]
+    text = model.urdf.read_text()
+    bad = tmp_path / "premium_1_5.urdf"
+    bad.write_text(text.replace('<mass value="0.0202"/>', '<mass value="-0.0202"/>', 1))
+    assert bad.read_text() != text
+    monkeypatch.setitem(config.MODELS, "premium_1_5", dataclasses.replace(model, urdf=bad))
+    _shipped.cache_clear()
+    try:
+        with pytest.raises(ParameterFileError, match=str(bad)):
+            shipped("premium_1_5")
+    finally:
+        _shipped.cache_clear()

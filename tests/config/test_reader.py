@@ -7,11 +7,9 @@ import re
 import mujoco
 import numpy as np
 import pytest
-import yaml
 
-from phantom_pin import ParameterFileError, config, describe
+from phantom_pin import Device, ParameterFileError, Phantom, config, describe
 from phantom_pin.cli import main
-from phantom_pin.config.builders import MOTOR_TOLERANCE
 from phantom_pin.config.reader import MAX_MAGNITUDE
 
 
@@ -40,16 +38,6 @@ def test_the_cli_says_it_in_one_line(capsys):
     assert out == "" and err.count("\n") == 1 and "l1 must be at most 1e+06" in err
 
 
-@pytest.mark.parametrize("name", [name for name in config.models() if config.read(name).actuation.motor])
-def test_the_shipped_motors_agree_with_their_own_data_sheet(name):
-    """maxon RE 25 118743: 23.4 mN m/A x 1.24 A = 29.0 mN m against the nominal 28.6 (1.5 %: the
-    no-load current makes no torque), x 5.5 A = 128.7 mN m against the stall 129 (0.2 %)."""
-    motor = config.read(name).actuation.motor
-    assert abs(motor.torque_constant * motor.max_continuous_current / motor.max_continuous_torque - 1) < 0.02
-    assert abs(motor.torque_constant * motor.stall_current / motor.stall_torque - 1) < 0.005
-    assert MOTOR_TOLERANCE > 0.02
-
-
 def test_the_largest_accepted_scale_still_steps_in_mujoco():
     """A 1e6 kg segment and the longest timestep accepted, each alone: MuJoCo's first hundred
     steps stay finite (before, 1e300 kg or a 1 s step was NaN on the first)."""
@@ -75,15 +63,53 @@ def test_the_magnitude_bound_holds_for_negative_numbers_and_list_items(source, k
         config.read(source, {key: value})
 
 
-def test_a_continuous_torque_equal_to_the_stall_torque_is_refused():
-    """A motor's continuous torque must be strictly below its stall torque (a winding cannot run
-    at stall): equal to the data sheet's 129 mN m (read with PyYAML) it is refused; just below it
-    is a motor."""
-    stated = yaml.safe_load((config.MODELS["premium_1_5"].config / "actuation.yaml").read_text())["motor"]
-    key = "actuation.motor.max_continuous_torque"
-    current = {"actuation.motor.max_continuous_current": 0.998 * stated["stall_current"]}  # Kt I = the torque
-    with pytest.raises(ParameterFileError, match=f"max_continuous_torque {stated['stall_torque']:g} N m must be "
-                                                 f"below stall_torque {stated['stall_torque']:g} N m"):
-        config.read("premium_1_5", {key: stated["stall_torque"], **current})
-    below = config.read("premium_1_5", {key: stated["stall_torque"] * (1 - 1e-9), **current})
-    assert below.actuation.motor.max_continuous_torque < stated["stall_torque"]
+def test_joint_limits_beyond_one_turn_are_refused(folder):
+    limits = folder / "joint_limits.yaml"
+    limits.write_text(limits.read_text().replace("joint1: {lower: -1.5707963267948966, upper: 1.5707963267948966}",
+                                                 "joint1: {lower: -1.0, upper: 100.0}"))
+    with pytest.raises(ParameterFileError, match="joint1.upper must be within one turn"):
+        config.read(folder)
+
+
+@pytest.mark.parametrize("file, old, new, message", [
+    ("kinematics.yaml", "l1: 0.215", "l1: -0.215", "l1 must be positive"),
+    ("kinematics.yaml", "l2: 0.170", "l2: abc", "l2 must be a finite number"),
+    ("physical_parameters.yaml", "  mass: 0.0202", "  mass_typo: 0.0202", "missing key segment_a.mass"),
+    ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369", "joint2: {lower: 3.0", "joint2.lower must be below"),
+    ("actuation.yaml", "motor:", "motor: [", "not valid YAML"),
+    ("actuation.yaml", "viscous: 5.0e-4", "viscous: -5.0e-4", "friction.viscous must not be negative"),
+    ("actuation.yaml", "coulomb: 0.01", "coulomb: -0.01", "friction.coulomb must not be negative"),
+    ("mjcf.yaml", "integrator: RK4", "integrator: RK5", "integrator must be"),
+])
+def test_malformed_files_are_named(folder, file, old, new, message):
+    """Every consumer reads the same checked Config: describe (URDF, MJCF), Phantom, Device."""
+    path = folder / file
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+    for call in (config.read, describe, Phantom.from_folder, lambda f: Device(Phantom.from_folder(f))):
+        with pytest.raises(ParameterFileError, match=message) as error:
+            call(folder)
+        assert file in str(error.value)
+
+
+@pytest.mark.parametrize("value, accepted", [(2 * np.pi - 0.1, True), (2 * np.pi + 0.1, False)])
+def test_a_joint_limit_is_within_one_turn(value, accepted):
+    overrides = {"joint_limits.joint3.upper": value, "joint_limits.stops.joint3.upper": value}
+    if accepted:
+        assert config.read("premium_1_5", overrides).limits.upper[2] == value
+    else:
+        with pytest.raises(ParameterFileError, match=r"joint3.upper must be within one turn"):
+            config.read("premium_1_5", overrides)
+
+
+@pytest.mark.parametrize("overrides, message", [
+    ({"joint_limits.joint1.lower": 0.5, "joint_limits.joint1.upper": 0.5}, "joint1.lower must be below joint1.upper"),
+    ({"joint_limits.stops.joint2.lower": 1.0, "joint_limits.stops.joint2.upper": 1.0},
+     "stops.joint2.lower must be below stops.joint2.upper"),
+    ({"stops.damping": -0.1}, "stops.damping must not be negative"),
+    ({"actuation.friction.coulomb": -0.01}, "friction.coulomb must not be negative"),
+])
+def test_empty_intervals_and_negative_dissipation_are_refused(overrides, message):
+    with pytest.raises(ParameterFileError, match=message):
+        config.read("premium_1_5", overrides)
