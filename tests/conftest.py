@@ -110,7 +110,8 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 #: whose node id contains the key (a test file's name, unique in tests/). A module whose
 #: module-scoped fixture (or a cache of its helpers, shared with another module) is expensive
 #: computes it once, not once per worker
-#: (codegen/test_generate.py: its headers, generated once per arguments; the SymPy derivations of
+#: (codegen/test_generate.py, test_servo.py and cli/test_codegen.py: their headers, generated once per
+#: arguments (helpers.generated); the SymPy derivations of
 #: references.cad and phantom_pin.report.derivation); the ROS 2 node tests over loopback run one
 #: at a time.
 GROUPS = {
@@ -125,6 +126,8 @@ GROUPS = {
     "/test_interop.py::": "interop",                   # each model's Drake plant
     "/test_gazebo.py::": "gazebo",
     "/test_generate.py::": "codegen",
+    "/test_servo.py::": "codegen",
+    "/test_codegen.py::": "codegen",
     "/test_stand_in.py::": "stand_in",                 # each model's stand-in and programs, built once
     "/test_cad_model.py::": "cad_model",
     "/test_derivation.py::": "derivation",
