@@ -66,14 +66,6 @@ def test_the_entry_points_have_top_level_names():
     assert {"check", "simulate_mujoco", "load_files"} <= set(phantom_pin.__all__)
 
 
-@pytest.mark.parametrize("bad, call", [("touch", "Phantom.from_model('touch')"),
-                                       (phantom_pin.Description, "Phantom.from_model(model)")])
-def test_check_refuses_what_is_not_a_phantom(bad, call):
-    with pytest.raises(InvalidInputError) as error:
-        phantom_pin.check(bad, states=1)
-    assert error.value.argument == "phantom" and call in error.value.detail
-
-
 def test_optimise_names_its_phantom():
     from phantom_pin.identification import optimise
 
