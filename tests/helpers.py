@@ -24,6 +24,7 @@ import yaml
 from PIL import Image
 
 from phantom_pin import Phantom, config
+from phantom_pin.interfaces import profiles
 from phantom_pin.viewer import CAMERA_POSITION
 from phantom_pin.viewer.screenshot import chromium_command
 
@@ -444,3 +445,7 @@ def call(library, name, width, a, b=None, c=None):
                                       args[0].ctypes.data_as(pointer), args[1].ctypes.data_as(pointer),
                                       out.ctypes.data_as(pointer))
     return out
+
+
+#: The drivers' profiles, by name (robots/phantom_description/config/drivers/).
+PROFILES = profiles.names()
