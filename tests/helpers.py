@@ -449,3 +449,18 @@ def call(library, name, width, a, b=None, c=None):
 
 #: The drivers' profiles, by name (robots/phantom_description/config/drivers/).
 PROFILES = profiles.names()
+
+
+def installed_profiles() -> list[str]:
+    """The drivers' profiles whose force message type installs here (the others' node refuses)."""
+    from phantom_pin.exceptions import MissingDataError
+    from phantom_pin.interfaces.ros2.node import message_type
+
+    def _installed(name: str) -> bool:
+        try:
+            message_type(profiles.load(name).force.type)
+        except MissingDataError:
+            return False
+        return True
+
+    return [name for name in profiles.names() if _installed(name)]
