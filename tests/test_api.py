@@ -1,7 +1,8 @@
 """One way to make each object and one name for each role (issue 40, step 2): every public
 function or method that takes a Phantom calls it ``phantom``, a Device ``device``, a Description
 ``description``; the entry points without a top-level name have one; and a function given the
-wrong object refuses it naming the argument and the call that makes the right one."""
+wrong object refuses it naming the argument and the call that makes the right one; no function
+below the entry points defaults to a configuration."""
 
 import importlib
 import inspect

@@ -21,7 +21,7 @@ TESTS = Path(__file__).resolve().parent
 
 #: The modules with no mirrored test file, each with its reason (module paths under phantom_pin/;
 #: a package's __init__.py and __main__.py need none: they hand names on, tests/test_api.py and
-#: tests/cli/test_options.py run them).
+#: the command line's tests run them).
 EXEMPT = {
     "_paths.py": "constants alone (where the description folder and the driver profiles are)",
     "cli/identification.py": "moved by the identification stage work (tests/cli/test_identification_commands.py)",
@@ -34,12 +34,12 @@ EXEMPT = {
     "description/mimic.py": "no test of its own: dynamics/test_coupling.py reads the mimic tags",
     "description/mjcf.py": "no test of its own: describe()'s MJCF in MuJoCo (config/test_reader.py, "
                            "config/test_friction_per_joint.py, device/test_mujoco_plant.py)",
-    "description/urdf.py": "no test of its own: the URDF's readers (description/test_gimbal.py, test_description_physical.py)",
+    "description/urdf.py": "no test of its own: the URDF's readers (description/test_gimbal.py and others)",
     "device/controllers.py": "no test of its own: cli/test_cli_device.py's tracking simulate",
     "dynamics/build.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py, test_loader.py)",
     "dynamics/pinocchio_models.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py)",
-    "interfaces/openhaptics/plant.py": "no test of its own: the stand-in runs it (interfaces/openhaptics/test_stand_in.py)",
-    "interfaces/openhaptics/protocol.py": "no test of its own: the stand-in's records (interfaces/openhaptics/test_stand_in.py)",
+    "interfaces/openhaptics/plant.py": "no test of its own: the stand-in runs it (openhaptics/test_stand_in.py)",
+    "interfaces/openhaptics/protocol.py": "no test of its own: the stand-in's records (openhaptics/test_stand_in.py)",
     "report/appendix.py": "the appendix's printed torques, the reference report/test_closed_form.py checks against",
     "report/parameters.py": "no test of its own: the report's numbers (config/test_builders.py)",
 }

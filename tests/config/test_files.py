@@ -1,4 +1,6 @@
-"""TODO DOCSTRING"""
+"""The parameter files and the overrides (config/files.py): YAML numbers without a dot are
+numbers, binary, malformed and missing files raise one line naming the file, nested, dotted and
+qualified override keys are the same."""
 
 import dataclasses
 

@@ -1,4 +1,4 @@
-"""TODO DOCSTRING"""
+"""config.read (config/load.py): an override is checked like the file, before any model is built."""
 
 import pytest
 

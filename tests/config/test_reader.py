@@ -1,6 +1,7 @@
-"""Bounds that keep a configuration computable: every number's magnitude (SI units), the MJCF's
-timestep, and a motor's data sheet consistent with itself (torque = torque constant x current,
-continuous below stall). Against the maxon RE 25 data sheet's own arithmetic and MuJoCo."""
+"""The checks of the parameter files' numbers (config/reader.py): malformed or non-physical files
+raise ParameterFileError naming the file and the key; joint limits within one turn; the bounds that
+keep a configuration computable, every number's magnitude (SI units) and the MJCF's timestep,
+against MuJoCo."""
 
 import re
 

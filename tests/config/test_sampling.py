@@ -1,4 +1,5 @@
-"""TODO DOCSTRING"""
+"""The seeded postures (config/sampling.py): inside the box, the stops and both coupled stops of
+joint_limits.yaml, reaching each coupled stop; stops that keep a sliver are refused, not looped on."""
 
 import dataclasses
 

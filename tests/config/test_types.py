@@ -1,4 +1,4 @@
-"""TODO DOCSTRING"""
+"""The typed Config (config/types.py): the shipped configuration is frozen or read-only throughout."""
 
 import dataclasses
 
