@@ -1,8 +1,8 @@
-"""The force path without ROS (phantom_pin.interfaces.forces, ros2.DriverBridge; the profiles'
-own tests are test_profiles.py): each driver's joint_states read as the driver writes them (its source lines, driver_reference), the force it
-is sent taken back to OpenHaptics' frame by its own formula, and J^T F compared with the Touch's
-gravity from the report's closed form and the gimbal's reference load (J from complex steps of
-Ubitrack's kinematics): 1e-9 N m."""
+"""The force path without ROS (phantom_pin.interfaces.forces, ros2.DriverBridge; the profiles' own
+tests are test_profiles.py): each driver's joint_states read as the driver writes them (its source
+lines, driver_reference), the force it is sent taken back to OpenHaptics' frame by its own formula,
+and J^T F compared with the Touch's gravity from the report's closed form and the gimbal's reference
+load (J from complex steps of Ubitrack's kinematics): 1e-9 N m."""
 
 from __future__ import annotations
 
