@@ -1,7 +1,7 @@
-"""Shared fixtures (one Phantom, seeded random states inside the joint limits, the command line
-run in-process, the Touch's six-joint model, a copy of a configuration folder), the pytest markers of the Debian packages some
-tests need, and the groups the xdist workers keep together. What tests import lives in
-helpers.py."""
+"""Shared fixtures (one Phantom, seeded random states inside the joint limits, the command line run
+in-process, the Touch's six-joint model, a copy of a configuration folder), the pytest markers
+of the Debian packages some tests need, and the groups the xdist workers keep together. What
+tests import lives in helpers.py."""
 
 import os
 import shutil
