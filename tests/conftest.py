@@ -1,7 +1,7 @@
-"""Shared fixtures (one Phantom, seeded random states inside the joint limits, the command line
-run in-process, the Touch's six-joint model), the pytest markers of the Debian packages some
-tests need, and the groups the xdist workers keep together. What tests import lives in
-helpers.py."""
+"""Shared fixtures (one Phantom, seeded random states inside the joint limits, the command line run
+in-process, the Touch's six-joint model, a copy of a configuration folder), the pytest markers
+of the Debian packages some tests need, and the groups the xdist workers keep together. What
+tests import lives in helpers.py."""
 
 import os
 import shutil
@@ -60,6 +60,15 @@ def states():
     return random_states(CONFIG.limits, N_STATES, seed=20261121)
 
 
+@pytest.fixture()
+def folder(tmp_path):
+    """A copy of premium_1_5's configuration folder (tmp_path/config), to edit."""
+    from phantom_pin.config import MODELS
+
+    shutil.copytree(MODELS["premium_1_5"].config, tmp_path / "config")
+    return tmp_path / "config"
+
+
 @pytest.fixture(scope="module")
 def six():
     """The Touch's six-joint model built from its committed URDF by Pinocchio alone (helpers.Six):
@@ -101,7 +110,8 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 #: whose node id contains the key (a test file's name, unique in tests/). A module whose
 #: module-scoped fixture (or a cache of its helpers, shared with another module) is expensive
 #: computes it once, not once per worker
-#: (codegen/test_generate.py: its headers, generated once per arguments; the SymPy derivations of
+#: (codegen/test_generate.py, test_servo.py and cli/test_codegen.py: their headers, generated once per
+#: arguments (helpers.generated); the SymPy derivations of
 #: references.cad and phantom_pin.report.derivation); the ROS 2 node tests over loopback run one
 #: at a time.
 GROUPS = {
@@ -116,6 +126,8 @@ GROUPS = {
     "/test_interop.py::": "interop",                   # each model's Drake plant
     "/test_gazebo.py::": "gazebo",
     "/test_generate.py::": "codegen",
+    "/test_servo.py::": "codegen",
+    "/test_codegen.py::": "codegen",
     "/test_stand_in.py::": "stand_in",                 # each model's stand-in and programs, built once
     "/test_cad_model.py::": "cad_model",
     "/test_derivation.py::": "derivation",

@@ -4,6 +4,8 @@ with a known truth, and the browser helpers: render an HTML file in headless chr
 a world point to its pixel with meshcat's camera (75 degrees vertical field of view, looking at
 the world origin, z up, from viewer.CAMERA_POSITION)."""
 
+import ctypes
+import functools
 import json
 import os
 import re
@@ -17,10 +19,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pinocchio as pin
+import pytest
 import yaml
 from PIL import Image
 
 from phantom_pin import Phantom, config
+from phantom_pin.interfaces import profiles
 from phantom_pin.viewer import CAMERA_POSITION
 from phantom_pin.viewer.screenshot import chromium_command
 
@@ -368,3 +372,95 @@ def message(profile: object) -> SimpleNamespace:
     if kind == "WrenchStamped":
         return SimpleNamespace(header=SimpleNamespace(stamp=None), wrench=SimpleNamespace(force=vector))
     return SimpleNamespace(force=vector)
+
+
+# The generated C header (tests/codegen/, tests/cli/test_codegen.py): generated once per
+# arguments in a process (conftest.GROUPS keeps its tests on one worker), compiled and called.
+
+#: An identified-style overlay on the CAD model: masses, centres of mass off the links' axes and
+#: products of inertia, as `phantom-pin identify` writes them (links.NAME.{mass,com.k,inertia.xy}),
+#: each a number the CAD already has nonzero (a zero made nonzero doubles SymPy's work: 7.5 s of CPU
+#: against 3.5 s, for the same code paths).
+OVERLAY = {"links.forearm_link.com.0": 3.1e-05, "links.forearm_link.mass": 0.028,
+           "links.turret_link.inertia.xz": -1.9e-04, "links.lower_bar_link.com.0": 0.1012,
+           "links.crank_link.inertia.xy": 3.5e-06, "links.upper_arm_link.com.1": 0.0022,
+           "links.upper_arm_link.inertia.yz": 3e-6, "links.crank_link.mass": 0.2}
+
+
+STRICT_C = ["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+STRICT_CXX = ["g++", "-std=c++17", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+
+
+#: A shared library over the header: each function looped over n states (row-major arrays).
+SHIM = """#include "model.h"
+#define LOOP(name, call) void batch_##name(int n, const double *a, const double *b, \\
+    const double *c, double *out) { int k; (void)b; (void)c; for (k = 0; k < n; ++k) { call; } }
+LOOP(gravity, phantom_gravity(a + 3 * k, out + 3 * k))
+LOOP(inverse_dynamics, phantom_inverse_dynamics(a + 3 * k, b + 3 * k, c + 3 * k, out + 3 * k))
+LOOP(mass_matrix, phantom_mass_matrix(a + 3 * k, out + 9 * k))
+LOOP(coriolis, phantom_coriolis(a + 3 * k, b + 3 * k, out + 3 * k))
+LOOP(tip_position, phantom_tip_position(a + 3 * k, out + 3 * k))
+LOOP(tip_jacobian, phantom_tip_jacobian(a + 3 * k, out + 9 * k))
+LOOP(jacobian_transpose_force, phantom_jacobian_transpose_force(a + 3 * k, b + 3 * k, out + 3 * k))
+LOOP(theta_from_openhaptics, phantom_theta_from_openhaptics(a + 3 * k, out + 3 * k))
+LOOP(openhaptics_torque_from_tau, phantom_openhaptics_torque_from_tau(a + 3 * k, out + 3 * k))
+"""
+
+
+@functools.cache
+def _generated(name, prefix, overlay):
+    from phantom_pin.codegen import header
+
+    return header(name, prefix=prefix, overrides=dict(overlay) if overlay else None)
+
+
+def generated(name, prefix="phantom", overrides=None):
+    """header(name, prefix, overrides), generated once per arguments in this process (SymPy
+    takes seconds); the tests of header()'s own errors call it directly."""
+    return _generated(name, prefix, tuple(sorted((overrides or {}).items())))
+
+
+def build(text, folder, shim=SHIM):
+    """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the ``shim`` as a
+    shared library (-O2); returns the ctypes library. Fails in one line without gcc and g++."""
+    if not (shutil.which("gcc") and shutil.which("g++")):
+        pytest.fail("gcc and g++ compile the header: apt-get install g++ (.ci/run installs it)", pytrace=False)
+    (folder / "model.h").write_text(text)
+    (folder / "shim.c").write_text(shim)
+    (folder / "shim.cpp").write_text(shim)
+    subprocess.run([*STRICT_C, "-O2", "-fPIC", "-shared", "shim.c", "-o", "libmodel.so", "-lm"],
+                   cwd=folder, check=True, capture_output=True, text=True)
+    subprocess.run([*STRICT_CXX, "-O2", "-c", "shim.cpp", "-o", "shim_cpp.o"], cwd=folder, check=True,
+                   capture_output=True, text=True)
+    return ctypes.CDLL(str(folder / "libmodel.so"))
+
+
+def call(library, name, width, a, b=None, c=None):
+    """The batch_<name> of the library on (n, 3) arrays: (n, width)."""
+    a = np.ascontiguousarray(a, dtype=float)
+    out = np.empty((len(a), width))
+    pointer = ctypes.POINTER(ctypes.c_double)
+    args = [np.ascontiguousarray(x if x is not None else a, dtype=float) for x in (b, c)]
+    getattr(library, f"batch_{name}")(ctypes.c_int(len(a)), a.ctypes.data_as(pointer),
+                                      args[0].ctypes.data_as(pointer), args[1].ctypes.data_as(pointer),
+                                      out.ctypes.data_as(pointer))
+    return out
+
+
+#: The drivers' profiles, by name (robots/phantom_description/config/drivers/).
+PROFILES = profiles.names()
+
+
+def installed_profiles() -> list[str]:
+    """The drivers' profiles whose force message type installs here (the others' node refuses)."""
+    from phantom_pin.exceptions import MissingDataError
+    from phantom_pin.interfaces.ros2.node import message_type
+
+    def _installed(name: str) -> bool:
+        try:
+            message_type(profiles.load(name).force.type)
+        except MissingDataError:
+            return False
+        return True
+
+    return [name for name in profiles.names() if _installed(name)]

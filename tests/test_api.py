@@ -1,17 +1,19 @@
 """One way to make each object and one name for each role (issue 40, step 2): every public
 function or method that takes a Phantom calls it ``phantom``, a Device ``device``, a Description
 ``description``; the entry points without a top-level name have one; and a function given the
-wrong object refuses it naming the argument and the call that makes the right one."""
+wrong object refuses it naming the argument and the call that makes the right one; no function
+below the entry points defaults to a configuration."""
 
 import importlib
 import inspect
 import pkgutil
 import re
+from pathlib import Path
 
 import pytest
 
 import phantom_pin
-from phantom_pin import InvalidInputError, Phantom
+from phantom_pin import InvalidInputError, Phantom, config
 
 #: The object each role's parameter holds (its annotation names the class), and that name.
 ROLES = {"Phantom": "phantom", "Device": "device", "Description": "description"}
@@ -65,14 +67,6 @@ def test_the_entry_points_have_top_level_names():
     assert {"check", "simulate_mujoco", "load_files"} <= set(phantom_pin.__all__)
 
 
-@pytest.mark.parametrize("bad, call", [("touch", "Phantom.from_model('touch')"),
-                                       (phantom_pin.Description, "Phantom.from_model(model)")])
-def test_check_refuses_what_is_not_a_phantom(bad, call):
-    with pytest.raises(InvalidInputError) as error:
-        phantom_pin.check(bad, states=1)
-    assert error.value.argument == "phantom" and call in error.value.detail
-
-
 def test_optimise_names_its_phantom():
     from phantom_pin.identification import optimise
 
@@ -90,3 +84,34 @@ def test_a_device_of_a_named_model_is_that_models_phantom():
         device, phantom = phantom_pin.Device.from_model(name), Phantom.from_model(name)
         assert device.config is phantom.config
         assert (device.phantom.gravity(theta) == phantom.gravity(theta)).all()
+
+
+def _defaults(function):
+    try:
+        return [p.default for p in inspect.signature(function).parameters.values()]
+    except (TypeError, ValueError):
+        return []
+
+
+def test_no_function_below_the_entry_points_defaults_to_a_configuration():
+    """Every function takes the Description (or Config) it works on: no parameter below the
+    public entry points defaults to a model name, a configuration folder or a Config."""
+    entry_points = {"describe", "shipped", "description_of", "read", "resolve", "load", "__init__", "simulate",
+                    "default_device", "main"}
+    found = []
+    for module_info in pkgutil.walk_packages(phantom_pin.__path__, "phantom_pin."):
+        module = importlib.import_module(module_info.name)
+        for name, item in vars(module).items():
+            if getattr(item, "__module__", None) != module.__name__:
+                continue
+            functions = [(name, item)] if inspect.isfunction(item) else []
+            if inspect.isclass(item):
+                functions += [(f"{name}.{n}", f) for n, f in vars(item).items() if inspect.isfunction(f)]
+            for qualified, function in functions:
+                if qualified.split(".")[-1] in entry_points and not qualified.startswith(("Regressor", "Structured")):
+                    continue
+                for default in _defaults(function):
+                    if (isinstance(default, (Path, config.Config)) or default in config.models()
+                            or default is config.DEFAULT):
+                        found.append(f"{module.__name__}.{qualified}")
+    assert not found

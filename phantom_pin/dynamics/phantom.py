@@ -113,7 +113,7 @@ class Phantom:
     @classmethod
     def from_model(cls, model: str) -> Phantom:
         """The named model ``model`` (phantom_pin.models()), from its committed URDF and SRDF
-        (equal to describe(model)'s, tests/description/test_description.py; the one Description
+        (equal to describe(model)'s, tests/description/test_description_build.py; the one Description
         of shipped(model), Phantom()'s for the default). InvalidInputError naming ``model`` for
         anything else."""
         if not (isinstance(model, str) and model in MODELS):
@@ -412,7 +412,7 @@ class Phantom:
                     and BOOL is not q.dtype and BOOL is not dtheta.dtype  # type: ignore[attr-defined]
                     and BOOL is not ddtheta.dtype):  # type: ignore[attr-defined]
                 tau = pin.rnea(self.model, self.data, theta, dtheta, ddtheta)  # (a fresh array)
-                # NaN/inf in any input, or an overflow, reaches tau (tests/dynamics/test_fast_paths.py);
+                # NaN/inf in any input, or an overflow, reaches tau (tests/dynamics/test_fast.py);
                 # only then are the inputs inspected, to name the bad one.
                 t0, t1, t2 = tau.tolist()
                 if isfinite(t0 + t1 + t2):

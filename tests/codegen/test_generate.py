@@ -3,18 +3,16 @@ through ctypes, and compared function by function with Pinocchio through Phantom
 shipped model and on an identified-style overlay; the committed headers are fresh; bad input
 is refused and nothing is written."""
 
-import ctypes
-import functools
-import shutil
 import subprocess
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
+from helpers import OVERLAY, SHIM, STRICT_C, build, call, generated
 from phantom_pin import Device, Phantom, describe, simulate
 from phantom_pin.cli import main
-from phantom_pin.codegen import header, write_header
+from phantom_pin.codegen import header
 from phantom_pin.codegen.generate import committed_header
 from phantom_pin.config import MODELS, models
 from phantom_pin.config.sampling import random_states
@@ -23,72 +21,10 @@ from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 #: Relative tolerance per state: max |C - Pinocchio| / max |Pinocchio| of each output.
 TOLERANCE = 1e-12
 N_STATES = 1000
-#: An identified-style overlay on the CAD model: masses, centres of mass off the links' axes and
-#: products of inertia, as `phantom-pin identify` writes them (links.NAME.{mass,com.k,inertia.xy}),
-#: each a number the CAD already has nonzero (a zero made nonzero doubles SymPy's work: 7.5 s of CPU
-#: against 3.5 s, for the same code paths).
-OVERLAY = {"links.forearm_link.com.0": 3.1e-05, "links.forearm_link.mass": 0.028,
-           "links.turret_link.inertia.xz": -1.9e-04, "links.lower_bar_link.com.0": 0.1012,
-           "links.crank_link.inertia.xy": 3.5e-06, "links.upper_arm_link.com.1": 0.0022,
-           "links.upper_arm_link.inertia.yz": 3e-6, "links.crank_link.mass": 0.2}
 CASES = [(name, None) for name in models()] + [("premium_1_5_cad", OVERLAY)]
-STRICT_C = ["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
-STRICT_CXX = ["g++", "-std=c++17", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 
-#: A shared library over the header: each function looped over n states (row-major arrays).
-SHIM = """#include "model.h"
-#define LOOP(name, call) void batch_##name(int n, const double *a, const double *b, \\
-    const double *c, double *out) { int k; (void)b; (void)c; for (k = 0; k < n; ++k) { call; } }
-LOOP(gravity, phantom_gravity(a + 3 * k, out + 3 * k))
-LOOP(inverse_dynamics, phantom_inverse_dynamics(a + 3 * k, b + 3 * k, c + 3 * k, out + 3 * k))
-LOOP(mass_matrix, phantom_mass_matrix(a + 3 * k, out + 9 * k))
-LOOP(coriolis, phantom_coriolis(a + 3 * k, b + 3 * k, out + 3 * k))
-LOOP(tip_position, phantom_tip_position(a + 3 * k, out + 3 * k))
-LOOP(tip_jacobian, phantom_tip_jacobian(a + 3 * k, out + 9 * k))
-LOOP(jacobian_transpose_force, phantom_jacobian_transpose_force(a + 3 * k, b + 3 * k, out + 3 * k))
-LOOP(theta_from_openhaptics, phantom_theta_from_openhaptics(a + 3 * k, out + 3 * k))
-LOOP(openhaptics_torque_from_tau, phantom_openhaptics_torque_from_tau(a + 3 * k, out + 3 * k))
-"""
 #: The header of a model with a stylus gimbal: its pose, (p, R) as 12 numbers per state.
 STYLUS_SHIM = "LOOP(stylus_pose, phantom_stylus_pose(a + 3 * k, b + 3 * k, out + 12 * k, out + 12 * k + 3))\n"
-
-
-@functools.cache
-def _generated(name, prefix, overlay):
-    return header(name, prefix=prefix, overrides=dict(overlay) if overlay else None)
-
-
-def generated(name, prefix="phantom", overrides=None):
-    """header(name, prefix, overrides), generated once per arguments in this process (SymPy
-    takes seconds); the tests of header()'s own errors call it directly."""
-    return _generated(name, prefix, tuple(sorted((overrides or {}).items())))
-
-
-def build(text, folder, shim=SHIM):
-    """Compile ``text`` as model.h: strictly as C99 and C++17 (objects), then the ``shim`` as a
-    shared library (-O2); returns the ctypes library. Fails in one line without gcc and g++."""
-    if not (shutil.which("gcc") and shutil.which("g++")):
-        pytest.fail("gcc and g++ compile the header: apt-get install g++ (.ci/run installs it)", pytrace=False)
-    (folder / "model.h").write_text(text)
-    (folder / "shim.c").write_text(shim)
-    (folder / "shim.cpp").write_text(shim)
-    subprocess.run([*STRICT_C, "-O2", "-fPIC", "-shared", "shim.c", "-o", "libmodel.so", "-lm"],
-                   cwd=folder, check=True, capture_output=True, text=True)
-    subprocess.run([*STRICT_CXX, "-O2", "-c", "shim.cpp", "-o", "shim_cpp.o"], cwd=folder, check=True,
-                   capture_output=True, text=True)
-    return ctypes.CDLL(str(folder / "libmodel.so"))
-
-
-def call(library, name, width, a, b=None, c=None):
-    """The batch_<name> of the library on (n, 3) arrays: (n, width)."""
-    a = np.ascontiguousarray(a, dtype=float)
-    out = np.empty((len(a), width))
-    pointer = ctypes.POINTER(ctypes.c_double)
-    args = [np.ascontiguousarray(x if x is not None else a, dtype=float) for x in (b, c)]
-    getattr(library, f"batch_{name}")(ctypes.c_int(len(a)), a.ctypes.data_as(pointer),
-                                      args[0].ctypes.data_as(pointer), args[1].ctypes.data_as(pointer),
-                                      out.ctypes.data_as(pointer))
-    return out
 
 
 def per_state_error(actual, expected):
@@ -160,36 +96,6 @@ def test_the_stylus_pose_matches_phantom_and_pinocchio_on_the_touch_urdf(tmp_pat
         assert "_stylus_pose" not in generated(name)
 
 
-def test_openhaptics_helpers_follow_the_published_conventions(tmp_path):
-    """The header's OpenHaptics conversions against the published conventions written out here,
-    not against phantom_pin.interfaces.conventions (the same convention twice). Angles: Ubitrack/
-    component_haptic_calibration's PhantomForwardKinematics.h lines 101-103 put the tip of
-    OpenHaptics' angles a at x = -(l1 c2 + l2 s3) s1, y = l1 s2 - l2 c3 + l2, z = -l1 + (l1 c2 +
-    l2 s3) c1 (l1 = l2 = 133.35 mm, its default): the header's tip at theta_from_openhaptics(a)
-    is there (1e-12 m), and theta = (-a1, a2, a3) exactly. Torques: SensAble's CommandJointTorque
-    sample gives HD_CURRENT_JOINT_TORQUE in mN m on OpenHaptics' own angles, so it does tau's
-    power on their rates (1e-9 relative) and equals 1000 (-tau1, tau2, tau3) exactly; a spring
-    restoring theta is the sample's restoring spring, torque = k (0 - a) with k > 0."""
-    library = build(generated("touch"), tmp_path)
-    rng = np.random.default_rng(5)
-    angles = rng.uniform([-0.98, 0.0, 0.0], [0.98, 1.75, 2.0], (50, 3))   # inside the Touch's stops
-    theta = call(library, "theta_from_openhaptics", 3, angles)
-    assert np.array_equal(theta, np.column_stack([-angles[:, 0], angles[:, 1], angles[:, 2]]))
-    length = 0.13335
-    s1, c1, s2, c2, s3, c3 = (f(angles[:, k]) for k in range(3) for f in (np.sin, np.cos))
-    ubitrack = np.column_stack([-(length * c2 + length * s3) * s1, length * s2 - length * c3 + length,
-                                -length + (length * c2 + length * s3) * c1])
-    assert np.abs(call(library, "tip_position", 3, theta) - ubitrack).max() < 1e-12
-    tau, rates = rng.normal(0, 1, (50, 3)), rng.normal(0, 1, (50, 3))   # N m; OpenHaptics' angle rates
-    torque = call(library, "openhaptics_torque_from_tau", 3, tau)
-    assert np.array_equal(torque, 1000 * np.column_stack([-tau[:, 0], tau[:, 1], tau[:, 2]]))
-    theta_rates = np.column_stack([-rates[:, 0], rates[:, 1], rates[:, 2]])   # d theta / dt of d a / dt
-    power_mw = np.einsum("ni,ni->n", torque, rates)
-    assert np.abs(power_mw - 1000 * np.einsum("ni,ni->n", tau, theta_rates)).max() < 1e-9 * np.abs(power_mw).max()
-    restoring = call(library, "openhaptics_torque_from_tau", 3, -0.5 * theta)   # a spring to theta = 0
-    assert np.all(restoring * angles <= 0) and np.all(restoring[angles != 0] != 0)  # the sample's: to a = 0
-
-
 @pytest.mark.parametrize("name", models())
 def test_committed_headers_are_fresh(name):
     """Each shipped model's committed header is what its configuration generates now."""
@@ -218,42 +124,6 @@ def test_bad_input_is_refused_with_describes_line(tmp_path):
         with pytest.raises(InvalidInputError) as error:
             header("touch", prefix=prefix)
         assert error.value.argument == "prefix"
-
-
-def test_the_writer_never_overwrites_without_force(tmp_path):
-    target = tmp_path / "model.h"
-    write_header("one", target)
-    with pytest.raises(InvalidInputError):
-        write_header("two", target)
-    assert target.read_text() == "one"
-    write_header("two", target, force=True)
-    assert target.read_text() == "two"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.h"]  # no temporary left
-
-
-def test_cli_writes_the_header_and_refuses_bad_input(tmp_path, capsys):
-    """phantom-pin codegen: the header of --model with --set and --prefix; on bad input one
-    line naming the option, exit 2, and no file."""
-    out = tmp_path / "arm.h"
-    assert main(["codegen", "--model", "touch", "--prefix", "arm", "-o", str(out)]) == 0
-    assert out.read_text() == generated("touch", prefix="arm")
-    assert main(["codegen", "--model", "touch", "-o", str(out)]) == 2
-    assert "--force" in capsys.readouterr().err
-    assert out.read_text() == generated("touch", prefix="arm")
-    bad = tmp_path / "bad.h"
-    assert main(["codegen", "--model", "touch", "--prefix", "9lives", "-o", str(bad)]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith("phantom-pin: error: --prefix:") and err.count("\n") == 1
-    assert main(["codegen", "--model", "touch", "--set", "links.forearm_link.mass=-1", "-o", str(bad)]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1
-    assert main(["info", "--model", "touch", "--set", "links.forearm_link.mass=-1"]) == 2
-    assert capsys.readouterr().err == err  # the same line as any command's describe()
-    assert not bad.exists()
-    sets = [argument for key, value in OVERLAY.items() for argument in ("--set", f"{key}={value!r}")]
-    assert main(["codegen", "--model", "premium_1_5_cad", *sets, "-o", str(out), "--force"]) == 0
-    assert out.read_text() == generated("premium_1_5_cad", overrides=OVERLAY)  # --set as overrides=
-
 
 
 @pytest.mark.parametrize("name", ["premium_1_5", "touch"])
@@ -295,12 +165,6 @@ def test_without_sympy_one_line_names_the_package(monkeypatch, tmp_path, capsys)
     assert not (tmp_path / "a.h").exists()
 
 
-def test_a_missing_config_folder_is_blamed_on_config(tmp_path, capsys):
-    assert main(["codegen", "--config", str(tmp_path / "none"), "-o", str(tmp_path / "a.h")]) == 2
-    assert capsys.readouterr().err.startswith("phantom-pin: error: --config: ")
-    assert not (tmp_path / "a.h").exists()
-
-
 def test_an_overlays_banner_is_wrapped_into_short_comment_lines():
     """L10: identify's overlay sets dozens of keys; the banner lists each, in lines of at most
     100 characters (it was one line of 3,400), and the header still compiles (-Werror)."""
@@ -309,84 +173,3 @@ def test_an_overlays_banner_is_wrapped_into_short_comment_lines():
     assert len(overlay) > 1 and max(len(line) for line in overlay) <= 100
     flat = " ".join(line.strip(" *") for line in overlay)
     assert all(f"{key} = {value!r}" in flat for key, value in OVERLAY.items())
-
-
-#: The servo loop's own terms (docs/servo-loop.md, "In your servo loop"): per state a, b = angles.
-SERVO_SHIM = """#include "model.h"
-void servo(int n, const double *a, const double *g, const double *r, double *out) {
-    int k; for (k = 0; k < n; ++k) {
-        phantom_openhaptics_force(a + 3 * k, g + 3 * k, out + 12 * k);
-        phantom_openhaptics_joint_torque(a + 3 * k, g + 3 * k, out + 12 * k + 3);
-        phantom_openhaptics_force_friction(a + 3 * k, g + 3 * k, r + 3 * k, out + 12 * k + 6);
-        phantom_openhaptics_joint_torque_friction(a + 3 * k, g + 3 * k, r + 3 * k, out + 12 * k + 9); } }
-"""
-
-
-@pytest.mark.parametrize("name", models())
-def test_the_servo_loop_functions_compensate_gravity_and_friction(name, tmp_path):
-    """NAME_openhaptics_force and _joint_torque (and their _friction forms), compiled strictly,
-    on 200 seeded states inside the stops (the Touch's gimbal inside its ranges, OpenHaptics'
-    angles a = (-theta1, theta2, theta3)): J^T F and the joint torques on theta equal the
-    gravity of references independent of Phantom (tests/references/openhaptics.py: the closed
-    form, the CAD's re-derivation, the Touch's six-joint URDF in Pinocchio) to 1e-9 N m, plus the
-    friction law (actuation.yaml's numbers) at the rates given; NAME_STYLUS says whether the
-    model has a gimbal."""
-    from references.openhaptics import gravity_and_jacobian
-    text = generated(name)
-    library = build(text, tmp_path, SERVO_SHIM)
-    config = describe(name).config
-    n = 200
-    theta = random_states(config.limits, n, seed=61)[0]
-    rng = np.random.default_rng(62)
-    gimbal = np.zeros((n, 3)) if config.gimbal is None else \
-        rng.uniform(config.gimbal.lower, config.gimbal.upper, (n, 3))
-    rates = rng.normal(0, 1, (n, 3))
-    sign = np.array([-1.0, 1.0, 1.0])
-    out = np.empty((n, 12))
-    pointer = ctypes.POINTER(ctypes.c_double)
-    arrays = [np.ascontiguousarray(x) for x in (sign * theta, gimbal, rates)]
-    library.servo(ctypes.c_int(n), *(x.ctypes.data_as(pointer) for x in arrays), out.ctypes.data_as(pointer))
-    law = config.actuation.friction
-    for k in range(n):
-        gravity, jacobian = gravity_and_jacobian(name, theta[k], None if config.gimbal is None else gimbal[k])
-        friction = np.array(law.viscous) * sign * rates[k] + np.array(law.coulomb) * np.sign(sign * rates[k])
-        assert np.abs(jacobian.T @ out[k, :3] - gravity).max() <= 1e-9
-        assert np.abs(sign * out[k, 3:6] / 1000 - gravity).max() <= 1e-9
-        assert np.abs(jacobian.T @ out[k, 6:9] - gravity - friction).max() <= 1e-9
-        assert np.abs(sign * out[k, 9:12] / 1000 - gravity - friction).max() <= 1e-9
-    assert f"#define PHANTOM_STYLUS {int(config.gimbal is not None)}" in text
-
-
-TRANSPARENT_SHIM = """#include "model.h"
-void transparent(int n, const double *a, double kappa, double dead_band, double *out) {
-    phantom_estimator e; const double g[3] = {0.0, 0.0, 0.0}; int k;
-    phantom_estimator_init(&e, 1000.0, 20.0);
-    for (k = 0; k < n; ++k) {
-        phantom_estimator_update(&e, a + 3 * k);
-        phantom_openhaptics_joint_torque_transparent(a + 3 * k, g, &e, kappa, dead_band, out + 3 * k); } }
-"""
-
-
-@pytest.mark.parametrize("name", models())
-def test_the_transparent_joint_torque_is_the_compensators(name, tmp_path):
-    """The header's estimator and NAME_openhaptics_joint_torque_transparent, over 300 ticks of a
-    seeded smooth motion (OpenHaptics' angles, 1 kHz, with a pause the dead band must see), give
-    the pyOpenHaptics Compensator's joint torques with gravity, friction and kappa = 0.5 of the
-    inertia, tick by tick, to 1e-9 relative: one estimator and one law in two languages (the
-    stylus at locked_at, where the header's M and C hold)."""
-    from phantom_pin.interfaces.openhaptics import Compensator
-    library = build(generated(name), tmp_path, TRANSPARENT_SHIM)
-    t = np.arange(300) / 1000.0
-    rng = np.random.default_rng(71)
-    base, amplitude = np.array([0.1, 0.4, 0.5]), rng.uniform(0.05, 0.2, 3)
-    angles = base + amplitude * np.sin(2 * np.pi * 1.5 * np.minimum(t, 0.15)[:, None] + rng.uniform(0, 1, 3))
-    out = np.empty((len(t), 3))
-    pointer = ctypes.POINTER(ctypes.c_double)
-    a = np.ascontiguousarray(angles)
-    library.transparent(ctypes.c_int(len(t)), a.ctypes.data_as(pointer), ctypes.c_double(0.5), ctypes.c_double(0.01),
-                        out.ctypes.data_as(pointer))
-    compensate = Compensator(name, "joint_torque", ("gravity", "friction", "inertia"), kappa=0.5)
-    gimbal = None if describe(name).config.gimbal is None else [0.0, 0.0, 0.0]
-    python = np.array([compensate.torque(x, gimbal) for x in angles]) * np.array([-1.0, 1.0, 1.0]) * 1000.0
-    assert np.abs(out - python).max() <= 1e-9 * np.abs(python).max()
-    assert np.abs(out[200:] - out[-1]).max() < np.abs(out[100:150] - out[-1]).max()   # the pause: inertia off

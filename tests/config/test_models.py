@@ -10,8 +10,9 @@ from pathlib import Path
 
 import pytest
 
+import phantom_pin
 from helpers import run_cli
-from phantom_pin import InvalidInputError, describe
+from phantom_pin import Device, InvalidInputError, Phantom, config, describe
 from phantom_pin.config import MODELS, RENAMED
 from phantom_pin.description.build import shipped
 
@@ -49,3 +50,20 @@ def test_an_old_name_is_refused_with_the_new_one(old, tmp_path):
     result = subprocess.run([str(xacro), str(MODELS[new].urdf_xacro), f"model:={old}"], capture_output=True,
                             text=True, timeout=60)
     assert result.returncode != 0 and f"{old} is now called {new} (model:={new})" in result.stderr
+
+
+def test_models_are_named_and_resolve_like_folders():
+    assert config.models() == phantom_pin.models() == ["premium_1_5", "premium_1_5_cad", "touch"]
+    by_name, by_folder = config.read("premium_1_5"), config.read(MODELS["premium_1_5"].config)
+    assert by_name == by_folder and by_name.name == "premium_1_5"
+    for call in (config.read, describe, Phantom, Device, phantom_pin.load):
+        with pytest.raises(InvalidInputError, match="premium_9"):
+            call("premium_9")
+    with pytest.raises(InvalidInputError, match="expected a model name"):
+        config.read(123)
+
+
+@pytest.mark.parametrize("call", [Phantom, config.read, describe, Device])
+def test_a_configuration_is_a_name_or_a_path(call):
+    with pytest.raises(InvalidInputError, match="expected a"):
+        call(123)

@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from helpers import REPORT
-from phantom_pin import Device, InvalidInputError, ParameterFileError, Phantom, closed_form, config
+from phantom_pin import (
+    Device,
+    InvalidInputError,
+    ParameterFileError,
+    Phantom,
+    closed_form,
+    config,
+)
 from phantom_pin.config import MODELS
 
 CONFIG_DIR = MODELS["premium_1_5"].config
@@ -315,3 +322,15 @@ def test_huge_input_gives_results_or_errors_without_numpy_warnings(device):
         assert device.reachable([1e308] * 3) is False
         with pytest.raises(InvalidInputError, match="^theta: too large"):
             device.encoder_counts([1e308] * 3)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda device: Device(3), "phantom"),
+    (lambda device: device.available_torque([0.0, 0.3, 0.4], "yes"), "continuous"),
+    (lambda device: device.tip_force_capacity([0.0, 0.3, 0.4], [0.0, 0.0, 0.0]), "direction"),
+    (lambda device: device.encoder_counts([1e300, 0.0, 0.0]), "theta"),
+])
+def test_the_device_names_the_bad_argument_in_the_field(device, call, name):
+    with pytest.raises(InvalidInputError) as raised:
+        call(device)
+    assert raised.value.argument == name and str(raised.value) == f"{name}: {raised.value.detail}"

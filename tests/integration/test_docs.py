@@ -57,7 +57,7 @@ def test_simulation_doc_quotes_the_shipped_friction_and_stops():
 
 def test_the_cli_page_says_what_ctrl_c_does_to_show_and_ros2():
     """docs/cli.md's Ctrl-C sentence (one line, exit 130) names its exceptions: `show`'s live
-    viewer and the `ros2` node exit 0 on it, their normal stop (tests/cli/test_cli.py's
+    viewer and the `ros2` node exit 0 on it, their normal stop (tests/cli/test_model.py's
     test_show_serves_on_loopback_until_interrupted runs show and sends SIGINT: exit 0)."""
     readme = " ".join((ROOT / "docs" / "cli.md").read_text().split())
     start = readme.index("Ctrl-C prints one line and exits with 130")

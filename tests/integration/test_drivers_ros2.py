@@ -25,26 +25,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import in_process
+from helpers import in_process, installed_profiles
 from helpers import ros_environment as environment
 from helpers import stop_process as stop
 from phantom_pin import Phantom, closed_form
-from phantom_pin.exceptions import MissingDataError
 from phantom_pin.interfaces import profiles
 from phantom_pin.interfaces.ros2.node import message_type
 from phantom_pin.interfaces.ros2.simulated_driver import FIRST_COMMAND
 from references import driver as ref
 
-
-def _installed(name: str) -> bool:
-    try:
-        message_type(profiles.load(name).force.type)
-    except MissingDataError:
-        return False
-    return True
-
-
-INSTALLED = [name for name in profiles.names() if _installed(name)]
+INSTALLED = installed_profiles()
 THETA0 = np.array([0.2, 0.6, 0.5])   # rad: gravity beats the static friction there (test_sim_driver)
 REPORT = Phantom.from_model("touch").config.report
 #: The bad wrench each profile's test sends, and the field its warning names.
@@ -452,25 +442,3 @@ def test_without_the_node_the_stylus_falls():
         watcher.close()
         code, err = _stop(simulated)
     assert code == 0, err
-
-
-def test_the_node_refuses_a_profile_whose_message_type_is_missing_and_bad_options_in_one_line(cli):
-    """In process (the refusals come before ROS starts): one line naming the option, exit 2."""
-    cases = [(["ros2", "--driver", "nosuch"], "--driver"),
-             (["ros2", "--max-force", "-1", "--driver", "sawsensablephantom"], "--max-force"),
-             (["ros2", "--max-force", "nan", "--driver", "sawsensablephantom"], "--max-force"),
-             (["ros2", "--topic", "gravity_torque=tip_pose"], "--topic"),
-             (["ros2", "--topic", "wrench=a", "--topic", "wrench=b"], "--topic"),
-             (["ros2", "--compensate", "none"], "--compensate"),
-             (["ros2", "--relay"], "--relay"),
-             (["sim-driver", "--driver", "sawsensablephantom", "--theta0", "0", "9", "0"], "--theta0"),
-             (["sim-driver", "--driver", "sawsensablephantom", "--hold", "-1"], "--hold"),
-             (["sim-driver", "--driver", "sawsensablephantom", "--gimbal", "0", "5", "0"], "--gimbal"),
-             (["sim-driver", "--driver", "sawsensablephantom", "--rate", "0"], "--rate")]
-    if "geomagic_touch_ros2" not in INSTALLED:
-        cases.append((["ros2", "--driver", "geomagic_touch_ros2"], "--driver"))
-    for args, option in cases:
-        code, _, err = cli("--model", "touch", *args)
-        assert code == 2 and len(err.strip().splitlines()) == 1 and option in err, (args, err)
-    code, _, err = cli("ros2", "--driver", "sawsensablephantom")     # premium_1_5: no stylus gimbal
-    assert code == 2 and "--model touch" in err

@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from phantom_pin import InvalidInputError, models
-from phantom_pin.viewer.screenshot import screenshot
+from phantom_pin import models
 
 ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "docs" / "pictures.py"
@@ -65,19 +64,3 @@ def test_the_script_renders_a_model_and_the_frames(tmp_path, capsys, monkeypatch
     (tmp_path / "touch.png").unlink()
     assert pictures.main(["--output", str(tmp_path)]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1 and not (tmp_path / "touch.png").exists()
-
-
-def test_screenshot_refuses_bad_arguments_naming_them(tmp_path):
-    """Before chromium runs: a page that is no file, a size out of range, an existing PNG without
-    force; nothing is written."""
-    page, png = tmp_path / "page.html", tmp_path / "page.png"
-    page.write_text("<html></html>")
-    png.write_bytes(b"kept")
-    target = tmp_path / "a.png"
-    cases = ((tmp_path / "none.html", target, {}, "html"), (page, target, {"width": 0}, "width"),
-             (page, target, {"height": 1.5}, "height"), (page, png, {}, "png"))
-    for html, output, options, argument in cases:
-        with pytest.raises(InvalidInputError) as error:
-            screenshot(html, output, **options)
-        assert error.value.argument == argument
-    assert png.read_bytes() == b"kept" and not (tmp_path / "a.png").exists()

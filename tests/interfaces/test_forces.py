@@ -1,8 +1,8 @@
-"""The force path without ROS (phantom_pin.interfaces.forces, profiles, ros2.DriverBridge): each driver's
-joint_states read as the driver writes them (its source lines, driver_reference), the force it
-is sent taken back to OpenHaptics' frame by its own formula, and J^T F compared with the Touch's
-gravity from the report's closed form and the gimbal's reference load (J from complex steps of
-Ubitrack's kinematics): 1e-9 N m."""
+"""The force path without ROS (phantom_pin.interfaces.forces, ros2.DriverBridge; the profiles' own
+tests are test_profiles.py): each driver's joint_states read as the driver writes them (its source
+lines, driver_reference), the force it is sent taken back to OpenHaptics' frame by its own formula,
+and J^T F compared with the Touch's gravity from the report's closed form and the gimbal's reference
+load (J from complex steps of Ubitrack's kinematics): 1e-9 N m."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from helpers import message
+from helpers import PROFILES, message
 from phantom_pin import InvalidInputError, Phantom
 from phantom_pin.config.types import Friction
 from phantom_pin.interfaces import profiles
@@ -19,19 +19,10 @@ from phantom_pin.interfaces.forces import SINGULAR, Renderer
 from phantom_pin.interfaces.ros2.node import DriverBridge, fill_force
 from references import driver as ref
 
-PROFILES = profiles.names()
-
 
 @pytest.fixture(scope="module")
 def touch() -> Phantom:
     return Phantom.from_model("touch")
-
-
-def test_every_driver_of_drivers_md_has_a_profile_with_its_sources():
-    assert set(PROFILES) == set(ref.FORCE)
-    for name in PROFILES:
-        profile = profiles.load(name)
-        assert profile.name == name and profile.sources and all("@" in s for s in profile.sources)
 
 
 @pytest.mark.parametrize("name", PROFILES)
@@ -188,49 +179,7 @@ def test_the_relay_sends_the_same_numbers_as_a_vector3_beside_the_drivers_topic(
         assert np.array_equal(ref.FORCE["geomagic_touch_ros2"](omni), direct.openhaptics)
 
 
-def test_every_profile_cites_its_sources_for_the_joint_states_and_the_force():
-    """Each fact of a profile with the driver's file and line (owner/repo@commit path:lines, or a page of
-    the OpenHaptics guide the driver ships)."""
-    import re
-
-    import yaml
-
-    for name in PROFILES:
-        node = yaml.safe_load((profiles.PROFILES_DIR / f"{name}.yaml").read_text())
-        for section in ("joint_states", "force"):
-            sources = node[section]["sources"]
-            cited = r"[\w.-]+/[\w.-]+@[0-9a-f]{7}\b.*(:\d| p\.\d)"
-            assert sources and all(re.match(cited, s) for s in sources.values()), (name, section, sources)
-
-
 # -- what the mutation survivors of ../shared/data/mutants6.md got past (each against a reference) --
-def test_a_profile_whose_frame_map_mirrors_an_axis_is_refused(tmp_path, monkeypatch):
-    """Mutant 05. A frame change between right-handed frames is a rotation, det +1; a hand-written
-    map with one axis negated (det -1, numpy's determinant) renders every force mirrored: the
-    profile is refused with a ParameterFileError (a ValueError) naming to_openhaptics; the same
-    file with the driver's own map loads."""
-    import yaml
-
-    from phantom_pin.exceptions import ParameterFileError
-
-    node = yaml.safe_load((profiles.PROFILES_DIR / "phantom_touch_ros2.yaml").read_text())
-    mirrored = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]
-    assert round(np.linalg.det(np.array(mirrored, dtype=float))) == -1
-    monkeypatch.setattr(profiles, "PROFILES_DIR", tmp_path)
-    (tmp_path / "phantom_touch_ros2.yaml").write_text(yaml.safe_dump(node))
-    profiles.load.cache_clear()
-    try:
-        assert profiles.load("phantom_touch_ros2").force.to_openhaptics.tolist() == np.eye(3).tolist()
-        node["force"]["to_openhaptics"] = mirrored
-        (tmp_path / "phantom_touch_ros2.yaml").write_text(yaml.safe_dump(node))
-        profiles.load.cache_clear()
-        with pytest.raises(ParameterFileError) as error:
-            profiles.load("phantom_touch_ros2")
-        assert isinstance(error.value, ValueError) and "to_openhaptics" in str(error.value)
-    finally:
-        profiles.load.cache_clear()
-
-
 @pytest.mark.parametrize("name", PROFILES)
 def test_the_relay_of_every_driver_fills_a_bare_vector3_with_a_stamp_given(touch, name):
     """Mutant 06. --relay sends geometry_msgs/Vector3, which has no header, whatever the driver's

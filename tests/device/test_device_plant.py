@@ -1,8 +1,8 @@
 """device.plant.Plant, the simulator's plant, against the report's closed form (M, C, N) with the
 friction and stop laws and mahilab/Phantom's constants written here; a stuck joint against the
 Lagrange-multiplier form of the constraint (a 4x4 solve); the saturation clip against the data
-sheet's torques. And the device layer's promises: errors name their argument in the field, and
-no module reads another's private names or hides an import of the package inside a function."""
+sheet's torques. And the device layer's promise: no module reads another's private names or hides
+an import of the package inside a function."""
 
 import ast
 import math
@@ -13,8 +13,7 @@ import pytest
 import yaml
 
 from helpers import REPORT
-from phantom_pin import Device, InvalidInputError, MissingDataError, closed_form, config, simulate
-from phantom_pin.device.mujoco_plant import simulate_mujoco
+from phantom_pin import Device, MissingDataError, closed_form, config
 from phantom_pin.device.plant import Plant
 
 DEG = math.pi / 180
@@ -130,61 +129,6 @@ def test_counts_per_radian_are_the_encoder_and_the_ratios(device):
     with pytest.raises(MissingDataError) as raised:
         _ = Device.from_model("touch").counts_per_radian
     assert raised.value.argument == "counts_per_radian"
-
-
-@pytest.mark.parametrize("arguments, name", [
-    ({"duration": -1.0}, "duration"),
-    ({"rate": float("nan")}, "rate"),
-    ({"substeps": 0}, "substeps"),
-    ({"friction": "yes"}, "friction"),
-    ({"saturation": "stall"}, "saturation"),
-    ({"controller": lambda t, q, v: [1.0, 2.0]}, "controller"),
-    ({"theta0": [20.0, 0.0, 0.0]}, "theta0"),
-    ({"progress": 3}, "progress"),
-])
-def test_simulate_names_the_bad_argument_in_the_field(arguments, name):
-    settings = {"theta0": [0.0, 0.3, 0.4], "duration": 0.01} | arguments
-    with pytest.raises(InvalidInputError) as raised:
-        simulate(settings.pop("theta0"), settings.pop("duration"), **settings)
-    assert raised.value.argument == name and str(raised.value).startswith(f"{name}: ")
-
-
-@pytest.mark.parametrize("arguments, name", [({"rate": 333.0}, "rate"), ({"timestep": 3e-4}, "timestep"),
-                                             ({"timestep": -1.0}, "timestep"), ({"duration": 0.0}, "duration")])
-def test_simulate_mujoco_names_the_bad_argument_in_the_field(arguments, name):
-    """MuJoCo steps 1 ms by default: 333 Hz and 1 kHz at 0.3 ms are no whole number of steps."""
-    settings = {"duration": 0.01} | arguments
-    with pytest.raises(InvalidInputError) as raised:
-        simulate_mujoco([0.0, 0.3, 0.4], settings.pop("duration"), **settings)
-    assert raised.value.argument == name and str(raised.value).startswith(f"{name}: ")
-
-
-@pytest.mark.parametrize("arguments, name", [
-    ({"dtheta0": [1e6, 0.0, 0.0]}, "dtheta0"),                                     # rad/s
-    ({"controller": lambda t, q, v: np.array([1e300, 0.0, 0.0]), "saturation": False}, "controller"),
-])
-def test_a_diverging_run_names_its_cause_in_the_field(arguments, name):
-    with pytest.raises(InvalidInputError) as raised:
-        simulate([0.0, 0.3, 0.4], 0.05, **arguments)
-    assert raised.value.argument == name and "the state diverged" in raised.value.detail
-
-
-@pytest.mark.parametrize("call, name", [
-    (lambda device: Device(3), "phantom"),
-    (lambda device: device.available_torque([0.0, 0.3, 0.4], "yes"), "continuous"),
-    (lambda device: device.tip_force_capacity([0.0, 0.3, 0.4], [0.0, 0.0, 0.0]), "direction"),
-    (lambda device: device.encoder_counts([1e300, 0.0, 0.0]), "theta"),
-])
-def test_the_device_names_the_bad_argument_in_the_field(device, call, name):
-    with pytest.raises(InvalidInputError) as raised:
-        call(device)
-    assert raised.value.argument == name and str(raised.value) == f"{name}: {raised.value.detail}"
-
-
-def test_quantization_without_an_encoder_names_the_option():
-    with pytest.raises(MissingDataError) as raised:
-        simulate([0.2, 0.6, 0.8], 0.01, device=Device.from_model("touch"), quantization=True)
-    assert raised.value.argument == "quantization"
 
 
 def test_the_device_modules_keep_to_their_own_private_names_and_import_at_the_top():

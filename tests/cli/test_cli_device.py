@@ -1,5 +1,6 @@
-"""phantom-pin simulate and the device data of phantom-pin info: outputs against
-phantom_pin.simulate and the published numbers, exit codes, --force, nothing written on failure."""
+"""phantom-pin simulate and the device data of phantom-pin info (cli/device.py): outputs against
+phantom_pin.simulate and the published numbers, exit codes, --force, nothing written on failure,
+the format from the output file's extension."""
 
 import csv
 import json
@@ -270,3 +271,39 @@ def test_a_malformed_record_is_refused(tmp_path, cli):
     code, _, err = cli("--model", "touch", "simulate", "--trajectory", path)
     assert code == 2 and err == (f"phantom-pin: error: --trajectory: {path}: its line '# phantom-pin: touch, report' "
                                  "is not '# phantom-pin: model NAME, convention NAME'\n")
+
+
+@pytest.mark.parametrize("name, kind", [("run.csv", "csv"), ("run.json", "json"), ("RUN.CSV", "csv")])
+def test_simulate_writes_the_format_of_the_extension(tmp_path, cli, name, kind):
+    """Before: `simulate ... -o run.csv` wrote JSON into run.csv."""
+    target = tmp_path / name
+    code, _, _ = cli("simulate", "--theta0", "0.1", "0.3", "0.4", "--duration", "0.01", "-o", str(target))
+    text = target.read_text()
+    assert code == 0
+    if kind == "csv":
+        rows = list(csv.reader(line for line in text.splitlines() if not line.startswith("#")))   # the record
+        assert rows[0][0] == "t [s]" and len(rows) == 12 and float(rows[-1][0]) == pytest.approx(0.01, abs=1e-15)
+    else:
+        assert len(json.loads(text)["t"]) == 11
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["-o", "OUT/run.csv", "--format", "json"], "--format: json into"),
+    (["-o", "OUT/run.json", "--format", "csv"], "--format: csv into"),
+    (["-o", "OUT/run.txt"], "--output: "),
+    (["-o", ""], "--output: empty"),
+])
+def test_simulate_refuses_a_format_that_contradicts_the_extension_before_the_run(tmp_path, cli, argv, message):
+    args = [a.replace("OUT", str(tmp_path)) for a in argv]
+    code, out, err = cli("simulate", "--theta0", "0.1", "0.3", "0.4", "--duration", "1e9", *args)
+    assert code == 2 and out == "" and err.count("\n") == 1 and message in err, err   # 1e9 s: not run
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_simulate_format_without_a_file_and_with_a_matching_extension(tmp_path, cli):
+    code, out, _ = cli("simulate", "--theta0", "0.1", "0.3", "0.4", "--duration", "0.01", "--format", "csv")
+    assert code == 0 and out.startswith("t [s],")
+    target = tmp_path / "run.txt"
+    code, _, _ = cli("simulate", "--theta0", "0.1", "0.3", "0.4", "--duration", "0.01", "--format", "json",
+                     "-o", str(target))
+    assert code == 0 and len(json.loads(target.read_text())["t"]) == 11

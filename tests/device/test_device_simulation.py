@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from helpers import HELD, REPORT
-from phantom_pin import Device, InvalidInputError, Phantom, closed_form, simulate
+from phantom_pin import Device, InvalidInputError, MissingDataError, Phantom, closed_form, simulate
 from phantom_pin.device.simulation import default_device
 
 START = np.array([0.3, 0.8, 0.4])                  # rad, released at rest
@@ -335,3 +335,19 @@ def test_simulate_holds_the_gimbal_where_it_is_asked_and_keeps_the_energy(six):
     assert np.abs(elsewhere - elsewhere[0]).max() > 1e-4 * kinetic
     with pytest.raises(InvalidInputError, match=r"^gimbal: joint6 at 9.0 rad is outside its range"):
         simulate([0.2, 0.3, 0.5], 0.01, device=Device(Phantom.from_model("touch")), gimbal=[0.0, 0.0, 9.0])
+
+
+@pytest.mark.parametrize("arguments, name", [
+    ({"dtheta0": [1e6, 0.0, 0.0]}, "dtheta0"),                                     # rad/s
+    ({"controller": lambda t, q, v: np.array([1e300, 0.0, 0.0]), "saturation": False}, "controller"),
+])
+def test_a_diverging_run_names_its_cause_in_the_field(arguments, name):
+    with pytest.raises(InvalidInputError) as raised:
+        simulate([0.0, 0.3, 0.4], 0.05, **arguments)
+    assert raised.value.argument == name and "the state diverged" in raised.value.detail
+
+
+def test_quantization_without_an_encoder_names_the_option():
+    with pytest.raises(MissingDataError) as raised:
+        simulate([0.2, 0.6, 0.8], 0.01, device=Device.from_model("touch"), quantization=True)
+    assert raised.value.argument == "quantization"

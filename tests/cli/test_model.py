@@ -1,12 +1,12 @@
-"""The phantom-pin command line: outputs against closed_form, exit codes, --force,
-overridden URDFs against the closed form with the same overrides, the viewer in chromium."""
+"""phantom-pin's model commands (cli/model.py: info, check, fk, ik, dynamics, urdf, srdf,
+mjcf, show): outputs against closed_form, exit codes, --force, overridden URDFs against the closed
+form with the same overrides, the viewer in chromium."""
 
 import dataclasses
 import json
 import os
 import shutil
 import signal
-import stat
 import subprocess
 import sys
 import time
@@ -60,18 +60,6 @@ def test_info_lists_the_report_masses(cli):
     masses["lower_bar_link"] += masses.pop("forearm_pin_link")
     assert masses == pytest.approx({"turret_link": 0.35, "upper_arm_link": 0.2359, "crank_link": 0.1906,
                                     "lower_bar_link": 0.0249, "forearm_link": 0.0202}, rel=1e-15)
-
-
-@pytest.mark.parametrize("argv, message", [
-    (["ik", "0", "0.3", "0.3"], "outside the reachable shell"),
-    (["fk", "0", "0"], "required"),
-    (["fk", "0", "nan", "0"], "theta: contains NaN"),
-    (["check", "-n", "0"], "-n"),
-    (["bogus"], "invalid choice"),
-])
-def test_bad_arguments_give_one_line_and_exit_code_2(cli, argv, message):
-    code, _, err = cli(*argv)
-    assert code == 2 and message in err and err.count("\n") == 1
 
 
 def test_coupled_stops_without_a_posture_exit_2_and_write_nothing(tmp_path, cli):
@@ -133,21 +121,6 @@ def test_srdf_override_of_the_rotor_inertia_reaches_the_armature(tmp_path, cli):
                                rtol=1e-12)
     code, _, err = cli("srdf", "-o", str(tmp_path / "bad.srdf"), "--set", "actuation.motor.rotor_inertia=2e-6")
     assert code == 2 and "upper_arm_link" in err and not (tmp_path / "bad.srdf").exists()
-
-
-@pytest.mark.parametrize("argv, message", [
-    (["--set", "foo=1"], "foo: no parameter file has the key 'foo'"),
-    (["--set", "motor.max_speed=1"], "qualify it, e.g. actuation.motor.max_speed"),
-    (["--set", "kinematics.l4=1"], "kinematics.yaml has no key 'l4'"),
-    (["--set", "l1=abc"], "--set: expected KEY=NUMBER"),
-    (["--set", "segment_a=1"], "segment_a: not a number"),
-    (["--set", "l1=-0.1"], "l1 must be positive"),
-    (["--params", "/nonexistent/params.yaml"], "--params"),
-])
-def test_bad_overrides_give_one_line_and_exit_code_2(tmp_path, cli, argv, message):
-    target = tmp_path / "phantom.urdf"
-    code, _, err = cli("urdf", "-o", str(target), *argv)
-    assert code == 2 and message in err and err.count("\n") == 1 and not target.exists()
 
 
 @pytest.mark.chromium
@@ -302,20 +275,6 @@ def test_check_draws_and_evaluates_in_chunks(monkeypatch, cli):
     assert sizes == [7] * 35 + [5] and report["passed"] and report["states"] == 250
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["urdf", "-o", "/nonexistent_dir/x.urdf"], "--output: folder /nonexistent_dir does not exist"),
-    (["urdf", "-o", "{tmp}", "--force"], "is a folder"),
-    (["srdf", "-o", "{tmp}", "--force"], "is a folder"),
-    (["show", "--html", "{tmp}", "--force"], "--html: "),
-    (["dynamics", "--theta", "0", "0", "0", "--dtheta", "1e200", "1e200", "1e200", "--json"], "overflows"),
-    (["check", "-n", "1.5"], "-n: expected a positive whole number"),
-    (["ik", "0", "0.17", "0.17", "--branch", "left"], "invalid choice"),
-])
-def test_more_bad_arguments_give_one_line_and_exit_code_2(tmp_path, cli, argv, message):
-    code, out, err = cli(*(a.format(tmp=tmp_path) for a in argv))
-    assert code == 2 and message in err and err.count("\n") == 1 and out == ""
-
-
 @pytest.mark.parametrize("file, old, new, message", [
     ("joint_limits.yaml", "joint2: {lower: -1.4660765716752369, upper: 2.076941809873252}",
      "joint2: {lower: -100.0, upper: 100.0}",
@@ -329,24 +288,6 @@ def test_bad_configuration_gives_one_line_naming_the_file(tmp_path, cli, file, o
         code, _, err = cli("--config", str(config), *argv)
         assert code == 2 and message in err and file in err and err.count("\n") == 1
     assert not (tmp_path / "x.urdf").exists()
-
-
-def test_binary_params_file_is_named(tmp_path, cli):
-    params = tmp_path / "params.yaml"
-    params.write_bytes(bytes(range(128, 256)))
-    code, _, err = cli("urdf", "-o", str(tmp_path / "x.urdf"), "--params", str(params))
-    assert code == 2 and "params.yaml: not a text file" in err and err.count("\n") == 1
-
-
-def test_negative_numbers_in_scientific_notation_are_values(cli):
-    code, out, _ = cli("fk", "-1e-3", "0", "0", "--json")
-    assert code == 0
-    np.testing.assert_allclose(json.loads(out)["g_st"], cf.forward_kinematics([-1e-3, 0, 0], REPORT), atol=1e-12)
-    code, out, _ = cli("dynamics", "--theta", "-1e-3", "0.1", "0.2", "--dtheta", "-2E+0", "0", "-.5",
-                       "--json")
-    assert code == 0
-    np.testing.assert_allclose(json.loads(out)["tau"], cf.inverse_dynamics([-1e-3, 0.1, 0.2], [-2, 0, -0.5],
-                                                                           [0, 0, 0], REPORT), rtol=1e-9)
 
 
 @pytest.mark.parametrize("argv, warned", [
@@ -364,54 +305,6 @@ def test_out_of_limit_angles_are_computed_with_one_warning_line(cli, argv, warne
         assert err == ""
     else:
         assert err.count("\n") == 1 and err.startswith("phantom-pin: warning: ") and warned in err
-
-
-def _popen(*argv):
-    return subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", *argv],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-
-
-def test_closed_output_pipe_ends_quietly():
-    """phantom-pin info | head -1: the reader goes away; no traceback, exit 141 (128 + SIGPIPE)."""
-    process = _popen("info")
-    process.stdout.close()
-    assert process.wait(60) == 141
-    assert process.stderr.read() == ""
-
-
-def _cpu_seconds(pid: int) -> float:
-    fields = open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
-def _peak_rss_mb(pid: int) -> float:
-    status = open(f"/proc/{pid}/status").read()
-    return int(status.split("VmHWM:")[1].split()[0]) / 1024
-
-
-@pytest.mark.slow
-def test_huge_check_runs_in_bounded_memory_and_ctrl_c_gives_one_line():
-    """check -n 2e7, the most it takes (2 TiB of states at once before, for 1e11): after 3 s of
-    CPU (its start, about 0.6 s, then a dozen of its 10 000-state chunks, about 0.18 s each; its
-    2e7 states' angles alone are 480 MB) its peak memory is below 400 MB; Ctrl-C then ends it
-    with one line and exit 130 (128 + SIGINT). The command starts with SIGINT's default
-    disposition, whatever pytest's own (a pytest started in the background ignores SIGINT, its
-    children inherit that, and Python then leaves SIGINT ignored: check ran on, as any program
-    whose parent ignores SIGINT does)."""
-    process = subprocess.Popen([sys.executable, "-m", "phantom_pin.cli", "check", "-n", "20000000"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    try:
-        deadline = time.monotonic() + 120
-        while _cpu_seconds(process.pid) < 3.0 and process.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert process.poll() is None, process.stderr.read()
-        assert _peak_rss_mb(process.pid) < 400
-        process.send_signal(signal.SIGINT)
-        assert process.wait(60) == 130
-    finally:
-        process.kill()
-    assert process.stderr.read() == "phantom-pin: interrupted\n"
 
 
 def test_mjcf_scene_includes_the_model_from_its_own_folder(tmp_path, cli, monkeypatch):
@@ -439,26 +332,6 @@ def test_check_refuses_more_states_than_a_few_minutes_take(cli):
     code, out, err = cli("check", "-n", "100000000000")
     assert code == 2 and out == "" and err == ("phantom-pin: error: -n: 100000000000 states is more than 2e+07 "
                                                "(about 4 minutes); check fewer\n")
-
-
-def test_every_command_takes_the_overrides(cli, tmp_path):
-    """--set and --params reach every command's model: fk with l1, l2 changed follows eq. 10
-    with them (written here); info reports the changed mass; check passes on the changed model."""
-    params = tmp_path / "p.yaml"
-    params.write_text("l1: 0.2\nsegment_a.mass: 0.03\n")
-    code, out, _ = cli("fk", "0.3", "0.5", "0.7", "--params", str(params), "--set", "l2=0.15", "--json")
-    tip = np.array(json.loads(out)["g_st"])[:3, 3]
-    l1, l2, (t1, t2, t3) = 0.2, 0.15, (0.3, 0.5, 0.7)
-    reach = l1 * np.cos(t2) + l2 * np.sin(t3)
-    np.testing.assert_allclose(tip, [np.sin(t1) * reach, l2 - l2 * np.cos(t3) + l1 * np.sin(t2),
-                                     -l1 + np.cos(t1) * reach], rtol=0, atol=1e-12)
-    code, out, _ = cli("info", "--params", str(params), "--json")
-    masses = {link["name"]: link["mass"] for link in json.loads(out)["links"]}
-    assert code == 0 and masses["forearm_link"] == pytest.approx(0.03, rel=1e-12)
-    code, out, _ = cli("check", "-n", "50", "--set", "l1=0.2")
-    assert code == 0 and "all checks pass" in out
-    code, _, err = cli("dynamics", "--theta", "0", "0", "0", "--set", "foo=1")
-    assert code == 2 and err.count("\n") == 1 and "foo" in err
 
 
 def test_info_says_when_overrides_apply(tmp_path, capsys):
@@ -508,60 +381,6 @@ def test_show_on_the_touch_checks_the_arm_and_the_gimbal_against_their_own_range
     assert "warning: theta" in err and bounds(arm.lower, arm.upper) in err, err
 
 
-@pytest.mark.parametrize("unbuffered", ["1", None])
-def test_simulate_into_a_pipe_closed_part_way_exits_141(unbuffered):
-    """Output into a pipe that its reader closes part way exits 141, without a word, buffered or
-    with PYTHONUNBUFFERED=1 (as Docker images set it: unbuffered, Python writes the 219 kB at once
-    and the reader's exit leaves a short write, not an error); docs/cli.md says 141. Read in full,
-    the output is a whole JSON document of duration x rate + 1 samples."""
-    import os
-    import subprocess
-    import sys
-
-    env = {k: v for k, v in os.environ.items() if k != "PYTHONUNBUFFERED"} | (
-        {"PYTHONUNBUFFERED": unbuffered} if unbuffered else {})
-    argv = [sys.executable, "-m", "phantom_pin.cli", "simulate", "--theta0", "0", "0.3", "0.4", "--duration", "1"]
-    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
-    assert len(process.stdout.read(10)) == 10
-    process.stdout.close()
-    assert process.wait(120) == 141 and process.stderr.read() == b""
-    process.stderr.close()
-    whole = subprocess.run(argv, capture_output=True, env=env, check=True, timeout=120)
-    assert len(whole.stdout) > 2**16 and len(json.loads(whole.stdout)["t"]) == 1001
-
-
-@pytest.mark.parametrize("argv, message", [
-    (["ik", "1e308", "0", "0"], "position: [1.e+308 0.e+000 0.e+000] m is 1e+308 m from the shoulder, outside the "
-                                "reachable shell [0.0450, 0.3850] m"),                       # 4 digits, not 309
-    (["--set", "=0.2", "fk", "0", "0", "0"], "--set: expected KEY=NUMBER, got '=0.2' (no key)"),       # no key
-    (["urdf", "-o", "/dev/full", "-f"], "--output: cannot write /dev/full (No space left on device)"),  # a failed write
-    (["--config", "{tmp}", "info"], "{tmp}: not a configuration folder (it has none of kinematics.yaml, "),  # empty
-    (["excite", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),  # one wording
-    (["urdf", "-o", "{tmp}/old.csv"], "--output: {tmp}/old.csv exists; use --force to overwrite it"),
-])
-def test_an_error_names_the_option_at_fault_in_one_readable_line(tmp_path, cli, argv, message):
-    """An error names the option at fault in one readable line (exit 2, nothing overwritten): ik's
-    distance to the shoulder in four significant digits (not 309 digits at 1e308), --set without
-    a key as such, a write that fails by --output, a folder with none of the parameter files as
-    not a configuration folder, an existing output with "use --force" in every command."""
-    (tmp_path / "old.csv").write_text("kept\n")
-    code, out, err = cli(*[a.replace("{tmp}", str(tmp_path)) for a in argv])
-    assert (code, out) == (2, "") and err.count("\n") == 1
-    assert err.startswith("phantom-pin: error: " + message.replace("{tmp}", str(tmp_path))), err
-    assert (tmp_path / "old.csv").read_text() == "kept\n"
-
-
-@pytest.mark.parametrize("argv, option", [(["identify", "{missing}", "-o", "{tmp}/id.yaml"], "LOG"),
-                                          (["simulate", "--trajectory", "{missing}"], "--trajectory")])
-def test_a_missing_log_or_trajectory_is_named_by_its_option(tmp_path, cli, argv, option):
-    """A log or trajectory that cannot be read is named by its option (LOG, --trajectory) with the
-    system's reason, in one line (not Python's errno text)."""
-    missing = tmp_path / "missing.csv"
-    code, out, err = cli(*[a.replace("{missing}", str(missing)).replace("{tmp}", str(tmp_path)) for a in argv])
-    assert (code, out) == (2, "") and err == f"phantom-pin: error: {option}: {missing}: cannot read (No such file or " \
-                                             "directory)\n"
-
-
 @pytest.mark.parametrize("prefix, valid", [('a"b', False), ("a b", False), ("9lives", False), ("arm/", True),
                                            ("left_", True), ("", True)])
 def test_urdf_refuses_a_prefix_that_is_no_ros_name(tmp_path, cli, prefix, valid):
@@ -574,41 +393,6 @@ def test_urdf_refuses_a_prefix_that_is_no_ros_name(tmp_path, cli, prefix, valid)
     if not valid:
         assert err == ("phantom-pin: error: --prefix: expected a ROS name's start (letters, digits, _ and /, not "
                        f"starting with a digit), got {prefix!r}\n")
-
-
-@pytest.mark.parametrize("output, scene", [("model.xml", "/dev/full"), ("/dev/full", "scene.xml")])
-def test_mjcf_writes_neither_file_when_one_cannot_be_written(tmp_path, cli, output, scene):
-    """mjcf writes both of its files or neither: with either unwritable (a full device), the
-    folder stays empty and one line names the option whose file failed."""
-    paths = [p if p.startswith("/dev") else str(tmp_path / p) for p in (output, scene)]
-    code, out, err = cli("mjcf", "-o", paths[0], "--scene", paths[1], "--force")
-    option = "--scene" if scene.startswith("/dev") else "--output"
-    assert (code, out, err) == (2, "", f"phantom-pin: error: {option}: cannot write /dev/full (No space left on "
-                                       "device)\n")
-    assert list(tmp_path.iterdir()) == []
-
-
-def test_written_files_take_the_umask_and_an_overwritten_file_keeps_its_mode(tmp_path, cli):
-    """The command line's files are staged beside their targets and renamed into place: a new
-    file gets the mode open() would give it (0666 less the umask), an overwritten one keeps its
-    own, a symbolic link is written through (as open() would), and no temporary file is left
-    behind."""
-    mask = os.umask(0o027)
-    try:
-        assert cli("mjcf", "-o", tmp_path / "m.xml", "--scene", tmp_path / "s.xml")[0] == 0
-        os.chmod(tmp_path / "s.xml", 0o600)
-        (tmp_path / "s.xml").write_text("old\n")
-        assert cli("mjcf", "-o", tmp_path / "m.xml", "--scene", tmp_path / "s.xml", "--force")[0] == 0
-    finally:
-        os.umask(mask)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.xml", "s.xml"]
-    assert stat.S_IMODE((tmp_path / "m.xml").stat().st_mode) == 0o640
-    assert stat.S_IMODE((tmp_path / "s.xml").stat().st_mode) == 0o600
-    assert "m.xml" in (tmp_path / "s.xml").read_text()
-    (tmp_path / "link.xml").symlink_to(tmp_path / "m.xml")  # written through, as open() would
-    (tmp_path / "m.xml").write_text("old\n")
-    assert cli("mjcf", "-o", tmp_path / "link.xml", "--force")[0] == 0
-    assert (tmp_path / "link.xml").is_symlink() and "<mujoco" in (tmp_path / "m.xml").read_text()
 
 
 def test_fk_and_dynamics_take_gimbal_angles(cli, six):

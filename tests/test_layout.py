@@ -1,0 +1,111 @@
+"""The tests' shape: tests/ mirrors the package, one test file per module with logic
+(phantom_pin/<a>/<b>.py: tests/<a>/test_<b>.py; the root's phantom_pin/_x.py: tests/test_x.py),
+no test file imports another (what they share is in helpers.py, conftest.py's fixtures and the
+references package), and no two test files share a name (pytest's default import mode puts each
+test file's own folder on sys.path: two test_x.py would be one module).
+
+A module name two modules of the package share takes its folder's name too, the mirror named
+after the module's package: cli/feel.py's tests/cli/test_cli_feel.py, device/feel.py's
+tests/device/test_device_feel.py (device/device.py's stays tests/device/test_device.py).
+
+Read from the files (pathlib and ast), as tests/test_imports.py reads the package."""
+
+import ast
+from collections import Counter
+from pathlib import Path
+
+import phantom_pin
+
+PACKAGE = Path(phantom_pin.__file__).resolve().parent
+TESTS = Path(__file__).resolve().parent
+
+#: The modules with no mirrored test file, each with its reason (module paths under phantom_pin/;
+#: a package's __init__.py and __main__.py need none: they hand names on, tests/test_api.py and
+#: the command line's tests run them).
+EXEMPT = {
+    "_paths.py": "constants alone (where the description folder and the driver profiles are)",
+    "cli/identification.py": "moved by the identification stage work (tests/cli/test_identification_commands.py)",
+    "_blas.py": "moved by the identification stage work (tests/identification/test_kernels.py tests it)",
+    # No test of its own yet (issue 51, item 5): each is exercised through the tests named.
+    "_integration.py": "no test of its own: device/test_device_plant.py checks the plant's RK4 step",
+    "_validation.py": "no test of its own: every public function's bad-input tests (dynamics/test_fast.py)",
+    "codegen/c.py": "no test of its own: codegen/test_generate.py compiles and runs its C text",
+    "codegen/tree.py": "no test of its own: codegen/test_generate.py, the header of every model",
+    "description/mimic.py": "no test of its own: dynamics/test_coupling.py reads the mimic tags",
+    "description/mjcf.py": "no test of its own: describe()'s MJCF in MuJoCo (config/test_reader.py, "
+                           "config/test_friction_per_joint.py, device/test_mujoco_plant.py)",
+    "description/urdf.py": "no test of its own: the URDF's readers (description/test_gimbal.py and others)",
+    "device/controllers.py": "no test of its own: cli/test_cli_device.py's tracking simulate",
+    "dynamics/build.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py, test_loader.py)",
+    "dynamics/pinocchio_models.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py)",
+    "interfaces/openhaptics/plant.py": "no test of its own: the stand-in runs it (openhaptics/test_stand_in.py)",
+    "interfaces/openhaptics/protocol.py": "no test of its own: the stand-in's records (openhaptics/test_stand_in.py)",
+    "report/appendix.py": "the appendix's printed torques, the reference report/test_closed_form.py checks against",
+    "report/parameters.py": "no test of its own: the report's numbers (config/test_builders.py)",
+}
+#: The subpackages another change restructures.
+EXEMPT_PACKAGES = {
+    "identification": "moved by the identification stage work",
+}
+#: The test folders whose files may still import one another, for the same reason.
+EXEMPT_IMPORTS = {
+    "identification": "moved by the identification stage work",
+}
+
+
+def _modules() -> list[Path]:
+    """Every module of the package but the __init__ and __main__ files, relative to it."""
+    return [path.relative_to(PACKAGE) for path in sorted(PACKAGE.rglob("*.py"))
+            if path.name not in ("__init__.py", "__main__.py")]
+
+
+def mirror(module: Path) -> Path:
+    """The test file of a module (relative to tests/): test_<name>.py in the module's folder, its
+    package's name in front where another module shares the name (the leading underscore of a
+    private module left off)."""
+    shared = Counter(path.stem for path in _modules())
+    stem = module.stem.lstrip("_")
+    parent = module.parent.name
+    if shared[module.stem] > 1 and parent and parent != stem:
+        stem = f"{parent}_{stem}"
+    return module.parent / f"test_{stem}.py"
+
+
+def _test_files() -> list[Path]:
+    return sorted(path for path in TESTS.rglob("test_*.py"))
+
+
+def test_every_module_has_its_mirrored_test_file():
+    exempt = {module for module in _modules() if module.as_posix() in EXEMPT or module.parts[0] in EXEMPT_PACKAGES}
+    missing = [f"phantom_pin/{module.as_posix()}: tests/{mirror(module).as_posix()}"
+               for module in _modules() if module not in exempt and not (TESTS / mirror(module)).is_file()]
+    assert not missing, missing
+    stale = [name for name in EXEMPT if not (PACKAGE / name).is_file() or (TESTS / mirror(Path(name))).is_file()]
+    assert not stale, f"exempt but gone or mirrored: {stale}"
+
+
+def _imported(path: Path) -> set[str]:
+    """The top-level names of the modules a file imports, anywhere in it."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names |= {alias.name.partition(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names.add(node.module.partition(".")[0])
+    return names
+
+
+def test_no_test_file_imports_another():
+    """A test file imports helpers, conftest or references, never a test_*.py (nor a conftest
+    module by name: its fixtures come by pytest)."""
+    tests = {path.stem for path in _test_files()}
+    wrong = {path.relative_to(TESTS).as_posix(): sorted(_imported(path) & (tests | {"conftest"}))
+             for path in sorted(TESTS.rglob("*.py"))
+             if path.relative_to(TESTS).parts[0] not in EXEMPT_IMPORTS}
+    wrong = {path: names for path, names in wrong.items() if names}
+    assert not wrong, wrong
+
+
+def test_every_test_file_name_is_unique():
+    counts = Counter(path.name for path in _test_files())
+    assert not [name for name, n in counts.items() if n > 1], counts.most_common(3)
