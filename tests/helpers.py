@@ -148,8 +148,8 @@ def excitation_file(path, model="touch"):
     rows to the last bits of the evaluation's products, on any machine and for any future
     optimiser, so that a test of a method's property keeps its case (issue 50, 2)."""
     from phantom_pin.cli.common import csv_text
-    from phantom_pin.identification.excitation import Fourier
-    from phantom_pin.identification.io import TRAJECTORY_COLUMNS
+    from phantom_pin.identification.data.io import TRAJECTORY_COLUMNS
+    from phantom_pin.identification.fitting.excitation import Fourier
 
     series = json.loads(EXCITATIONS.read_text())[model]
     trajectory = Fourier(*(np.array(series[key]) for key in ("q0", "a", "b")), series["period"])

@@ -34,7 +34,7 @@ from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import io
+from phantom_pin.identification.data import io
 
 #: simulate()'s arguments that are options of the command (its errors name them).
 OPTIONS = {name: "--" + name for name in ("theta0", "dtheta0", "duration", "rate", "quantization", "gimbal")} | {

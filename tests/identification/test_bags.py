@@ -16,7 +16,7 @@ from phantom_pin import Phantom, config, describe, drivers
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import LogError, MissingDataError
-from phantom_pin.identification import bags, io
+from phantom_pin.identification.data import bags, io
 
 TYPES = get_typestore(Stores.ROS2_HUMBLE)
 JointState, Header, Time = (TYPES.types[name] for name in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header",

@@ -8,11 +8,11 @@ import pytest
 
 from helpers import CONFIG, REPORT
 from phantom_pin import Phantom, describe
-from phantom_pin.identification import base, constants
-from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.base import base_parameters
-from phantom_pin.identification.regressor import Regressor
-from phantom_pin.identification.structures import Report, Structured
+from phantom_pin.identification.structure import base, constants
+from phantom_pin.identification.structure import parameterization as pz
+from phantom_pin.identification.structure.base import base_parameters
+from phantom_pin.identification.structure.regressor import Regressor
+from phantom_pin.identification.structure.structures import Report, Structured
 from phantom_pin.report import closed_form
 from test_regressor import states as _states
 
@@ -118,7 +118,7 @@ def test_the_device_has_the_trees_base_parameters_but_the_hinge_pins():
     """The general structure's base (x: the five bodies, the rotor inertia, friction; the pins
     fixed) has 24 parameters: the tree's 26 less the pins' own first moments along their bars,
     which the tree identifies separately and the device fixes (config: hinge_pin)."""
-    from phantom_pin.identification.structures import General
+    from phantom_pin.identification.structure.structures import General
 
     general = General(REGRESSOR.phantom)
     tree = base_parameters(REGRESSOR.stacked(*states(300, 5)), REGRESSOR.names)

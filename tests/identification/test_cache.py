@@ -7,7 +7,7 @@ import gc
 import numpy as np
 
 from phantom_pin import describe
-from phantom_pin.identification import cache, constants
+from phantom_pin.identification.structure import cache, constants
 
 
 def test_the_description_is_immutable_and_carries_no_cache():

@@ -18,8 +18,9 @@ from phantom_pin.config.sampling import sample_postures
 from phantom_pin.description.physical import check_urdf
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.dynamics.loader import PhantomLoader, load_files
-from phantom_pin.identification import constants, io, simulation
-from phantom_pin.identification import parameterization as pz
+from phantom_pin.identification.data import io, simulation
+from phantom_pin.identification.structure import constants
+from phantom_pin.identification.structure import parameterization as pz
 
 
 def sample(n, seed):

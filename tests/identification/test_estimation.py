@@ -12,7 +12,9 @@ import pytest
 from helpers import CONFIG, REPORT, T10, model_torques, sines
 from phantom_pin import Device, Phantom, closed_form
 from phantom_pin.cli import main
-from phantom_pin.identification import constants, estimation, io
+from phantom_pin.identification.data import io
+from phantom_pin.identification.fitting import estimation
+from phantom_pin.identification.structure import constants
 
 PHANTOM = Phantom()
 RATE = 1000.0
@@ -56,8 +58,8 @@ def test_the_exact_log_gives_the_true_general_base_parameters():
     condition number above 1e3) against those of the report's numbers (structures.General.matrix
     at the shipped model's bodies), each within 2e-4 of its typical size (the base parameters mix
     kg, kg m and kg m^2)."""
-    from phantom_pin.identification import excitation
-    from phantom_pin.identification.structures import General
+    from phantom_pin.identification.fitting import excitation
+    from phantom_pin.identification.structure.structures import General
 
     model = General(PHANTOM)
     t = np.arange(10001) / RATE
@@ -84,7 +86,7 @@ def test_a_log_the_condition_gate_refused_is_identified(tmp_path, capsys):
     within 2e-4 of their typical size (as excite's exact log, above), no problem, and identify
     prints the condition number as a diagnostic beside the predicted torque uncertainty, and
     writes the overlay."""
-    from phantom_pin.identification.structures import General
+    from phantom_pin.identification.structure.structures import General
 
     assert report(log()).condition < 20
     fit = estimation.estimate(log(), PHANTOM, timing="sampled")
@@ -169,7 +171,7 @@ def test_identify_writes_nothing_when_the_overlay_is_not_physical(tmp_path, caps
     """The overlay is checked (describe() and its physical check of every link) before it is
     written: here that check refuses it, and no file appears."""
     from phantom_pin.exceptions import ParameterFileError
-    from phantom_pin.identification import overlays
+    from phantom_pin.identification.verdict import overlays
 
     def refuse(*args, **kwargs):
         raise ParameterFileError("link forearm_link: mass must be positive (kg), got -1.0")
@@ -280,7 +282,7 @@ def test_the_excitation_and_the_log_check_their_arguments(call, argument):
 
 
 def excitation_optimise(**kwargs):
-    from phantom_pin.identification import excitation
+    from phantom_pin.identification.fitting import excitation
     return excitation.optimise(PHANTOM, **kwargs)
 
 
@@ -292,7 +294,8 @@ def test_a_log_with_torques_beyond_1000_n_m_is_refused_at_once(monkeypatch):
     model's torques with 2000 N m on joint 2's, refused before any fit (the filter, the first
     costly stage, is never reached)."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import estimation, io
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.fitting import estimation
 
     def unreachable(*args, **kwargs):
         raise AssertionError("filtered before the refusal")
@@ -311,7 +314,8 @@ def test_a_joint_moving_in_fewer_than_50_samples_is_too_little_motion():
     0.5 Hz (peak 10.7 mrad/s): at --min-speed 10.5 mrad/s the filtered log has between 5 and 50
     of its samples moving (counted by filtering.filtered), which is too little motion."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import estimation, filtering, io
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.fitting import estimation, filtering
 
     phantom = Phantom()
     theta, dtheta, ddtheta = sines(T10)
@@ -333,7 +337,8 @@ def test_a_gain_is_corrected_only_beyond_1_percent_and_refused_beyond_2(gain, co
     times too small: 0.5 % off (thousands of sigma on a noiseless log, but within 1 %) is
     estimated and kept at 1; 2.5 is refused."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import estimation, io
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.fitting import estimation
 
     phantom = Phantom()
     theta, dtheta, ddtheta = sines(T10)
@@ -356,7 +361,8 @@ def test_friction_estimated_3_to_30_sigma_below_zero_is_refused():
     gives its standard deviation s; -10 s as the truth is estimated about 10 s below zero and
     refused as negative."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import estimation, io
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.fitting import estimation
 
     phantom = Phantom()
     theta, dtheta, ddtheta = sines(T10)

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from phantom_pin.identification import filtering, io
+from phantom_pin.identification.data import io
+from phantom_pin.identification.fitting import filtering
 
 RATE, DURATION = 1000.0, 60.0
 

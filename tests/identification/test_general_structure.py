@@ -15,7 +15,8 @@ from helpers import CONFIG, excitation_file, run_cli
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.identification import estimation, io, simulation
+from phantom_pin.identification.data import io, simulation
+from phantom_pin.identification.fitting import estimation
 from phantom_pin.inertial import INERTIA_KEYS, Inertial, problem, uncarve
 
 #: Per body: factor on mass and inertia, centre of mass offset (m), products xy, xz, yz (kg m^2).

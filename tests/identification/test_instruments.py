@@ -18,7 +18,9 @@ from phantom_pin import Device, Phantom, describe, drivers
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, LogError, PhantomPinError
-from phantom_pin.identification import estimate, overlay, result, simulation
+from phantom_pin.identification import estimate, overlay
+from phantom_pin.identification.data import simulation
+from phantom_pin.identification.verdict import result
 from test_prior import sum_of_sines
 
 TRUTH = describe("premium_1_5_cad")
@@ -119,7 +121,7 @@ def test_identify_reference_on_the_command_line(tmp_path, capsys):
     its reference in OpenHaptics' convention give the same model; a reference the log does not
     follow or no trajectory file refused in one line naming --reference, exit 2, nothing written."""
     from phantom_pin.cli import main
-    from phantom_pin.identification import io
+    from phantom_pin.identification.data import io
 
     whole, _ = closed_loop()
     n = int(round(CLI_DURATION * 1000)) + 1        # the plumbing, not the accuracy: the first 20 s

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from phantom_pin.exceptions import LogError
-from phantom_pin.identification import io
+from phantom_pin.identification.data import io
 
 HEADER = "t,theta1,theta2,theta3,tau1,tau2,tau3"
 

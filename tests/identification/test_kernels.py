@@ -37,9 +37,9 @@ def kernel_sensitive() -> dict:
 
     from phantom_pin import Phantom, describe
     from phantom_pin.identification import optimise
-    from phantom_pin.identification.io import Log
-    from phantom_pin.identification.selection import choose_min_speed
-    from phantom_pin.identification.structures import General
+    from phantom_pin.identification.data.io import Log
+    from phantom_pin.identification.fitting.selection import choose_min_speed
+    from phantom_pin.identification.structure.structures import General
     from phantom_pin.inertial import Inertial
 
     device = Phantom(describe("touch", overrides={"actuation.friction.coulomb.joint3": 0.02}))

@@ -1,4 +1,4 @@
-"""identify --report: one self-contained HTML page of the fit (phantom_pin.identification.page),
+"""identify --report: one self-contained HTML page of the fit (phantom_pin.identification.verdict.page),
 written with the overlay or not at all, opened in headless chromium (helpers.browse): it renders,
 its plots are not empty, no console message, no request from the page. Its curves carry the
 numbers: the measured torques are the log's own (filtered: within a share of their RMS), the
@@ -13,7 +13,8 @@ import pytest
 from helpers import AFFINE_TOLERANCE, affine, check_page, svg_points
 from phantom_pin import Phantom
 from phantom_pin.config import read_overrides
-from phantom_pin.identification import identify, io
+from phantom_pin.identification import identify
+from phantom_pin.identification.data import io
 
 #: The filtered torques against the log's at the same rows, where the joint's equation is fitted:
 #: the 20 Hz filter and the held timing's half sample (measured: 0.75-1.3 % of the torque RMS on

@@ -4,7 +4,7 @@ Monte Carlo of the parameters, and the poorly excited directions of a known info
 import numpy as np
 import pytest
 
-from phantom_pin.identification import prediction
+from phantom_pin.identification.fitting import prediction
 
 
 def test_the_torque_uncertainty_is_the_spread_of_sampled_parameters():
@@ -41,7 +41,7 @@ def test_a_poorly_excited_direction_spread_over_many_parameters_is_named_by_its_
     """A poorly excited direction is named by its three largest components, also when none has
     more than 0.2 of its square (spread over many parameters). Unit vector by hand: the three
     largest."""
-    from phantom_pin.identification import prediction
+    from phantom_pin.identification.fitting import prediction
 
     vector = np.array([3.0, -3.0, 2.9, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0, 2.0])
     vector /= np.linalg.norm(vector)                 # largest square 9 / 58.41 = 0.154
@@ -54,7 +54,7 @@ def test_a_poorly_excited_direction_spread_over_many_parameters_is_named_by_its_
 def test_a_model_worse_than_the_prior_by_more_than_10_percent_is_refused(ratio, refused):
     """A fit worse than the prior by more than 10 % on a joint's log is refused, 8 % is not (the
     module's 1.1, "markedly worse")."""
-    from phantom_pin.identification import prediction
+    from phantom_pin.identification.fitting import prediction
 
     shares = dict(log=np.zeros(3), states=np.zeros(3), prior_states=np.zeros(3), directions=(), spread=0.3)
     prior_log = np.array([0.01, 0.02, 0.03])

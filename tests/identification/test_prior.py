@@ -17,8 +17,9 @@ import pytest
 from helpers import CONFIG
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import random_states
-from phantom_pin.identification import estimation, excitation, io, least_squares, prediction, simulation
-from phantom_pin.identification.structures import General
+from phantom_pin.identification.data import io, simulation
+from phantom_pin.identification.fitting import estimation, excitation, least_squares, prediction
+from phantom_pin.identification.structure.structures import General
 from test_end_to_end import COULOMB, VISCOUS, truth_overrides
 
 RATE = 1000.0
@@ -296,7 +297,9 @@ def test_a_prior_spread_beyond_where_it_counts_is_refused_naming_the_option(tmp_
     against the fit of the log alone (no prior at all): at MAX_SPREAD the prior no longer moves
     the estimate (relative difference below 1e-9 on a noiseless 10 s log of the model's own
     torques), and no warning is raised."""
-    from phantom_pin.identification import estimation, io, prior
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.fitting import estimation
+    from phantom_pin.identification.structure import prior
 
     t, theta, dtheta, ddtheta = sum_of_sines(10, 0.2, 1)
     tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + CONFIG.actuation.friction.torque(dtheta)
@@ -322,7 +325,7 @@ def test_a_tight_wrong_prior_does_not_make_a_good_log_look_unrelated_to_its_moti
     (checks.MAX_RESIDUAL_SHARE) of the torque RMS on every joint; a prior 10-30 % off the device
     held tight (spread 1e-6) pulls the written fit to leave more than that, which says nothing of
     the log. No "do not follow the motion" among the problems."""
-    from phantom_pin.identification import checks
+    from phantom_pin.identification.fitting import checks
 
     fit = estimation.estimate(lab[3]["narrow"], PRIOR, prior_spread=1e-6)
     assert (fit.log_rms / fit.torque_rms).max() < checks.MAX_RESIDUAL_SHARE

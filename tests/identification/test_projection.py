@@ -8,10 +8,10 @@ from helpers import CONFIG, URDF_PATH
 from phantom_pin import ParameterFileError, Phantom, describe
 from phantom_pin.config.types import BODIES as BODIES_FULL
 from phantom_pin.description.physical import check_urdf
-from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification import physical
-from phantom_pin.identification.regressor import Regressor
-from phantom_pin.identification.structures import General, Report
+from phantom_pin.identification.structure import parameterization as pz
+from phantom_pin.identification.structure import physical
+from phantom_pin.identification.structure.regressor import Regressor
+from phantom_pin.identification.structure.structures import General, Report
 from phantom_pin.inertial import Inertial, problem
 
 DESCRIPTION = describe()

@@ -9,8 +9,8 @@ from helpers import CONFIG
 from phantom_pin import Phantom, closed_form, describe
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.dynamics.coupling import Coupling
-from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.regressor import Regressor
+from phantom_pin.identification.structure import parameterization as pz
+from phantom_pin.identification.structure.regressor import Regressor
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,9 @@ import pytest
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification import io, static
-from phantom_pin.identification.structures import General
+from phantom_pin.identification.data import io
+from phantom_pin.identification.fitting import static
+from phantom_pin.identification.structure.structures import General
 
 PRIOR = Phantom()                                  # the report's model: what identify starts from
 TRUTH = Phantom.from_model("premium_1_5_cad")                 # the device: another arm

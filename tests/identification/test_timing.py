@@ -18,7 +18,9 @@ from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main
 from phantom_pin.config.sampling import random_states
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import estimation, filtering, io, result, simulation, timing
+from phantom_pin.identification.data import io, simulation, timing
+from phantom_pin.identification.fitting import estimation, filtering
+from phantom_pin.identification.verdict import result
 from test_end_to_end import COULOMB, VISCOUS, truth_overrides
 from test_prior import PRIOR, error, sum_of_sines, truth_log
 
@@ -237,7 +239,8 @@ def test_a_delay_between_the_grid_points_is_estimated_to_a_tenth_of_the_grid_ste
     grid step past 1 ms: estimated within 25 us (12 us measured; with the sub-sample step
     doubled, 124 us)."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import estimation, io
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.fitting import estimation
 
     phantom = Phantom()
     delay = 1.1e-3

@@ -8,7 +8,7 @@ import pytest
 from phantom_pin import Device, Phantom, describe, simulate
 from phantom_pin.device.controllers import tracking
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import simulation
+from phantom_pin.identification.data import simulation
 
 DEVICE = Device(Phantom(describe()))
 RATE = 1000.0

@@ -22,7 +22,7 @@ import numpy as np
 
 from phantom_pin.config import Config
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification import parameterization
+from phantom_pin.identification.structure import parameterization
 from phantom_pin.inertial import TRIANGLE_SLACK, problem
 from phantom_pin.report.parameters import links
 

@@ -5,7 +5,7 @@ pivoting, W P = Q [R1 R2], gives the numerical rank r (|R_kk| > tol |R_11|) and 
 parameters beta = pi_1 + R1^-1 R2 pi_2 (pi_1 the r pivot columns' parameters), with
 W pi = W_1 beta for every pi. ``BaseParameters.matrix`` is the map K: beta = K pi.
 
-Two models are used (run ``python -m phantom_pin.identification.structures`` to print both):
+Two models are used (run ``python -m phantom_pin.identification.structure.structures`` to print both):
 the general rigid-body model (structures.General: every standard parameter of the five bodies,
 the rotor inertia and the friction, through ``Regressor``'s tree bodies), and the report's
 structure (structures.Structured: the report parameters of ``parameterization``, where centres of mass
@@ -22,7 +22,7 @@ import numpy as np
 
 from phantom_pin import _blas
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.identification.regressor import Regressor
+from phantom_pin.identification.structure.regressor import Regressor
 
 #: Relative size of |R_kk| below which a column counts as dependent.
 RANK_TOLERANCE = 1e-9

@@ -17,10 +17,10 @@ import numpy as np
 
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import LogError
-from phantom_pin.identification.filtering import EDGE
-from phantom_pin.identification.fit import Fit
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.structures import Structure
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.fitting.filtering import EDGE
+from phantom_pin.identification.fitting.fit import Fit
+from phantom_pin.identification.structure.structures import Structure
 
 #: Angles further than this beyond the stops (rad) are no posture of the arm: refused before
 #: the fit, as simulate refuses such a start.

@@ -22,7 +22,7 @@ from phantom_pin.device.controllers import tracking
 from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import Encoders, simulate
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification.io import Log
+from phantom_pin.identification.data.io import Log
 
 
 def _per_joint(value: object, name: str, unit: str, least: float, strict: bool) -> np.ndarray:

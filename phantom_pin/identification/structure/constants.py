@@ -16,8 +16,8 @@ import dataclasses
 import numpy as np
 
 from phantom_pin.description.build import Description
-from phantom_pin.identification import parameterization
-from phantom_pin.identification.cache import cached
+from phantom_pin.identification.structure import parameterization
+from phantom_pin.identification.structure.cache import cached
 from phantom_pin.report import closed_form
 from phantom_pin.report.parameters import ReportParameters
 

@@ -17,9 +17,9 @@ import html
 import numpy as np
 
 from phantom_pin import plots
-from phantom_pin.identification.fit import Curves
-from phantom_pin.identification.prediction import STATES
-from phantom_pin.identification.result import Identification, gain_lines, timing_lines
+from phantom_pin.identification.fitting.fit import Curves
+from phantom_pin.identification.fitting.prediction import STATES
+from phantom_pin.identification.verdict.result import Identification, gain_lines, timing_lines
 
 #: Colour of the predicted torques and of the friction law (the measured ones take the joint's).
 PREDICTED = "#222222"

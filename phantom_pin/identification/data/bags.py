@@ -24,7 +24,7 @@ import numpy as np
 from phantom_pin import drivers, profiles
 from phantom_pin._validation import uneven
 from phantom_pin.exceptions import LogError, MissingDataError
-from phantom_pin.identification.io import MIN_DURATION, RATE_TOLERANCE, Log
+from phantom_pin.identification.data.io import MIN_DURATION, RATE_TOLERANCE, Log
 
 __all__ = ["Recording", "read_bag", "is_bag"]
 
@@ -63,6 +63,20 @@ class Recording:
                  f"{100 * RATE_TOLERANCE:g} %)" if self.resampled else ""]
         return [f"{self.topic} ({self.driver}): {self.messages} messages over {self.log.t[-1] - self.log.t[0]:.3f} s "
                 f"at {self.log.rate:.6g} Hz (header stamps)" + "".join(f"; {n}" for n in notes if n)]
+
+    def stylus(self) -> np.ndarray:
+        """The gimbal angles (rad, (3,)) the stylus was held at: their median over the recording,
+        where the stylus is held still (STYLUS_SPREAD) for description.build.held to put the
+        model's stylus there; LogError where it swings further (its load then moves with it,
+        which a locked stylus does not model)."""
+        middle = np.median(self.gimbal, axis=0)
+        spread = np.abs(self.gimbal - middle).max(axis=0)
+        if (spread > STYLUS_SPREAD).any():
+            j = int(np.argmax(spread))
+            raise LogError(f"the stylus's gimbal angle {j + 1} swings {spread[j]:.3g} rad about its median in the "
+                           f"bag (at most {STYLUS_SPREAD:g} rad): identify with the stylus held still (taped or "
+                           "docked), its load is modelled locked", argument="path")
+        return middle
 
 
 def is_bag(path: Path | str) -> bool:

@@ -45,7 +45,7 @@ import numpy as np
 
 from phantom_pin.config.sampling import random_states
 from phantom_pin.config.types import Limits
-from phantom_pin.identification.least_squares import rms
+from phantom_pin.identification.fitting.least_squares import rms
 
 #: The seeded states inside the stops the prediction is judged over (number, seed).
 STATES, SEED = 200, 0

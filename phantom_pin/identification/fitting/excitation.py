@@ -17,8 +17,8 @@ from phantom_pin import _blas
 from phantom_pin.description.build import Description
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification.least_squares import condition_number as condition_number  # (lived here)
-from phantom_pin.identification.structures import General, Report, friction_block
+from phantom_pin.identification.fitting.least_squares import condition_number as condition_number  # (lived here)
+from phantom_pin.identification.structure.structures import General, Report, friction_block
 
 #: The rate (rad/s) below which the optimiser's Coulomb column is smoothed (its sign's jump
 #: would stall SLSQP's finite differences); the result is checked with the law itself.
@@ -95,7 +95,7 @@ def _check_arguments(**values: float) -> None:
 
 def optimise(phantom: Phantom, period: float = 5.0, harmonics: int = 5,
              samples: int = 150, margin: float = 0.05, torque_share: float = 0.8,
-             restarts: int = 3, iterations: int = 150, seed: int = 0, times: np.ndarray | None = None,
+             restarts: int = 2, iterations: int = 60, seed: int = 0, times: np.ndarray | None = None,
              progress: Callable[[float], None] | None = None,
              amplitude_weight: float = 3.0) -> Excitation:
     """Minimise log(condition number) - amplitude_weight x mean log(singular value) of the

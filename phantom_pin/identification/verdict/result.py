@@ -13,17 +13,16 @@ from pathlib import Path
 import numpy as np
 
 from phantom_pin.dynamics.model import Phantom
-from phantom_pin.identification import prior as priors
-from phantom_pin.identification.checks import GAIN_BOUNDS, RefusedError, refusal
-from phantom_pin.identification.estimation import GAIN_EVIDENCE, GAIN_NOTED, NEEDS_GENERAL, Fit, estimate
-from phantom_pin.identification.filtering import NOISE_SHARE
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.overlays import overlay
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.data.timing import LEAD, TIMING_MARGIN
+from phantom_pin.identification.fitting.checks import GAIN_BOUNDS, RefusedError, refusal
+from phantom_pin.identification.fitting.estimation import GAIN_EVIDENCE, GAIN_NOTED, NEEDS_GENERAL, Fit, estimate
+from phantom_pin.identification.fitting.filtering import CUTOFF, NOISE_SHARE
+from phantom_pin.identification.fitting.selection import FOLDS, TIE
+from phantom_pin.identification.structure import prior as priors
+from phantom_pin.identification.verdict.overlays import overlay, write_yaml, yaml_text
 
 __all__ = ["Identification", "RefusedError", "identify", "refusal"]
-from phantom_pin._validation import output_path
-from phantom_pin.identification.selection import FOLDS, TIE
-from phantom_pin.identification.timing import LEAD, TIMING_MARGIN
 
 
 @dataclasses.dataclass(frozen=True)
@@ -79,7 +78,7 @@ class Identification:
     def write(self, path: Path | str, force: bool = False) -> None:
         """Write the overlay (text()) to ``path`` (YAML); an existing file only with ``force``
         (InvalidInputError naming ``path`` otherwise)."""
-        write_yaml(path, [], {}, force=force, text=self.text())
+        write_yaml(path, self.text(), force=force)
 
     def text(self) -> str:
         """The overlay: dotted --params keys (SI units) with the fit in comments, as YAML text."""
@@ -106,22 +105,8 @@ class Identification:
         return yaml_text([line[2:] for line in lines], self.keys)
 
 
-def yaml_text(comments: list[str], keys: dict[str, object]) -> str:
-    """An overlay's text: the ``comments`` (one ``# `` line each), then the ``keys`` as YAML."""
-    lines = [f"# {line}" for line in comments] + [f"{key}: {value!r}" for key, value in keys.items()]
-    return "\n".join(lines) + "\n"
-
-
-def write_yaml(path: Path | str, comments: list[str], keys: dict[str, object], force: bool = False,
-               text: str | None = None) -> None:
-    """An overlay file at ``path``: yaml_text(``comments``, ``keys``), or ``text`` if given; an
-    existing file only with ``force`` (InvalidInputError naming ``path`` otherwise)."""
-    path = output_path(path, force, "path")
-    path.write_text(yaml_text(comments, keys) if text is None else text, encoding="utf-8")
-
-
-def identify(log: Log, phantom: Phantom, *, cutoff: float = 20.0, structure: str = "general",
-             timing: str | None = None, prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
+def identify(log: Log, phantom: Phantom, *, cutoff: float = CUTOFF, structure: str = "general",
+             timing: str | None = None, prior_spread: float = priors.SPREAD, delay: float | None = None,
              gains: bool = True, min_speed: float | None = None, accept: bool = False,
              given: dict[str, object] | None = None, source: str = "a log",
              progress: Callable[[float], None] | None = None,

@@ -7,7 +7,7 @@ import dataclasses
 
 import numpy as np
 
-from phantom_pin.identification.prediction import Prediction
+from phantom_pin.identification.fitting.prediction import Prediction
 
 
 @dataclasses.dataclass(frozen=True)

@@ -29,13 +29,18 @@ import numpy as np
 
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
-from phantom_pin.identification import checks
-from phantom_pin.identification import prior as priors
-from phantom_pin.identification.filtering import MIN_CYCLES, MIN_SPEED, Samples, filtered, quiet_cutoff
-from phantom_pin.identification.fit import Curves, Fit
-from phantom_pin.identification.instruments import Instruments, instrumented_delay, instruments, reference_angles
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.least_squares import (
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.data.timing import HOLD, TIMINGS, criterion, delay_argument, estimate_delay
+from phantom_pin.identification.fitting import checks
+from phantom_pin.identification.fitting.filtering import CUTOFF, MIN_CYCLES, MIN_SPEED, Samples, filtered, quiet_cutoff
+from phantom_pin.identification.fitting.fit import Curves, Fit
+from phantom_pin.identification.fitting.instruments import (
+    Instruments,
+    instrumented_delay,
+    instruments,
+    reference_angles,
+)
+from phantom_pin.identification.fitting.least_squares import (
     condition_number,
     inverse_information,
     marginal,
@@ -43,11 +48,11 @@ from phantom_pin.identification.least_squares import (
     rms,
     solve_gains,
 )
-from phantom_pin.identification.least_squares import fit as least_squares
-from phantom_pin.identification.prediction import judge
-from phantom_pin.identification.selection import FOLDS, choose_min_speed, choose_timing, validate_gains
-from phantom_pin.identification.structures import STRUCTURES, Structure
-from phantom_pin.identification.timing import HOLD, TIMINGS, criterion, delay_argument, estimate_delay
+from phantom_pin.identification.fitting.least_squares import fit as least_squares
+from phantom_pin.identification.fitting.prediction import judge
+from phantom_pin.identification.fitting.selection import FOLDS, choose_min_speed, choose_timing, validate_gains
+from phantom_pin.identification.structure import prior as priors
+from phantom_pin.identification.structure.structures import STRUCTURES, Structure
 
 #: A gain is corrected (and the driver told) where the log shows it differs from 1: by more than
 #: GAIN_NOTED and GAIN_EVIDENCE standard deviations; else it stays 1 and the estimate is only
@@ -123,7 +128,7 @@ class _Timed:
     gain_scores: dict[str, float]
 
 
-def estimate(log: Log, phantom: Phantom, cutoff: float = 20.0, structure: str = "general",
+def estimate(log: Log, phantom: Phantom, cutoff: float = CUTOFF, structure: str = "general",
              prior_weight: float = 1e-3, progress: Callable[[float], None] | None = None,
              timing: str | None = "held", prior_spread: float = priors.SPREAD, delay: float | None = 0.0,
              gains: bool = True, min_speed: float | None = MIN_SPEED, refuse: bool = False,

@@ -28,10 +28,10 @@ import numpy as np
 from phantom_pin.config.types import BODIES
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification import constants, parameterization, physical
-from phantom_pin.identification.base import base_parameters, sample, words
-from phantom_pin.identification.cache import cached
-from phantom_pin.identification.regressor import INERTIAL_NAMES, Regressor
+from phantom_pin.identification.structure import constants, parameterization, physical
+from phantom_pin.identification.structure.base import base_parameters, sample, words
+from phantom_pin.identification.structure.cache import cached
+from phantom_pin.identification.structure.regressor import INERTIAL_NAMES, Regressor
 from phantom_pin.inertial import INERTIA_KEYS, Inertial, carve, problem, uncarve
 
 FRICTION = constants.FRICTION_NAMES

@@ -29,10 +29,10 @@ import numpy as np
 from phantom_pin.config.sampling import sample_postures
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, LogError
-from phantom_pin.identification import prior as priors
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.least_squares import metric_root
-from phantom_pin.identification.structures import General, Structure
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.fitting.least_squares import metric_root
+from phantom_pin.identification.structure import prior as priors
+from phantom_pin.identification.structure.structures import General, Structure
 
 __all__ = ["Rest", "Gravity", "rest_of", "estimate_gravity"]
 

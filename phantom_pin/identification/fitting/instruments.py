@@ -32,11 +32,11 @@ import dataclasses
 import numpy as np
 
 from phantom_pin.exceptions import InvalidInputError, LogError
-from phantom_pin.identification.filtering import Samples, filtered
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.least_squares import fit
-from phantom_pin.identification.structures import Structure
-from phantom_pin.identification.timing import DELAY_BRACKET, lagged
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.data.timing import DELAY_BRACKET, lagged
+from phantom_pin.identification.fitting.filtering import Samples, filtered
+from phantom_pin.identification.fitting.least_squares import fit
+from phantom_pin.identification.structure.structures import Structure
 
 __all__ = ["Instruments", "instrumented_delay", "instruments", "reference_angles"]
 

@@ -39,10 +39,12 @@ import numpy as np
 
 from phantom_pin.config import Friction
 from phantom_pin.exceptions import LogError
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.structures import friction_block
-from phantom_pin.identification.timing import HOLD, lagged
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.data.timing import HOLD, lagged
+from phantom_pin.identification.structure.structures import friction_block
 
+#: The low-pass cutoff (Hz) of estimate, identify and ``identify --cutoff`` unless given.
+CUTOFF = 20.0
 #: Fewest periods of the cutoff the log must span (the filter's transients and edges).
 MIN_CYCLES = 10.0
 #: Filter order and edge cut (s).

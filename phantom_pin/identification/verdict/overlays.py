@@ -1,15 +1,21 @@
 """A Fit (estimation.estimate) as a --params overlay: the keys of the identified bodies, each
-joint's friction, and what the fit is only valid with (its model and lengths); result.py
-writes them as a YAML file with the fit in comments (docs/identification.md, step 9)."""
+joint's friction, and what the fit is only valid with (its model and lengths; the stylus posture
+it was held at: ``stylus_keys``); ``yaml_text`` and ``write_yaml``, the one writer of an overlay's text and file (the
+fit's comments: result.py; gravity from rest: ``gravity_overlay``; docs/identification.md, step 9)."""
 
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
+from phantom_pin._validation import output_path
 from phantom_pin.config import MODEL_KEY, MODELS, REPORT_SEGMENTS, Config, section
 from phantom_pin.description.build import describe
+from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError, PhantomPinError
-from phantom_pin.identification.fit import Fit
+from phantom_pin.identification.fitting.fit import Fit
+from phantom_pin.identification.fitting.static import Gravity
+from phantom_pin.identification.structure.structures import General
 
 
 def overlay(fit: Fit, given: dict | None = None, config: Config | None = None) -> tuple[dict[str, object], list[str]]:
@@ -76,3 +82,34 @@ def _friction_key(key: object) -> bool:
     """Whether an override key names actuation.yaml's friction (any of its forms)."""
     parts = str(key).split(".")
     return parts[1 if parts[0] == "actuation" else 0:][:1] == ["friction"]
+
+
+def stylus_keys(config: Config) -> dict[str, float]:
+    """The overrides of ``config``'s stylus posture, ``gimbal.locked_at.0..2`` (rad): what an overlay
+    identified on a model whose stylus was held (description.build.held, at a recording's gimbal
+    angles) carries in its ``given``, so that it is applied with the load it was fitted with; none
+    for a model without a stylus gimbal."""
+    gimbal = config.gimbal
+    return {} if gimbal is None else {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(gimbal.locked_at)}
+
+
+def gravity_overlay(gravity: Gravity, phantom: Phantom, given: dict | None, source: str, lines: list[str]) -> str:
+    """The overlay of gravity from rest (static.estimate_gravity on ``phantom``, made with the
+    overrides ``given``): the rigid body's keys (friction as given), the comment ``lines`` after
+    one naming the ``source`` (the log's name)."""
+    keys = identified_keys(General(phantom).overrides(gravity.x), given, phantom.config, None)
+    return yaml_text([f"Identified by phantom-pin identify --static from {source}: a --params overlay of the rigid "
+                      "body (gravity from rest postures; friction as given). SI units.", *lines], keys)
+
+
+def yaml_text(comments: list[str], keys: dict[str, object]) -> str:
+    """An overlay's text: the ``comments`` (one ``# `` line each), then the ``keys`` as YAML."""
+    lines = [f"# {line}" for line in comments] + [f"{key}: {value!r}" for key, value in keys.items()]
+    return "\n".join(lines) + "\n"
+
+
+def write_yaml(path: Path | str, text: str, force: bool = False) -> None:
+    """The overlay ``text`` (yaml_text) into the file ``path``; an existing file only with ``force``
+    (InvalidInputError naming ``path`` otherwise)."""
+    path = output_path(path, force, "path")
+    path.write_text(text, encoding="utf-8")

@@ -26,7 +26,7 @@ import numpy as np
 from phantom_pin.config import Config
 from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError
-from phantom_pin.identification.cache import cached
+from phantom_pin.identification.structure.cache import cached
 from phantom_pin.report.parameters import ReportParameters, links
 
 #: The report parameters, named by their --params key (first moments: mass * com).

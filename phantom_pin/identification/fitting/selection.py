@@ -26,13 +26,13 @@ import numpy as np
 
 from phantom_pin.dynamics.model import Phantom
 from phantom_pin.exceptions import LogError
-from phantom_pin.identification import checks
-from phantom_pin.identification.filtering import Samples, filtered
-from phantom_pin.identification.io import Log
-from phantom_pin.identification.least_squares import fit as least_squares
-from phantom_pin.identification.least_squares import solve_gains
-from phantom_pin.identification.structures import Structure
-from phantom_pin.identification.timing import HOLD, TIMINGS
+from phantom_pin.identification.data.io import Log
+from phantom_pin.identification.data.timing import HOLD, TIMINGS
+from phantom_pin.identification.fitting import checks
+from phantom_pin.identification.fitting.filtering import Samples, filtered
+from phantom_pin.identification.fitting.least_squares import fit as least_squares
+from phantom_pin.identification.fitting.least_squares import solve_gains
+from phantom_pin.identification.structure.structures import Structure
 
 __all__ = ["choose_min_speed", "choose_timing", "validate_gains"]
 
