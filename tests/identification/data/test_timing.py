@@ -1,7 +1,7 @@
 """The delay between positions and torques, and the torque timing (issue 31, item 4), on a
 device that is not the prior: the report's device with its parameters moved by 10-30 %
-(test_end_to_end.truth_overrides), tracking a lab's 60 s sum of sines
-(test_prior.lab_log: the repo's own plant, 1 % torque noise, encoder
+(helpers.truth_overrides), tracking a lab's 60 s sum of sines
+(helpers.lab_log: the repo's own plant, 1 % torque noise, encoder
 quantization, commands held for a sample). Delayed logs are that log with its torques written
 n samples late (1 kHz: n ms), so the true delay is known exactly; friction is judged against
 the device's own (VISCOUS, COULOMB), held-out torques against its own inverse dynamics on 500
@@ -13,7 +13,19 @@ import re
 import numpy as np
 import pytest
 
-from helpers import CONFIG, T10, model_torques, sines
+from helpers import (
+    CONFIG,
+    COULOMB,
+    T10,
+    VISCOUS,
+    error,
+    lab_prior,
+    model_torques,
+    sines,
+    sum_of_sines,
+    truth_log,
+    truth_overrides,
+)
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.cli import main
 from phantom_pin.config.sampling import random_states
@@ -21,9 +33,8 @@ from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 from phantom_pin.identification.data import io, simulation, timing
 from phantom_pin.identification.fitting import estimation, filtering
 from phantom_pin.identification.verdict import result
-from test_end_to_end import COULOMB, VISCOUS, truth_overrides
-from test_prior import PRIOR, error, sum_of_sines, truth_log
 
+PRIOR = lab_prior()
 TRUE_FRICTION = np.array([VISCOUS] * 3 + [COULOMB] * 3)
 
 

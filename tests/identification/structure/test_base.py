@@ -6,7 +6,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from helpers import CONFIG, REPORT
+from helpers import CONFIG, REPORT, three_frequency_log
+from helpers import seeded_states as _states
 from phantom_pin import Phantom, describe
 from phantom_pin.identification.structure import base, constants
 from phantom_pin.identification.structure import parameterization as pz
@@ -14,7 +15,6 @@ from phantom_pin.identification.structure.base import base_parameters
 from phantom_pin.identification.structure.regressor import Regressor
 from phantom_pin.identification.structure.structures import Report, Structured
 from phantom_pin.report import closed_form
-from test_regressor import states as _states
 
 REGRESSOR = Regressor(Phantom())
 DESCRIPTION = REGRESSOR.phantom.description
@@ -100,12 +100,10 @@ def test_sample_stays_inside_the_regressors_own_limits():
 
 
 def test_a_smooth_excitation_shows_all_26_base_parameters():
-    """On a three-frequency trajectory (tests/identification/test_estimation.py's, sampled at
+    """On a three-frequency trajectory (helpers.three_frequency_log, sampled at
     50 Hz) the weakest of the 26 base parameters pivots at about 1e-5 of the strongest: the
     rank keeps it (a tolerance of 1e-4 would give 25)."""
-    from test_estimation import log
-
-    data = log()
+    data = three_frequency_log()
     rates = np.gradient(data.theta, data.t, axis=0)
     accelerations = np.gradient(rates, data.t, axis=0)
     keep = slice(0, None, 20)

@@ -5,9 +5,8 @@ describe() generates through xacro and Pinocchio reads."""
 import numpy as np
 import pytest
 
-from helpers import CONFIG
+from helpers import CONFIG, seeded_states
 from phantom_pin import Phantom, closed_form, describe
-from phantom_pin.config.sampling import sample_postures
 from phantom_pin.dynamics.coupling import Coupling
 from phantom_pin.identification.structure import parameterization as pz
 from phantom_pin.identification.structure.regressor import Regressor
@@ -18,22 +17,15 @@ def regressor():
     return Regressor(Phantom())
 
 
-def states(regressor, n, seed):
-    """Seeded states inside the limits of the regressor's configuration."""
-    rng = np.random.default_rng(seed)
-    theta = sample_postures(regressor.phantom.config.limits, n, np.random.default_rng(seed), draws=4 * n)
-    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
-
-
 def test_regressor_times_shipped_parameters_is_inverse_dynamics(regressor):
-    theta, dtheta, ddtheta = states(regressor, 1000, 0)
+    theta, dtheta, ddtheta = seeded_states(regressor, 1000, 0)
     tau = Phantom().inverse_dynamics(theta, dtheta, ddtheta)
     predicted = regressor(theta, dtheta, ddtheta) @ regressor.parameters()
     assert np.abs(predicted - tau).max() <= 1e-12 * np.abs(tau).max()
 
 
 def test_friction_columns_follow_the_actuation_law(regressor):
-    theta, dtheta, ddtheta = states(regressor, 50, 1)
+    theta, dtheta, ddtheta = seeded_states(regressor, 50, 1)
     viscous, coulomb = np.array([1e-3, 2e-3, 3e-3]), np.array([0.01, 0.02, 0.03])
     law = viscous * dtheta + coulomb * np.sign(dtheta)
     rigid = regressor(theta, dtheta, ddtheta) @ regressor.parameters()
@@ -50,7 +42,7 @@ def test_the_coulomb_column_is_the_full_level_at_any_rate():
 
 
 def test_single_state_equals_the_batch_row(regressor):
-    theta, dtheta, ddtheta = states(regressor, 3, 2)
+    theta, dtheta, ddtheta = seeded_states(regressor, 3, 2)
     np.testing.assert_array_equal(regressor(theta[1], dtheta[1], ddtheta[1]),
                                   regressor(theta, dtheta, ddtheta)[1])
 
@@ -81,7 +73,7 @@ def test_affine_map_reproduces_the_generated_urdf(regressor):
 def test_the_known_parameters_give_no_torque(regressor):
     """The hinge pins' compensation and the base's fixed mass and x/z inertias cancel."""
     _, offset = pz.affine_map(regressor.phantom.description, regressor.bodies)
-    y = regressor.stacked(*states(regressor, 200, 4))
+    y = regressor.stacked(*seeded_states(regressor, 200, 4))
     assert np.abs(y[:, :len(offset)] @ offset).max() < 1e-12  # N m, against torques of 0.1 N m
 
 
@@ -93,7 +85,7 @@ def test_affine_map_times_the_regressor_is_the_closed_form_at_other_parameters(r
     description = regressor.phantom.description
     affine, offset = pz.affine_map(description, regressor.bodies)
     x = pz.report_vector(description.config) * np.random.default_rng(7).uniform(0.85, 1.15, len(pz.NAMES))
-    theta, dtheta, ddtheta = states(regressor, 200, 8)
+    theta, dtheta, ddtheta = seeded_states(regressor, 200, 8)
     pi = np.concatenate([affine @ x + offset, np.zeros(6)])      # no friction
     tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, pz.report_parameters(x, description.config))
     predicted = regressor(theta, dtheta, ddtheta) @ pi
@@ -103,7 +95,7 @@ def test_affine_map_times_the_regressor_is_the_closed_form_at_other_parameters(r
 def test_every_column_is_what_its_name_says(regressor):
     """rotor_j is ddtheta_j on joint j, viscous_j is dtheta_j, coulomb_j is sign(dtheta_j), each
     on joint j only."""
-    theta, dtheta, ddtheta = states(regressor, 20, 9)
+    theta, dtheta, ddtheta = seeded_states(regressor, 20, 9)
     y = regressor(theta, dtheta, ddtheta)
     for j in range(3):
         for name, expected in ((f"rotor{j + 1}", ddtheta[:, j]), (f"viscous{j + 1}", dtheta[:, j]),

@@ -1,61 +1,28 @@
 """Identification with the prior (identification.prior: the Gauss-Markov estimate with the
 configuration's base parameters as its mean) and the predicted torque uncertainty
 (identification.prediction), on a device that is NOT the prior: the report's device with its
-parameters moved by 10-30 % (test_end_to_end.FACTORS), logged as a lab would,
+parameters moved by 10-30 % (helpers.FACTORS), logged as a lab would,
 a sum of five sines per joint around a working posture, tracked by the repo's own simulated
 plant (identification.simulation.track: friction, 1 % torque noise, encoder quantization), and
 identified on the shipped model (the prior). Judged on held-out motion against the device's own
 inverse dynamics (Pinocchio on its description): a second sum-of-sines trajectory and 500
 seeded states inside the stops."""
 
-import functools
 import warnings
 
 import numpy as np
 import pytest
 
-from helpers import CONFIG
+from helpers import CONFIG, COULOMB, VISCOUS, error, lab_log, lab_prior, sum_of_sines, truth_log, truth_overrides
+from helpers import LAB_RATE as RATE
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import random_states
 from phantom_pin.identification.data import io, simulation
 from phantom_pin.identification.fitting import estimation, excitation, least_squares, prediction
 from phantom_pin.identification.structure.structures import General
-from test_end_to_end import COULOMB, VISCOUS, truth_overrides
 
-RATE = 1000.0
-#: The working posture the lab's motion is centred on (rad): inside every stop.
-POSTURE = np.array([0.0, 0.3, 0.45])
-PRIOR = Phantom()
+PRIOR = lab_prior()
 MODEL = General(PRIOR)
-
-
-def sum_of_sines(duration, amplitude, seed, sines=5, band=(0.1, 1.0)):
-    """A lab's excitation: per joint, ``sines`` sines of seeded frequencies in ``band`` (Hz) and
-    phases, each of amplitude ``amplitude`` / sines (rad), around POSTURE; (t, theta, dtheta,
-    ddtheta) at RATE over ``duration`` (s), the rates and accelerations exact."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(int(round(duration * RATE)) + 1) / RATE
-    w = 2 * np.pi * rng.uniform(*band, (3, sines))
-    arg = w * t[:, None, None] + rng.uniform(0, 2 * np.pi, (3, sines))
-    a = amplitude / sines
-    return t, POSTURE + a * np.sin(arg).sum(-1), a * (w * np.cos(arg)).sum(-1), -a * (w**2 * np.sin(arg)).sum(-1)
-
-
-def lab_log(device, duration, amplitude, seed):
-    """The device tracking a sum of sines with the prior's torques as feed-forward (a lab knows
-    only its model), torque noise 1 % of the feed-forward's RMS, the encoder's angles."""
-    t, theta, dtheta, ddtheta = sum_of_sines(duration, amplitude, seed)
-    assert (CONFIG.limits.slack(theta) > 0.05).all()            # inside every stop
-    tau = PRIOR.inverse_dynamics(theta, dtheta, ddtheta) + CONFIG.actuation.friction.torque(dtheta)
-    return simulation.track(device, t, theta, dtheta, tau, torque_noise=0.01 * float(np.sqrt((tau**2).mean())),
-                            seed=seed)
-
-
-@functools.cache
-def truth_log(duration, amplitude, seed):
-    """lab_log of the device of truth_overrides(), simulated once per arguments (the wide log is
-    test_timing's too; conftest.GROUPS keeps both modules on one worker)."""
-    return lab_log(Device(Phantom(describe(overrides=truth_overrides()))), duration, amplitude, seed)
 
 
 @pytest.fixture(scope="module")
@@ -70,15 +37,6 @@ def lab():
     _, theta, dtheta, ddtheta = sum_of_sines(20, 0.4, 99)
     held = {"trajectory": (theta[::10], dtheta[::10], ddtheta[::10]), "states": random_states(CONFIG.limits, 500, 7)}
     return fits, truth, held, logs
-
-
-def error(beta, truth, states):
-    """The rigid-body torques of the base parameters ``beta`` (friction dropped) at ``states``
-    against the device's own inverse dynamics: RMS error per joint as a share of the torque RMS."""
-    phi, tau0 = MODEL.regressor_of(*states)
-    rigid = np.concatenate([beta[:-6], np.zeros(6)])
-    true = truth.inverse_dynamics(*states)
-    return np.sqrt(((phi @ rigid + tau0 - true) ** 2).mean(axis=0) / (true**2).mean(axis=0))
 
 
 def test_the_regularised_fit_is_never_worse_than_the_prior_on_held_out_motion(lab):

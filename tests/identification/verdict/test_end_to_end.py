@@ -3,14 +3,13 @@ device's own plant, phantom_pin.simulate) whose parameters differ from the repor
 with friction, torque noise and encoder quantization, through excite -> log -> identify
 --structure report -> urdf/srdf, judged on held-out inverse-dynamics torques."""
 
-import dataclasses
 import re
 
 import numpy as np
 import pinocchio as pin
 import pytest
 
-from helpers import CONFIG, REPORT, run_cli
+from helpers import CONFIG, COULOMB, REPORT, TORQUE_NOISE, VISCOUS, run_cli, true_x, truth, truth_overrides
 from phantom_pin import Device, Phantom, closed_form, describe
 from phantom_pin.cli import main
 from phantom_pin.config import read_overrides
@@ -31,32 +30,6 @@ def sample(n, seed):
 def overlaid(path):
     """The Description of the shipped configuration with an identify overlay applied."""
     return describe(overrides=read_overrides(path))
-
-#: The simulated device: every report parameter moved by 10-30 % (physically consistent).
-FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
-           "Iczz": 0.85, "mbe": 1.25, "l5": 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3,
-           "mdf": 1.3, "l6": 0.9, "Idfxx": 1.2, "Idfyy": 1.1, "Idfzz": 1.25, "Ibaseyy": 1.15}
-VISCOUS, COULOMB, TORQUE_NOISE = 8e-4, 0.015, 0.005       # N m s/rad, N m, N m (1 sigma)
-
-
-def truth():
-    p = REPORT
-    return dataclasses.replace(p, **{k: getattr(p, k) * f for k, f in FACTORS.items()})
-
-
-def true_x():
-    """The simulated device's report parameters (parameterization.NAMES)."""
-    t = truth()
-    return np.array([t.ma, t.Iaxx, t.Iayy, t.Iazz, t.mc, t.Icxx, t.Icyy, t.Iczz, t.mbe, t.mbe * t.l5,
-                     t.Ibexx, t.Ibeyy, t.Ibezz, t.mdf, t.mdf * t.l6, t.Idfxx, t.Idfyy, t.Idfzz,
-                     t.Ibaseyy, CONFIG.actuation.motor.rotor_inertia])
-
-
-def truth_overrides():
-    """The simulated device as --params keys: its report parameters and its friction."""
-    return {**pz.overrides(true_x(), CONFIG), "actuation.friction.viscous": VISCOUS,
-            "actuation.friction.coulomb": COULOMB}
-
 
 def rms(error, reference):
     return float(np.sqrt((error**2).mean()) / np.sqrt((reference**2).mean()))

@@ -10,6 +10,11 @@ import numpy as np
 import pytest
 
 from helpers import CONFIG, REPORT, T10, model_torques, sines
+from helpers import TRAJECTORY_AMPLITUDE as AMPLITUDE
+from helpers import TRAJECTORY_PHASE as PHASE
+from helpers import TRAJECTORY_RATE as RATE
+from helpers import TRAJECTORY_W as W
+from helpers import three_frequency_log as log
 from phantom_pin import Device, Phantom, closed_form
 from phantom_pin.cli import main
 from phantom_pin.identification.data import io
@@ -17,28 +22,6 @@ from phantom_pin.identification.fitting import estimation
 from phantom_pin.identification.structure import constants
 
 PHANTOM = Phantom()
-RATE = 1000.0
-W = 2 * np.pi / 5          # rad/s: the trajectory's base frequency (period 5 s)
-AMPLITUDE = np.array([[0.5, 0.0, 0.0], [0.0, 0.3, 0.0], [0.2, 0.0, 0.4]])   # rad; rows: joints, columns: harmonics 1..3
-PHASE = np.array([0.4, 0.3, 1.0])
-OFFSET = np.array([0.0, 0.3, 0.45])  # rad: inside every stop (theta3 - theta2 <= 0.95 < 55 deg)
-
-
-def log(joint1_scale: float = 1.0, noise=(0.0, 0.0, 0.0), start: float = 0.0, end: float = 10.0) -> io.Log:
-    """The log of the trajectory from ``start`` to ``end`` (s), joint 1's amplitude scaled,
-    with white torque noise of standard deviation ``noise`` (N m) per joint (seeded)."""
-    t = np.arange(round(start * RATE), round(end * RATE) + 1) / RATE
-    k = np.arange(1, 4)
-    phase = np.multiply.outer(t, k * W) + PHASE[:, None, None].T[0]      # (N, 3 harmonics), one phase per harmonic
-    amplitude = AMPLITUDE * np.array([joint1_scale, 1.0, 1.0])[:, None]
-    theta = OFFSET + np.sin(phase) @ amplitude.T
-    dtheta = (np.cos(phase) * k * W) @ amplitude.T
-    ddtheta = (-np.sin(phase) * (k * W) ** 2) @ amplitude.T
-    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + CONFIG.actuation.friction.torque(dtheta)
-    tau = tau + np.random.default_rng(0).standard_normal(tau.shape) * np.asarray(noise)
-    return io.Log(t - t[0], theta, tau)
-
-
 TRUTH = constants.nominal(PHANTOM.description)
 
 

@@ -13,7 +13,7 @@ import functools
 import numpy as np
 import pytest
 
-from helpers import run_cli
+from helpers import run_cli, sum_of_sines
 from phantom_pin import Device, Phantom, describe, drivers
 from phantom_pin.config import read_overrides
 from phantom_pin.config.sampling import random_states
@@ -21,7 +21,6 @@ from phantom_pin.exceptions import InvalidInputError, LogError, PhantomPinError
 from phantom_pin.identification import estimate, overlay
 from phantom_pin.identification.data import simulation
 from phantom_pin.identification.verdict import result
-from test_prior import sum_of_sines
 
 TRUTH = describe("premium_1_5_cad")
 #: The lab measured its lengths: the prior is the shipped model with the device's.
