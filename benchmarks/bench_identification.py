@@ -6,7 +6,7 @@ and the report-structure fits on a device NOT of the report's structure.
 
     python benchmarks/bench_identification.py
 
-The device is tests/identification/test_general_structure.py's (its numbers, not copied: imported).
+The device is tests/identification/verdict/test_general_structure.py's (its numbers, not copied: imported).
 """
 
 from __future__ import annotations
@@ -22,13 +22,16 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path[:0] = [str(Path(__file__).resolve().parents[1] / "tests" / folder) for folder in ("identification", ".")]
+TESTS = Path(__file__).resolve().parents[1] / "tests"
+sys.path[:0] = [str(TESTS / folder) for folder in ("identification/verdict", ".")]
+
+from test_general_structure import COULOMB, DEVICE, NOISE, VISCOUS  # noqa: E402
 
 from phantom_pin import Device, Phantom, describe  # noqa: E402
 from phantom_pin.cli import main  # noqa: E402
 from phantom_pin.config.sampling import sample_postures  # noqa: E402
-from phantom_pin.identification import estimate, io, overlay, simulation  # noqa: E402
-from test_general_structure import COULOMB, DEVICE, NOISE, VISCOUS  # noqa: E402
+from phantom_pin.identification import estimate, overlay  # noqa: E402
+from phantom_pin.identification.data import io, simulation  # noqa: E402
 
 
 def rms(error: np.ndarray, reference: np.ndarray) -> float:

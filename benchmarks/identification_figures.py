@@ -36,7 +36,7 @@ iterations; computed once per setup), fed forward with the prior's torques and f
 excite writes them; ``lab``, a lab's own log: five seeded sines per joint (0.1-1 Hz) around a
 working posture, inside every stop, fed forward with the prior's torques.
 
-The device: phantom_pin.identification.simulation.track, 1 kHz, the device's own plant (its
+The device: phantom_pin.identification.data.simulation.track, 1 kHz, the device's own plant (its
 rigid body and rotors, viscous + Coulomb friction with stiction, stops, saturation). Conditions
 (CONDITIONS; all at 60 s unless named):
 - the servo log: the tracked commands, each held for a sample, identified with the default
@@ -76,7 +76,7 @@ rows give: ``--seed 1`` (every seed of the table plus 1: other excitations, sine
 held-out motion) is the calibration set prediction.CALIBRATION was set from. Progress goes to
 stderr.
 
-The issue's Touch case (``touch``; tests/identification/test_selection.py): the shipped Touch but
+The issue's Touch case (``touch``; tests/identification/fitting/test_selection.py): the shipped Touch but
 for viscous friction 7e-4 N m s/rad on joint 2 and Coulomb friction 0.02 N m on joint 3
 (TOUCH_CASE), through the command line with its defaults: ``phantom-pin --model touch excite``,
 ``simulate --trajectory ... --set ...``, ``identify``; and ``identify --min-speed 0.01`` (the old
@@ -86,7 +86,7 @@ the other four, the delay, joint 2's and 3's torque gains and whether they were 
 friction speed threshold (chosen or given), identify's verdict (its stderr) and the issue's goal:
 both friction values within 5 %, no torque-constant advice, the rigid body within 0.3 %.
 
-Rest postures (``rest``; identify --static, static.py; tests/identification/test_static.py): per
+Rest postures (``rest``; identify --static, static.py; tests/identification/fitting/test_static.py): per
 setup (``--setups``) and seed (``--rest-seeds``, default 4), 12 seeded postures inside the stops
 (0.05 rad margin), their angles as the device's encoder reads them (the Touch's is not public:
 exact angles), the device's gravity torques with 1 % noise (relative, per entry), fitted on the
@@ -96,7 +96,7 @@ joint), the written model's gravity error at 500 other seeded postures inside th
 joint as a share of the device's, worst joint; joint 1 carries none), their ratio, the prior's
 error and the issue's goal: within 1 %.
 
-Bags (``bags``; bags.py, tests/identification/test_bags.py): for each driver profile that publishes
+Bags (``bags``; bags.py, tests/identification/data/test_bags.py): for each driver profile that publishes
 efforts, the Touch setup's clean excite log (instantaneous torques, 60 s, 20 with --quick) taken
 at the driver's rate, written as a CSV in the report's convention and as a rosbag2 recording
 (sqlite3, rosbags' writer) in the profile's shape (its topic, joint names, signs and elbow, the
@@ -132,18 +132,20 @@ from phantom_pin.config import Friction, read_overrides
 from phantom_pin.config.sampling import random_states, sample_postures
 from phantom_pin.description.build import Description
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
-from phantom_pin.identification import Fit, estimate, io, optimise, overlay, simulation, static
-from phantom_pin.identification import parameterization as pz
-from phantom_pin.identification.overlays import identified_keys
-from phantom_pin.identification.prediction import CALIBRATION
-from phantom_pin.identification.result import fit_warnings
-from phantom_pin.identification.structures import General
+from phantom_pin.identification import Fit, estimate, optimise, overlay
+from phantom_pin.identification.data import io, simulation
+from phantom_pin.identification.fitting import static
+from phantom_pin.identification.fitting.prediction import CALIBRATION
+from phantom_pin.identification.structure import parameterization as pz
+from phantom_pin.identification.structure.structures import General
+from phantom_pin.identification.verdict.overlays import identified_keys
+from phantom_pin.identification.verdict.result import fit_warnings
 from phantom_pin.interfaces import conventions, profiles
 
 RATE = 1000.0       # Hz, the servo loop's and the log's
 #: The report-structured devices: each report parameter (parameterization.SYMBOLS) times its
-#: factor (the first moments take their mass's and length's): tests/identification/test_end_to_end's
-#: device; the Touch's as tests/test_touch's (Idfxx 1.1: every link of the Touch stays physical).
+#: factor (the first moments take their mass's and length's): tests/helpers.py's FACTORS, the
+#: simulated device's; the Touch's as tests/test_touch's (Idfxx 1.1: every link of the Touch stays physical).
 MOVED = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85, "Iczz": 0.85,
          "mbe": 1.25, "mbe*l5": 1.25 * 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3, "mdf": 1.3, "mdf*l6": 1.3 * 0.9,
          "Idfxx": 1.2, "Idfyy": 1.1, "Idfzz": 1.25, "Ibaseyy": 1.15}
@@ -593,7 +595,8 @@ def coverage_notes(rows: list[Row]) -> list[str]:
 
 
 # -- the issue's Touch case: the shipped Touch but for two friction values, excite + simulate + identify ----------
-#: The issue's simulated Touch (tests/identification/test_selection.py): the shipped model but for viscous friction
+#: The issue's simulated Touch (tests/identification/fitting/test_selection.py): the shipped model but for viscous
+#: friction
 #: on joint 2 (N m s/rad) and Coulomb friction on joint 3 (N m, near joint 3's torque RMS).
 TOUCH_CASE = {"actuation.friction.viscous.joint2": 7e-4, "actuation.friction.coulomb.joint3": 0.02}
 #: The issue's goals for it: both friction values within 5 %, the rigid body within 0.3 % (held-out); for rest

@@ -4,7 +4,7 @@ report's model, and plot the torques of a held-out trajectory against those pred
 general identification, by the report-structure identification and by the report's parameters.
 
 The pipeline is a real device's: an optimised excitation trajectory, the device tracking it
-(phantom_pin.identification.simulation.track: the device's own plant with friction, 2 mN m of
+(phantom_pin.identification.data.simulation.track: the device's own plant with friction, 2 mN m of
 torque noise and its encoders), a log of the encoder's angles and the commanded torques,
 phantom_pin.identification.estimate, and the written --params overlay. The held-out motion is
 another excitation (another seed), 5 s long.
@@ -17,9 +17,10 @@ import numpy as np
 
 import common
 from phantom_pin import Device, Phantom, describe
-from phantom_pin.identification import estimate, optimise, simulation
-from phantom_pin.identification.overlays import overlay
-from phantom_pin.identification.result import recommendation
+from phantom_pin.identification import estimate, optimise
+from phantom_pin.identification.data import simulation
+from phantom_pin.identification.verdict.overlays import overlay
+from phantom_pin.identification.verdict.result import recommendation
 
 #: The simulated device's friction (N m s/rad, N m) and torque noise (N m, 1 sigma).
 VISCOUS, COULOMB, NOISE = 6e-4, 0.012, 0.002

@@ -16,7 +16,7 @@ import sys
 import types
 import warnings
 
-#: Old module path -> new module path (0.x: the device integrations, issue 51).
+#: Old module path -> new module path (0.x: the device integrations and identification's stages, issue 51).
 MOVED = {
     "phantom_pin.drivers": "phantom_pin.interfaces.conventions",
     "phantom_pin.profiles": "phantom_pin.interfaces.profiles",
@@ -27,6 +27,32 @@ MOVED = {
     "phantom_pin.plots": "phantom_pin.viewer.plots",
     "phantom_pin.verification": "phantom_pin.dynamics.verification",
     "phantom_pin.dynamics.model": "phantom_pin.dynamics.phantom",
+    # identification/ in its stages: data, structure, fitting, verdict (issue 51, item 4)
+    "phantom_pin.identification.io": "phantom_pin.identification.data.io",
+    "phantom_pin.identification.bags": "phantom_pin.identification.data.bags",
+    "phantom_pin.identification.timing": "phantom_pin.identification.data.timing",
+    "phantom_pin.identification.simulation": "phantom_pin.identification.data.simulation",
+    "phantom_pin.identification.cache": "phantom_pin.identification.structure.cache",
+    "phantom_pin.identification.regressor": "phantom_pin.identification.structure.regressor",
+    "phantom_pin.identification.base": "phantom_pin.identification.structure.base",
+    "phantom_pin.identification.parameterization": "phantom_pin.identification.structure.parameterization",
+    "phantom_pin.identification.constants": "phantom_pin.identification.structure.constants",
+    "phantom_pin.identification.physical": "phantom_pin.identification.structure.physical",
+    "phantom_pin.identification.structures": "phantom_pin.identification.structure.structures",
+    "phantom_pin.identification.prior": "phantom_pin.identification.structure.prior",
+    "phantom_pin.identification.least_squares": "phantom_pin.identification.fitting.least_squares",
+    "phantom_pin.identification.filtering": "phantom_pin.identification.fitting.filtering",
+    "phantom_pin.identification.instruments": "phantom_pin.identification.fitting.instruments",
+    "phantom_pin.identification.prediction": "phantom_pin.identification.fitting.prediction",
+    "phantom_pin.identification.fit": "phantom_pin.identification.fitting.fit",
+    "phantom_pin.identification.checks": "phantom_pin.identification.fitting.checks",
+    "phantom_pin.identification.selection": "phantom_pin.identification.fitting.selection",
+    "phantom_pin.identification.estimation": "phantom_pin.identification.fitting.estimation",
+    "phantom_pin.identification.excitation": "phantom_pin.identification.fitting.excitation",
+    "phantom_pin.identification.static": "phantom_pin.identification.fitting.static",
+    "phantom_pin.identification.result": "phantom_pin.identification.verdict.result",
+    "phantom_pin.identification.overlays": "phantom_pin.identification.verdict.overlays",
+    "phantom_pin.identification.page": "phantom_pin.identification.verdict.page",
 }
 
 

@@ -5,6 +5,7 @@ a world point to its pixel with meshcat's camera (75 degrees vertical field of v
 the world origin, z up, from viewer.CAMERA_POSITION)."""
 
 import ctypes
+import dataclasses
 import functools
 import json
 import os
@@ -23,7 +24,11 @@ import pytest
 import yaml
 from PIL import Image
 
-from phantom_pin import Phantom, config
+from phantom_pin import Device, Phantom, closed_form, config, describe
+from phantom_pin.config.sampling import sample_postures
+from phantom_pin.identification.data import io, simulation
+from phantom_pin.identification.structure import parameterization as pz
+from phantom_pin.identification.structure.structures import General
 from phantom_pin.interfaces import profiles
 from phantom_pin.viewer import CAMERA_POSITION
 from phantom_pin.viewer.screenshot import chromium_command
@@ -156,8 +161,8 @@ def excitation_file(path, model="touch"):
     rows to the last bits of the evaluation's products, on any machine and for any future
     optimiser, so that a test of a method's property keeps its case (issue 50, 2)."""
     from phantom_pin.cli.common import csv_text
-    from phantom_pin.identification.excitation import Fourier
-    from phantom_pin.identification.io import TRAJECTORY_COLUMNS
+    from phantom_pin.identification.data.io import TRAJECTORY_COLUMNS
+    from phantom_pin.identification.fitting.excitation import Fourier
 
     series = json.loads(EXCITATIONS.read_text())[model]
     trajectory = Fourier(*(np.array(series[key]) for key in ("q0", "a", "b")), series["period"])
@@ -464,3 +469,113 @@ def installed_profiles() -> list[str]:
         return True
 
     return [name for name in profiles.names() if _installed(name)]
+# The identification's logs with a known truth (tests/identification: each module's helpers that
+# another module takes).
+
+
+def seeded_states(regressor, n, seed):
+    """Seeded states inside the limits of the regressor's configuration."""
+    rng = np.random.default_rng(seed)
+    theta = sample_postures(regressor.phantom.config.limits, n, np.random.default_rng(seed), draws=4 * n)
+    return theta, rng.normal(0, 2, (n, 3)), rng.normal(0, 20, (n, 3))
+
+
+TRAJECTORY_RATE = 1000.0
+TRAJECTORY_W = 2 * np.pi / 5          # rad/s: the trajectory's base frequency (period 5 s)
+#: rad; rows: joints, columns: harmonics 1..3
+TRAJECTORY_AMPLITUDE = np.array([[0.5, 0.0, 0.0], [0.0, 0.3, 0.0], [0.2, 0.0, 0.4]])
+TRAJECTORY_PHASE = np.array([0.4, 0.3, 1.0])
+TRAJECTORY_OFFSET = np.array([0.0, 0.3, 0.45])  # rad: inside every stop (theta3 - theta2 <= 0.95 < 55 deg)
+
+
+def three_frequency_log(joint1_scale: float = 1.0, noise=(0.0, 0.0, 0.0), start: float = 0.0,
+                        end: float = 10.0) -> io.Log:
+    """The log of the three-frequency trajectory (exact rates and accelerations; the report's
+    inverse dynamics plus the friction law: the true beta is constants.nominal's) from ``start``
+    to ``end`` (s), joint 1's amplitude scaled, with white torque noise of standard deviation
+    ``noise`` (N m) per joint (seeded)."""
+    t = np.arange(round(start * TRAJECTORY_RATE), round(end * TRAJECTORY_RATE) + 1) / TRAJECTORY_RATE
+    k = np.arange(1, 4)
+    phase = np.multiply.outer(t, k * TRAJECTORY_W) + TRAJECTORY_PHASE[:, None, None].T[0]    # (N, 3 harmonics)
+    amplitude = TRAJECTORY_AMPLITUDE * np.array([joint1_scale, 1.0, 1.0])[:, None]
+    theta = TRAJECTORY_OFFSET + np.sin(phase) @ amplitude.T
+    dtheta = (np.cos(phase) * k * TRAJECTORY_W) @ amplitude.T
+    ddtheta = (-np.sin(phase) * (k * TRAJECTORY_W) ** 2) @ amplitude.T
+    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, REPORT) + CONFIG.actuation.friction.torque(dtheta)
+    tau = tau + np.random.default_rng(0).standard_normal(tau.shape) * np.asarray(noise)
+    return io.Log(t - t[0], theta, tau)
+
+
+#: The simulated device: every report parameter moved by 10-30 % (physically consistent).
+FACTORS = {"ma": 1.2, "Iaxx": 1.2, "Iayy": 1.2, "Iazz": 1.2, "mc": 0.85, "Icxx": 0.85, "Icyy": 0.85,
+           "Iczz": 0.85, "mbe": 1.25, "l5": 1.1, "Ibexx": 1.15, "Ibeyy": 1.2, "Ibezz": 1.3,
+           "mdf": 1.3, "l6": 0.9, "Idfxx": 1.2, "Idfyy": 1.1, "Idfzz": 1.25, "Ibaseyy": 1.15}
+VISCOUS, COULOMB, TORQUE_NOISE = 8e-4, 0.015, 0.005       # N m s/rad, N m, N m (1 sigma)
+
+
+def truth():
+    p = REPORT
+    return dataclasses.replace(p, **{k: getattr(p, k) * f for k, f in FACTORS.items()})
+
+
+def true_x():
+    """The simulated device's report parameters (parameterization.NAMES)."""
+    t = truth()
+    return np.array([t.ma, t.Iaxx, t.Iayy, t.Iazz, t.mc, t.Icxx, t.Icyy, t.Iczz, t.mbe, t.mbe * t.l5,
+                     t.Ibexx, t.Ibeyy, t.Ibezz, t.mdf, t.mdf * t.l6, t.Idfxx, t.Idfyy, t.Idfzz,
+                     t.Ibaseyy, CONFIG.actuation.motor.rotor_inertia])
+
+
+def truth_overrides():
+    """The simulated device as --params keys: its report parameters and its friction."""
+    return {**pz.overrides(true_x(), CONFIG), "actuation.friction.viscous": VISCOUS,
+            "actuation.friction.coulomb": COULOMB}
+
+
+LAB_RATE = 1000.0
+#: The working posture the lab's motion is centred on (rad): inside every stop.
+LAB_POSTURE = np.array([0.0, 0.3, 0.45])
+
+
+@functools.cache
+def lab_prior():
+    """The prior a lab identifies on: the shipped model (one Phantom for every test module)."""
+    return Phantom()
+
+
+def sum_of_sines(duration, amplitude, seed, sines=5, band=(0.1, 1.0)):
+    """A lab's excitation: per joint, ``sines`` sines of seeded frequencies in ``band`` (Hz) and
+    phases, each of amplitude ``amplitude`` / sines (rad), around LAB_POSTURE; (t, theta, dtheta,
+    ddtheta) at LAB_RATE over ``duration`` (s), the rates and accelerations exact."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(int(round(duration * LAB_RATE)) + 1) / LAB_RATE
+    w = 2 * np.pi * rng.uniform(*band, (3, sines))
+    arg = w * t[:, None, None] + rng.uniform(0, 2 * np.pi, (3, sines))
+    a = amplitude / sines
+    return t, LAB_POSTURE + a * np.sin(arg).sum(-1), a * (w * np.cos(arg)).sum(-1), -a * (w**2 * np.sin(arg)).sum(-1)
+
+
+def lab_log(device, duration, amplitude, seed):
+    """The device tracking a sum of sines with the prior's torques as feed-forward (a lab knows
+    only its model), torque noise 1 % of the feed-forward's RMS, the encoder's angles."""
+    t, theta, dtheta, ddtheta = sum_of_sines(duration, amplitude, seed)
+    assert (CONFIG.limits.slack(theta) > 0.05).all()            # inside every stop
+    tau = lab_prior().inverse_dynamics(theta, dtheta, ddtheta) + CONFIG.actuation.friction.torque(dtheta)
+    return simulation.track(device, t, theta, dtheta, tau, torque_noise=0.01 * float(np.sqrt((tau**2).mean())),
+                            seed=seed)
+
+
+@functools.cache
+def truth_log(duration, amplitude, seed):
+    """lab_log of the device of truth_overrides(), simulated once per arguments (the wide log is
+    test_prior's and test_timing's; conftest.GROUPS keeps both modules on one worker)."""
+    return lab_log(Device(Phantom(describe(overrides=truth_overrides()))), duration, amplitude, seed)
+
+
+def error(beta, truth, states):
+    """The rigid-body torques of the base parameters ``beta`` (friction dropped) at ``states``
+    against the device's own inverse dynamics: RMS error per joint as a share of the torque RMS."""
+    phi, tau0 = General(lab_prior()).regressor_of(*states)
+    rigid = np.concatenate([beta[:-6], np.zeros(6)])
+    true = truth.inverse_dynamics(*states)
+    return np.sqrt(((phi @ rigid + tau0 - true) ** 2).mean(axis=0) / (true**2).mean(axis=0))

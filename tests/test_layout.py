@@ -24,8 +24,6 @@ TESTS = Path(__file__).resolve().parent
 #: the command line's tests run them).
 EXEMPT = {
     "_paths.py": "constants alone (where the description folder and the driver profiles are)",
-    "cli/identification.py": "moved by the identification stage work (tests/cli/test_identification_commands.py)",
-    "_blas.py": "moved by the identification stage work (tests/identification/test_kernels.py tests it)",
     # No test of its own yet (issue 51, item 5): each is exercised through the tests named.
     "_integration.py": "no test of its own: device/test_device_plant.py checks the plant's RK4 step",
     "_validation.py": "no test of its own: every public function's bad-input tests (dynamics/test_fast.py)",
@@ -44,13 +42,9 @@ EXEMPT = {
     "report/parameters.py": "no test of its own: the report's numbers (config/test_builders.py)",
 }
 #: The subpackages another change restructures.
-EXEMPT_PACKAGES = {
-    "identification": "moved by the identification stage work",
-}
+EXEMPT_PACKAGES: dict[str, str] = {}
 #: The test folders whose files may still import one another, for the same reason.
-EXEMPT_IMPORTS = {
-    "identification": "moved by the identification stage work",
-}
+EXEMPT_IMPORTS: dict[str, str] = {}
 
 
 def _modules() -> list[Path]:

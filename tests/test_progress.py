@@ -54,7 +54,7 @@ def test_long_work_reports_its_share_done():
     import numpy as np
 
     from phantom_pin import Phantom, describe, simulate
-    from phantom_pin.identification import excitation
+    from phantom_pin.identification.fitting import excitation
 
     shares = []
     result = simulate([0.0, 0.3, 0.4], 0.05, progress=shares.append)

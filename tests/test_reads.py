@@ -10,7 +10,9 @@ import xacro
 
 from phantom_pin import Phantom, describe
 from phantom_pin.config import files
-from phantom_pin.identification import constants, estimation, excitation, io
+from phantom_pin.identification.data import io
+from phantom_pin.identification.fitting import estimation, excitation
+from phantom_pin.identification.structure import constants
 
 
 def test_excite_and_identify_read_nothing_after_describe(monkeypatch):

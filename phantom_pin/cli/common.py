@@ -197,7 +197,7 @@ RECORD = re.compile(r"#\s*phantom-pin:\s*model (?P<model>.+), convention (?P<con
 
 def csv_text(header: list[str], table: Any, model: str, convention: str) -> str:
     """A trajectory's or log's CSV: the ``header`` line, the record of ``model`` and ``convention``
-    (RECORD; phantom_pin.identification.io skips # lines, as numpy.loadtxt does; pandas with
+    (RECORD; phantom_pin.identification.data.io skips # lines, as numpy.loadtxt does; pandas with
     comment="#"), then the rows of ``table`` (N, len(header)) in their shortest exact decimals."""
     rows = (",".join(map(repr, row)) for row in table.tolist())
     return "\n".join([",".join(header), f"# phantom-pin: model {model}, convention {convention}", *rows]) + "\n"

@@ -33,7 +33,7 @@ from phantom_pin.device.device import Device
 from phantom_pin.device.simulation import SimulationResult, simulate
 from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import io
+from phantom_pin.identification.data import io
 from phantom_pin.viewer import plots
 
 #: simulate()'s arguments that are options of the command (its errors name them).

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import inspect
 import math
 from pathlib import Path
 
@@ -22,14 +23,33 @@ from phantom_pin.cli.common import (
     write_texts,
 )
 from phantom_pin.config import DEFAULT
-from phantom_pin.description.build import Description
+from phantom_pin.description.build import Description, held
 from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import PhantomPinError
-from phantom_pin.identification import bags, excitation, io, prior, selection, static, timing
-from phantom_pin.identification import page as identification_page
-from phantom_pin.identification.overlays import identified_keys
-from phantom_pin.identification.result import Identification, RefusedError, identify, refusal, write_yaml
-from phantom_pin.identification.structures import General
+from phantom_pin.identification import (
+    MIN_SPEEDS,
+    TRAJECTORY_COLUMNS,
+    Excitation,
+    Identification,
+    Recording,
+    RefusedError,
+    Rest,
+    continuous_effort,
+    delay_argument,
+    estimate_gravity,
+    gravity_overlay,
+    identify,
+    is_bag,
+    optimise,
+    read_bag,
+    read_log,
+    read_postures,
+    read_trajectory,
+    refusal,
+    report_page,
+    rest_of,
+    stylus_keys,
+)
 from phantom_pin.interfaces import conventions, profiles
 from phantom_pin.viewer import plots
 
@@ -55,61 +75,51 @@ def _suffix(path: Path, suffixes: tuple[str, ...], kind: str) -> None:
                               argument="--output")
 
 
-#: The options of the trajectory fit, which rest postures do not take (dest, option, default).
-TRAJECTORY_ONLY = (("structure", "--structure", "general"), ("delay", "--delay", None),
-                   ("fixed_gains", "--fixed-gains", False), ("torque_timing", "--torque-timing", None),
-                   ("min_speed", "--min-speed", None), ("cutoff", "--cutoff", 20.0),
-                   ("accept", "--accept", False), ("report", "--report", None), ("reference", "--reference", None))
+#: The defaults of the library's identify() and optimise(), the commands' own (one place each).
+IDENTIFY = {name: p.default for name, p in inspect.signature(identify).parameters.items() if p.default is not p.empty}
+OPTIMISE = {name: p.default for name, p in inspect.signature(optimise).parameters.items() if p.default is not p.empty}
+#: The options of the trajectory fit, which rest postures do not take (dest, option, default):
+#: identify()'s defaults (--fixed-gains: not its gains).
+TRAJECTORY_ONLY = (("structure", "--structure", IDENTIFY["structure"]), ("delay", "--delay", IDENTIFY["delay"]),
+                   ("fixed_gains", "--fixed-gains", not IDENTIFY["gains"]),
+                   ("torque_timing", "--torque-timing", IDENTIFY["timing"]),
+                   ("min_speed", "--min-speed", IDENTIFY["min_speed"]), ("cutoff", "--cutoff", IDENTIFY["cutoff"]),
+                   ("accept", "--accept", IDENTIFY["accept"]), ("report", "--report", None),
+                   ("reference", "--reference", IDENTIFY["reference"]))
 
 
-def _static_command(args: argparse.Namespace, phantom: Phantom, recording: bags.Recording | None,
+def _static_command(args: argparse.Namespace, phantom: Phantom, recording: Recording | None,
                     given: dict[str, object]) -> int:
-    """identify --static: gravity from rest postures (static.py), written as an overlay of the
-    rigid body (friction as given: rest says nothing of it)."""
+    """identify --static: gravity from rest postures (estimate_gravity), written as an overlay of
+    the rigid body (gravity_overlay: friction as given, rest says nothing of it)."""
     for dest, option, default in TRAJECTORY_ONLY:
         if getattr(args, dest) != default:
             raise PhantomPinError("fits a trajectory: --static fits rest postures (gravity) only", argument=option)
     if recording is not None:
-        rest = static.rest_of(recording.log)
+        rest = rest_of(recording.log)
     else:
-        table = io.read_postures(args.log)
-        rest = static.rest_of(io.read_log(args.log, args.convention)) if table is None else static.Rest(*table)
-    gravity = static.estimate_gravity(rest, phantom, args.prior_spread)
-    keys = identified_keys(General(phantom).overrides(gravity.x), given, phantom.config, None)
+        table = read_postures(args.log)
+        rest = rest_of(read_log(args.log, args.convention)) if table is None else Rest(*table)
+    gravity = estimate_gravity(rest, phantom, args.prior_spread)
     lines = [*([] if recording is None else recording.lines()), *gravity.lines(len(rest.theta))]
+    text = gravity_overlay(gravity, phantom, given, args.log.name, lines)
     for line in lines:
         print(line)
-    write_yaml(args.output, [f"Identified by phantom-pin identify --static from {args.log.name}: a --params overlay "
-                             "of the rigid body (gravity from rest postures; friction as given). SI units.",
-                             *lines], keys, force=True)
+    write_texts([(args.output, text, "--output")])
     print(f"wrote {args.output}")
     return 0
 
 
-def _recording(args: argparse.Namespace) -> bags.Recording | None:
-    """The bag LOG names (its driver profile's JointState: bags.read_bag), or None for a CSV log."""
-    if not bags.is_bag(args.log):
+def _recording(args: argparse.Namespace) -> Recording | None:
+    """The bag LOG names (its driver profile's JointState: read_bag), or None for a CSV log."""
+    if not is_bag(args.log):
         if args.driver is not None or args.topic is not None:
             raise PhantomPinError(f"{args.log} is a CSV log, not a rosbag2 recording: --driver and --topic read bags",
                                   argument="--driver" if args.driver is not None else "--topic")
         return None
     if args.convention != "report":
         raise PhantomPinError("a bag's conventions are its driver profile's (--driver)", argument="--convention")
-    return bags.read_bag(args.log, args.driver, args.topic)
-
-
-def _held_stylus(gimbal: np.ndarray) -> dict[str, float]:
-    """The overrides that put the model's stylus at a recording's gimbal angles (rad, (N, 3)):
-    their median, where the stylus is held still (bags.STYLUS_SPREAD); PhantomPinError where it
-    swings further (its load then moves with it, which a locked stylus does not model)."""
-    middle = np.median(gimbal, axis=0)
-    spread = np.abs(gimbal - middle).max(axis=0)
-    if (spread > bags.STYLUS_SPREAD).any():
-        j = int(np.argmax(spread))
-        raise PhantomPinError(f"the stylus's gimbal angle {j + 1} swings {spread[j]:.3g} rad about its median in the "
-                              f"bag (at most {bags.STYLUS_SPREAD:g} rad): identify with the stylus held still (taped "
-                              "or docked), its load is modelled locked", argument="LOG")
-    return {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(middle)}
+    return read_bag(args.log, args.driver, args.topic)
 
 
 def _reference(path: Path | None, model: str, convention: str) -> tuple[np.ndarray, np.ndarray] | None:
@@ -120,42 +130,56 @@ def _reference(path: Path | None, model: str, convention: str) -> tuple[np.ndarr
         return None
     check_record(path, model, convention, "--reference")
     try:
-        t, theta = io.read_trajectory(path, convention)[:2]
+        t, theta = read_trajectory(path, convention)[:2]
     except PhantomPinError as error:
         raise PhantomPinError(error.detail, argument="--reference") from None
     return t, theta
 
 
 def _delay(text: str | None) -> float | None:
-    """--delay's seconds (None: estimate it), checked by timing.delay_argument."""
+    """--delay's seconds (None: estimate it), checked by delay_argument."""
     if text is None:
         return None
     try:
         value = float(text)
     except ValueError:
         raise PhantomPinError(f"expected seconds (a number such as 0.001), got {text!r}", argument="--delay") from None
-    return timing.delay_argument(value)
+    return delay_argument(value)
 
 
 def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add the excite and identify subcommands to the phantom-pin parser."""
+    _add_excite(sub)
+    _add_identify(sub)
+
+
+def _add_excite(sub: argparse._SubParsersAction) -> None:
+    """excite's options, its defaults optimise()'s."""
     excite = sub.add_parser("excite", help="write an optimised excitation trajectory (CSV) inside the stops")
     excite.set_defaults(run=excite_command)
     excite.add_argument("--output", "-o", required=True, type=Path, action=Once)
     excite.add_argument("--duration", type=float, default=20.0,
                         help="seconds of trajectory, rounded up to whole periods (default 20)")
     excite.add_argument("--rate", type=float, default=1000.0, help="samples per second (default 1000)")
-    excite.add_argument("--period", type=float, default=5.0, help="period of the Fourier series, s (default 5)")
-    excite.add_argument("--harmonics", type=int, default=5, help="harmonics per joint (default 5)")
-    excite.add_argument("--iterations", type=int, default=60, help="SLSQP iterations per start (default 60)")
-    excite.add_argument("--restarts", type=int, default=2, help="random starts (default 2)")
-    excite.add_argument("--seed", type=int, default=0)
+    excite.add_argument("--period", type=float, default=OPTIMISE["period"],
+                        help=f"period of the Fourier series, s (default {OPTIMISE['period']:g})")
+    excite.add_argument("--harmonics", type=int, default=OPTIMISE["harmonics"],
+                        help=f"harmonics per joint (default {OPTIMISE['harmonics']})")
+    excite.add_argument("--iterations", type=int, default=OPTIMISE["iterations"],
+                        help=f"SLSQP iterations per start (default {OPTIMISE['iterations']})")
+    excite.add_argument("--restarts", type=int, default=OPTIMISE["restarts"],
+                        help=f"random starts (default {OPTIMISE['restarts']})")
+    excite.add_argument("--seed", type=int, default=OPTIMISE["seed"])
     excite.add_argument("--force", "-f", action="store_true", help="overwrite an existing file")
     excite.add_argument("--convention", choices=CONVENTIONS, default="report",
                         help="columns in the report's theta (rad) and N m (default), or OpenHaptics' joint "
                              "angles (rad) and joint torques (mN m), for HD_CURRENT_JOINT_TORQUE")
     add_plot_option(excite, "the trajectory's angles, rates and torques (in the report's terms) with the stops and "
                             "the joint torque limits")
+
+
+def _add_identify(sub: argparse._SubParsersAction) -> None:
+    """identify's options, its defaults identify()'s."""
     identify = sub.add_parser("identify", help="identify the device's parameters from a log (CSV) "
                                                "into a --params overlay (YAML)")
     identify.set_defaults(run=identify_command, options={"path": "LOG", "cutoff": "--cutoff",
@@ -168,33 +192,35 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     identify.add_argument("--topic", default=None,
                           help="the bag's sensor_msgs/JointState topic (default: the driver's, or the bag's only one)")
     identify.add_argument("--output", "-o", required=True, type=Path, action=Once)
-    identify.add_argument("--cutoff", type=float, default=20.0, help="low-pass cutoff in Hz (default 20)")
-    identify.add_argument("--torque-timing", choices=("held", "sampled"), default=None,
+    identify.add_argument("--cutoff", type=float, default=IDENTIFY["cutoff"],
+                          help=f"low-pass cutoff in Hz (default {IDENTIFY['cutoff']:g})")
+    identify.add_argument("--torque-timing", choices=("held", "sampled"), default=IDENTIFY["timing"],
                           help="held: each logged torque is a command applied until the next sample (a servo "
                                "loop's); sampled: the torque at that instant (a sensor, or a model); default: "
                                "chosen from the log on held-out quarters of it (held unless sampled fits them "
                                "better; docs/identification.md, step 4)")
-    identify.add_argument("--min-speed", type=float, default=None, metavar="RAD_PER_S",
+    identify.add_argument("--min-speed", type=float, default=IDENTIFY["min_speed"], metavar="RAD_PER_S",
                           help="fit a joint's torques only where its rate stays above this over the filter's span "
                                "(near rest a joint sticks; default: chosen from the log of "
-                               + ", ".join(f"{v:g}" for v in selection.MIN_SPEEDS) + " rad/s on held-out quarters "
+                               + ", ".join(f"{v:g}" for v in MIN_SPEEDS) + " rad/s on held-out quarters "
                                "of it, docs/identification.md, step 4)")
-    identify.add_argument("--reference", type=Path, default=None, metavar="TRAJ.csv",
+    identify.add_argument("--reference", type=Path, default=IDENTIFY["reference"], metavar="TRAJ.csv",
                           help="the trajectory the servo loop tracked (excite's CSV in the log's --convention, read "
                                "from the log's start): the log is a closed loop on it, identified with instrumental "
                                "variables against the noise the loop feeds back into the motion")
     identify.add_argument("--fixed-gains", action="store_true",
                           help="take the log's torques as they are (default: estimate each joint's torque gain "
                                "relative to joint 1, correct the model for it and report it)")
-    identify.add_argument("--delay", default=None, metavar="SECONDS",
+    identify.add_argument("--delay", default=IDENTIFY["delay"], metavar="SECONDS",
                           help="how long after the positions they belong to the torques were logged, s (default: "
                                "estimated from the log, between -5 and +5 ms); corrected for in the fit")
-    identify.add_argument("--structure", choices=("general", "report"), default="general",
+    identify.add_argument("--structure", choices=("general", "report"), default=IDENTIFY["structure"],
                           help="general: the rigid body in full, every identifiable base parameter (default); "
                                "report: the report's eight constants (a model in the report's form)")
-    identify.add_argument("--prior-spread", type=float, default=prior.SPREAD,
+    identify.add_argument("--prior-spread", type=float, default=IDENTIFY["prior_spread"],
                           help="how far the device may lie from the configuration you pass (the prior), as a "
-                               "relative standard deviation of every physical parameter (default 0.3, at most 1e6); "
+                               "relative standard deviation of every physical parameter (default "
+                               f"{IDENTIFY['prior_spread']:g}, at most 1e6); "
                                "what the log does not excite comes from the prior; inf: the log alone")
     identify.add_argument("--force", "-f", action="store_true", help="overwrite an existing --output file")
     identify.add_argument("--accept", action="store_true",
@@ -230,7 +256,7 @@ def excite_command(args: argparse.Namespace) -> int:
     times = np.arange(rows) / args.rate
     bar = Progress("excite", 1.0, enabled=False if args.quiet else None)
     try:
-        result = excitation.optimise(phantom, args.period, args.harmonics, iterations=args.iterations,
+        result = optimise(phantom, args.period, args.harmonics, iterations=args.iterations,
                                      restarts=args.restarts, seed=args.seed, times=times, progress=bar.update)
     except RuntimeError as error:
         raise PhantomPinError(str(error)) from None
@@ -240,12 +266,12 @@ def excite_command(args: argparse.Namespace) -> int:
     theta, dtheta, ddtheta = result.trajectory(t)
     tau = phantom.inverse_dynamics(theta, dtheta, ddtheta) + made.config.actuation.friction.torque(dtheta)
     peak = np.abs(tau).max(axis=0)
-    effort = excitation.continuous_effort(made)
+    effort = continuous_effort(made)
     page = None if plot is None else _plot(args, made, result, (t, theta, dtheta, tau), effort)
     if args.convention == "openhaptics":  # a linear map: rates and accelerations as angles
         theta, dtheta, ddtheta = (conventions.openhaptics_from_theta(x) for x in (theta, dtheta, ddtheta))
         tau = conventions.openhaptics_torque_from_tau(tau)
-    files = [(args.output, csv_text(list(io.TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
+    files = [(args.output, csv_text(list(TRAJECTORY_COLUMNS), np.column_stack([t, theta, dtheta, ddtheta, tau]),
                                     made.config.name, args.convention), "--output")]
     write_texts(files + ([] if plot is None or page is None else [(plot, page, "--plot")]))  # all or none
     if plot is not None and page is not None:
@@ -288,7 +314,7 @@ def _check_excitation(args: argparse.Namespace) -> None:
                               f"(about {MAX_ROWS * 13 * 8 / 1e9:.1f} GB in memory)")
 
 
-def _plot(args: argparse.Namespace, made: Description, result: excitation.Excitation,
+def _plot(args: argparse.Namespace, made: Description, result: Excitation,
           samples: tuple[np.ndarray, ...], effort: np.ndarray) -> str:
     """excite's --plot page: ``samples`` (t s, theta rad, dtheta rad/s, tau N m, in the report's
     terms) with the stops and ``effort``, the joint torque limits (N m) the optimisation kept to."""
@@ -316,8 +342,8 @@ def identify_command(args: argparse.Namespace) -> int:
     given = overrides(args)
     made = description(args, given)
     if recording is not None and made.config.gimbal is not None:
-        given = {**given, **_held_stylus(recording.gimbal)}    # the stylus's load at the bag's gimbal angles
-        made = description(args, given)
+        made = held(made, recording.stylus())   # the stylus's load at the bag's gimbal angles
+        given = {**given, **stylus_keys(made.config)}   # the overlay carries the posture it was fitted at
     phantom = Phantom(made)
     if args.static:
         return _static_command(args, phantom, recording, given)
@@ -325,7 +351,7 @@ def identify_command(args: argparse.Namespace) -> int:
     delay = _delay(args.delay)
     if recording is None:
         check_record(args.log, phantom.config.name, args.convention, "LOG")
-    log = io.read_log(args.log, args.convention) if recording is None else recording.log
+    log = read_log(args.log, args.convention) if recording is None else recording.log
     for line in [] if recording is None else recording.lines():
         print(line)
     bar = Progress("identify", 1.0, enabled=False if args.quiet else None)
@@ -359,7 +385,7 @@ def _check_fit(args: argparse.Namespace, phantom: Phantom, given: dict) -> None:
 
 def _write_fit(args: argparse.Namespace, result: Identification, phantom: Phantom, report: Path | None) -> None:
     """identify's overlay and --report page (both written, or neither), each reported."""
-    page = None if report is None else identification_page.report_page(result, phantom.config.name)
+    page = None if report is None else report_page(result, phantom.config.name)
     # --output and --report checked above, before any work; both written, or neither
     write_texts([(args.output, result.text(), "--output")] + ([] if page is None or report is None else
                                                               [(report, page, "--report")]))

@@ -36,7 +36,7 @@ from phantom_pin.dynamics import verification
 from phantom_pin.dynamics.loader import load
 from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import LogError, PhantomPinError
-from phantom_pin.identification import io
+from phantom_pin.identification.data import io
 
 THREE = {"nargs": 3, "type": float}
 #: The columns show --trajectory reads (s, rad: the report's theta), and a stylus gimbal's

@@ -108,7 +108,7 @@ class Description:
     take it, and everything else the Phantom made of it (``Device(phantom)``, the identification,
     the viewer's ``load``) or, in the CLI, the Description itself. It is immutable; what a
     consumer computes once per description lives with that consumer, keyed by it
-    (phantom_pin.identification.cache).
+    (phantom_pin.identification.structure.cache).
     """
 
     config: Config

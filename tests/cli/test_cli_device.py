@@ -97,7 +97,7 @@ def _trajectory(path, degrees=(), milliseconds=False, openhaptics=False):
     """A smooth 3 s trajectory inside the stops at 1 kHz with its exact derivatives and the
     report model's torque (N m), written as excite writes it; optionally with a unit slip."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import io
+    from phantom_pin.identification.data import io
     from phantom_pin.interfaces import conventions
 
     t = np.arange(3001) / 1000.0

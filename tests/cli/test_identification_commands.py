@@ -8,8 +8,8 @@ import yaml
 from helpers import CONFIG, CONFIG_DIR, REPORT, T10, model_torques, recorded_trajectory, sines
 from phantom_pin import Phantom, closed_form, describe
 from phantom_pin.cli import main
-from phantom_pin.identification import io
-from phantom_pin.identification.excitation import continuous_effort
+from phantom_pin.identification.data import io
+from phantom_pin.identification.fitting.excitation import continuous_effort
 
 DESCRIPTION = describe()
 EFFORT = continuous_effort(DESCRIPTION)   # N m at the joints
@@ -116,7 +116,7 @@ def test_excitation_respects_a_tight_torque_limit():
     """With 20 % of the continuous torque allowed the constraint is active; the torques,
     computed independently (closed form + the friction law), stay below it between the
     optimiser's samples too (2 % slack)."""
-    from phantom_pin.identification import excitation
+    from phantom_pin.identification.fitting import excitation
     from phantom_pin.report import closed_form
 
     result = excitation.optimise(Phantom(DESCRIPTION), torque_share=0.2, iterations=10, restarts=1)
@@ -182,7 +182,8 @@ def test_the_excitation_holds_its_bounds_at_every_written_sample():
     """optimise() samples a period at 12 points only here; between them its optimum leaves the
     stops by 1.2 rad. Checked at the 5000 samples the file will hold, the returned trajectory
     keeps the 0.05 rad margin and the 80 % torque share at every one of them."""
-    from phantom_pin.identification import constants, excitation
+    from phantom_pin.identification.fitting import excitation
+    from phantom_pin.identification.structure import constants
 
     times = np.arange(5000) / 1000.0
     result = excitation.optimise(Phantom(DESCRIPTION), 5.0, 5, samples=12, iterations=40, restarts=1, seed=3,
@@ -327,7 +328,7 @@ def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(t
     OpenHaptics' mN m)."""
     import time
 
-    from phantom_pin.identification import io
+    from phantom_pin.identification.data import io
 
     for units, convention in (("N m", "report"), ("Nm", "report"), ("N*m", "report"), ("mN m", "openhaptics")):
         _log(tmp_path / "ok.csv", units)
@@ -348,7 +349,8 @@ def test_a_log_whose_header_says_another_torque_unit_is_refused_before_any_fit(t
 def test_identify_passes_min_speed_to_the_fit(tmp_path, monkeypatch):
     """identify hands --min-speed to the fit (a spy in place of estimate)."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import io, result
+    from phantom_pin.identification.data import io
+    from phantom_pin.identification.verdict import result
 
     phantom = Phantom()
     theta, dtheta, ddtheta = sines(T10)
@@ -369,7 +371,7 @@ def test_identify_accept_warns_on_stderr(tmp_path, cli):
     on stdout. The model's own torques with tau3 2.5 times too small: a gain outside 0.5-2 (a
     problem --accept writes anyway)."""
     from phantom_pin import Phantom
-    from phantom_pin.identification import io
+    from phantom_pin.identification.data import io
 
     phantom = Phantom()
     theta, dtheta, ddtheta = sines(T10)

@@ -25,9 +25,11 @@ from phantom_pin.config.types import JOINTS, Friction
 from phantom_pin.description.build import describe, driver_urdf
 from phantom_pin.device.plant import Plant
 from phantom_pin.exceptions import InvalidInputError, ParameterFileError
-from phantom_pin.identification import Identification, constants, estimation, overlay
-from phantom_pin.identification import io as logs
-from phantom_pin.identification.structures import General, Report
+from phantom_pin.identification import Identification, overlay
+from phantom_pin.identification.data import io as logs
+from phantom_pin.identification.fitting import estimation
+from phantom_pin.identification.structure import constants
+from phantom_pin.identification.structure.structures import General, Report
 
 #: Per joint, joint1..joint3: viscous (N m s/rad) and Coulomb (N m), written in the YAML below.
 VISCOUS = (4.0e-4, 7.0e-4, 1.2e-3)

@@ -27,8 +27,8 @@ from phantom_pin import (
 from phantom_pin.cli import main
 from phantom_pin.config import MODELS, read_overrides
 from phantom_pin.config.sampling import sample_postures
-from phantom_pin.identification import io, simulation
-from phantom_pin.identification import parameterization as pz
+from phantom_pin.identification.data import io, simulation
+from phantom_pin.identification.structure import parameterization as pz
 from phantom_pin.interfaces import conventions
 from references import touch as touch_reference
 from references.gimbal import gimbal_gravity, gimbal_mass_matrix

@@ -348,7 +348,7 @@ def test_every_road_to_a_named_model_is_one_description():
     from phantom_pin import Device
     from phantom_pin.config import DEFAULT
     from phantom_pin.description.build import description_of, shipped
-    from phantom_pin.identification import cache
+    from phantom_pin.identification.structure import cache
 
     first = Phantom().description
     assert all(d is first for d in (Phantom.from_model(DEFAULT).description, shipped(), shipped(DEFAULT),
