@@ -6,7 +6,7 @@ and the report-structure fits on a device NOT of the report's structure.
 
     python benchmarks/bench_identification.py
 
-The device is tests/identification/verdict/test_general_structure.py's (its numbers, not copied: imported).
+The device is tests/identification/structure/test_structures.py's (its numbers, not copied: imported).
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from pathlib import Path
 import numpy as np
 
 TESTS = Path(__file__).resolve().parents[1] / "tests"
-sys.path[:0] = [str(TESTS / folder) for folder in ("identification/verdict", ".")]
+sys.path[:0] = [str(TESTS / "identification" / "structure"), str(TESTS)]
 
-from test_general_structure import COULOMB, DEVICE, NOISE, VISCOUS  # noqa: E402
+from test_structures import COULOMB, DEVICE, NOISE, VISCOUS  # noqa: E402
 
 from phantom_pin import Device, Phantom, describe  # noqa: E402
 from phantom_pin.cli import main  # noqa: E402

@@ -107,7 +107,7 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 
 #: Tests kept on one pytest-xdist worker, in the order collected (pyproject's addopts: -n auto
 #: --dist loadgroup; every other test is handed out one by one): a group name for each test
-#: whose node id contains the key (a test file's name, unique in tests/). A module whose
+#: whose node id contains the key (a test file's path under tests/). A module whose
 #: module-scoped fixture (or a cache of its helpers, shared with another module) is expensive
 #: computes it once, not once per worker
 #: (codegen/test_generate.py, test_servo.py and cli/test_codegen.py: their headers, generated once per
@@ -115,25 +115,25 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 #: references.cad and phantom_pin.report.derivation); the ROS 2 node tests over loopback run one
 #: at a time.
 GROUPS = {
-    "/test_general_structure.py::": "identification_general",
-    "/test_prior.py::": "lab_log",
-    "/test_timing.py::": "lab_log",
-    "/test_end_to_end.py::": "identification_end_to_end",
-    "/test_instruments.py::": "instruments",        # closed_loop(): 60 s simulated, 2-3 s
-    "/test_bags.py::": "bags",                      # report_csv: an identify
-    "/test_viewer.py::": "viewer",                          # two meshcat servers and their robots
-    "/test_srdf.py::": "srdf",                         # each model's collision geometry
-    "/test_interop.py::": "interop",                   # each model's Drake plant
-    "/test_gazebo.py::": "gazebo",
-    "/test_generate.py::": "codegen",
-    "/test_servo.py::": "codegen",
-    "/test_codegen.py::": "codegen",
-    "/test_stand_in.py::": "stand_in",                 # each model's stand-in and programs, built once
-    "/test_cad_model.py::": "cad_model",
-    "/test_derivation.py::": "derivation",
-    "/test_node.py::test_the_node_": "ros2",
-    "/test_drivers_ros2.py::test_the_stylus_floats": "ros2",
-    "/test_drivers_ros2.py::test_without_the_node": "ros2",
+    "identification/structure/test_structures.py::": "identification_general",
+    "identification/structure/test_prior.py::": "lab_log",
+    "identification/data/test_timing.py::": "lab_log",
+    "identification/verdict/test_result.py::": "identification_end_to_end",
+    "identification/fitting/test_instruments.py::": "instruments",  # closed_loop(): 60 s simulated, 2-3 s
+    "identification/data/test_bags.py::": "bags",                   # report_csv: an identify
+    "viewer/test_viewer.py::": "viewer",                            # two meshcat servers and their robots
+    "description/test_srdf.py::": "srdf",                           # each model's collision geometry
+    "integration/test_interop.py::": "interop",                     # each model's Drake plant
+    "integration/test_gazebo.py::": "gazebo",
+    "codegen/test_generate.py::": "codegen",
+    "codegen/test_servo.py::": "codegen",
+    "cli/test_codegen.py::": "codegen",
+    "openhaptics/test_stand_in.py::": "stand_in",                   # each model's stand-in and programs, built once
+    "config/test_cad_model.py::": "cad_model",
+    "report/test_derivation.py::": "derivation",
+    "ros2/test_node.py::test_the_node_": "ros2",
+    "integration/test_drivers_ros2.py::test_the_stylus_floats": "ros2",
+    "integration/test_drivers_ros2.py::test_without_the_node": "ros2",
 }
 
 def group(nodeid: str) -> str | None:

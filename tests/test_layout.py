@@ -1,17 +1,12 @@
 """The tests' shape: tests/ mirrors the package, one test file per module with logic
 (phantom_pin/<a>/<b>.py: tests/<a>/test_<b>.py; the root's phantom_pin/_x.py: tests/test_x.py),
-no test file imports another (what they share is in helpers.py, conftest.py's fixtures and the
-references package), and no two test files share a name (pytest's default import mode puts each
-test file's own folder on sys.path: two test_x.py would be one module).
-
-A module name two modules of the package share takes its folder's name too, the mirror named
-after the module's package: cli/feel.py's tests/cli/test_cli_feel.py, device/feel.py's
-tests/device/test_device_feel.py (device/device.py's stays tests/device/test_device.py).
+and no test file imports another (what they share is in helpers.py, conftest.py's fixtures and
+the references package; pytest imports test files by path, --import-mode=importlib, so
+tests/cli/test_feel.py and tests/device/test_feel.py are two modules).
 
 Read from the files (pathlib and ast), as tests/test_imports.py reads the package."""
 
 import ast
-from collections import Counter
 from pathlib import Path
 
 import phantom_pin
@@ -25,7 +20,7 @@ TESTS = Path(__file__).resolve().parent
 EXEMPT = {
     "_paths.py": "constants alone (where the description folder and the driver profiles are)",
     # No test of its own yet (issue 51, item 5): each is exercised through the tests named.
-    "_integration.py": "no test of its own: device/test_device_plant.py checks the plant's RK4 step",
+    "_integration.py": "no test of its own: device/test_plant.py checks the plant's RK4 step",
     "_validation.py": "no test of its own: every public function's bad-input tests (dynamics/test_fast.py)",
     "codegen/c.py": "no test of its own: codegen/test_generate.py compiles and runs its C text",
     "codegen/tree.py": "no test of its own: codegen/test_generate.py, the header of every model",
@@ -33,7 +28,7 @@ EXEMPT = {
     "description/mjcf.py": "no test of its own: describe()'s MJCF in MuJoCo (config/test_reader.py, "
                            "config/test_friction_per_joint.py, device/test_mujoco_plant.py)",
     "description/urdf.py": "no test of its own: the URDF's readers (description/test_gimbal.py and others)",
-    "device/controllers.py": "no test of its own: cli/test_cli_device.py's tracking simulate",
+    "device/controllers.py": "no test of its own: cli/test_device.py's tracking simulate",
     "dynamics/build.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py, test_loader.py)",
     "dynamics/pinocchio_models.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py)",
     "interfaces/openhaptics/plant.py": "no test of its own: the stand-in runs it (openhaptics/test_stand_in.py)",
@@ -54,15 +49,9 @@ def _modules() -> list[Path]:
 
 
 def mirror(module: Path) -> Path:
-    """The test file of a module (relative to tests/): test_<name>.py in the module's folder, its
-    package's name in front where another module shares the name (the leading underscore of a
-    private module left off)."""
-    shared = Counter(path.stem for path in _modules())
-    stem = module.stem.lstrip("_")
-    parent = module.parent.name
-    if shared[module.stem] > 1 and parent and parent != stem:
-        stem = f"{parent}_{stem}"
-    return module.parent / f"test_{stem}.py"
+    """The test file of a module (relative to tests/): test_<name>.py in the module's folder (the
+    leading underscore of a private module left off)."""
+    return module.parent / f"test_{module.stem.lstrip('_')}.py"
 
 
 def _test_files() -> list[Path]:
@@ -98,8 +87,3 @@ def test_no_test_file_imports_another():
              if path.relative_to(TESTS).parts[0] not in EXEMPT_IMPORTS}
     wrong = {path: names for path, names in wrong.items() if names}
     assert not wrong, wrong
-
-
-def test_every_test_file_name_is_unique():
-    counts = Counter(path.name for path in _test_files())
-    assert not [name for name, n in counts.items() if n > 1], counts.most_common(3)

@@ -197,7 +197,7 @@ def driver_urdf(model: str | Path, *, prefix: str = "",
 
 def shipped(model: str = configuration.DEFAULT) -> Description:
     """A named model with its committed URDF, SRDF and MJCF files (which
-    tests/description/test_description_build.py shows equal to describe(model)), read once per process:
+    tests/description/test_build.py shows equal to describe(model)), read once per process:
     every road to a named model (Phantom(), Phantom.from_model, shipped(), a CLI command) gets
     this one Description, so what is cached beside it (identification.cache) is computed once.
     InvalidInputError naming ``model`` for anything but a model's name."""

@@ -257,7 +257,7 @@ def workspace_volume(device: Device, nodes: int = QUADRATURE_NODES) -> float:
     """The volume (m^3) the tip sweeps over the postures inside the stops: the integral of
     |det J| over that region of joint space (J the tip Jacobian; the map is one-to-one there,
     which a Monte Carlo count of the points Device.reachable says the tip reaches confirms:
-    tests/device/test_device_feel.py). det J does not depend on theta1 (a turn of frame s's vertical
+    tests/device/test_feel.py). det J does not depend on theta1 (a turn of frame s's vertical
     axis), so the integral is theta1's range times a 2-D integral over (theta2, theta3): the
     stops' polygon, cut where its edges change, each piece by Gauss-Legendre with ``nodes``
     points along theta2 and along theta3."""

@@ -33,7 +33,7 @@ from phantom_pin.dynamics.phantom import solve_spd
 #: undamped stops (1e3, 1e4 N m/rad) within 5e-7 rad of 8 times the substeps.
 OSCILLATION_SCALE, DAMPING_SCALE = 0.3, 0.7
 #: Longest RK4 step (s) whatever the stiff terms: the free rigid body integrated at 1 ms is
-#: within 3e-11 rad of a 0.1 ms integration over 0.15 s (tests/device/test_device_simulation.py).
+#: within 3e-11 rad of a 0.1 ms integration over 0.15 s (tests/device/test_simulation.py).
 MAX_STEP = 1e-3
 #: An event (a stop engages or releases; a joint reverses, stops or breaks away) is located by
 #: regula falsi (Illinois) on its function, at most EVENT_ITERATIONS RK4 steps, to

@@ -113,7 +113,7 @@ class Phantom:
     @classmethod
     def from_model(cls, model: str) -> Phantom:
         """The named model ``model`` (phantom_pin.models()), from its committed URDF and SRDF
-        (equal to describe(model)'s, tests/description/test_description_build.py; the one Description
+        (equal to describe(model)'s, tests/description/test_build.py; the one Description
         of shipped(model), Phantom()'s for the default). InvalidInputError naming ``model`` for
         anything else."""
         if not (isinstance(model, str) and model in MODELS):

@@ -90,7 +90,7 @@ def links(p: ReportParameters, unprinted: Unprinted, rotor_inertia: float,
     (the forearm pin, at l1 along the bar), its vertical moment out of turret_link, so that
     the 3-DoF dynamics stay the report's exactly: inertial.carve, the one carving (for a model
     in full too), whose numbers are those of the xacro that generated the shipped URDF before
-    links were described in full, to the last bit (tests/description/test_description_build.py).
+    links were described in full, to the last bit (tests/description/test_build.py).
     """
     l1, l2, l3 = p.l1, p.l2, p.l3
     pin_xx, pin_yy, pin_zz = unprinted.pin_inertia

@@ -23,8 +23,8 @@ RUN = {"python", "bash"}
 #: be counted here on purpose (and a runnable block must not hide among them).
 NOT_RUN = {"bash-ci": 2,       # the README's quick start: .ci/run runs it (checked below)
            "bash-norun": 7,    # needs a device, a ROS 2 install or a driver; phantom-pin lines parsed;
-                               # docs/feel.md's reproduction (tests/device/test_device_feel.py and
-                               # tests/cli/test_cli_feel.py check what it prints)
+                               # docs/feel.md's reproduction (tests/device/test_feel.py and
+                               # tests/cli/test_feel.py check what it prints)
            "python-norun": 2,  # the relay (the driver's omni_msgs); a pyOpenHaptics callback (a device,
                                # or the stand-in: tests/interfaces/openhaptics/test_compensator.py runs it)
            "c": 2,             # the lines inside an OpenHaptics servo callback (examples/openhaptics_gravity.c)

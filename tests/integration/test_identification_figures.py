@@ -1,7 +1,7 @@
 """benchmarks/identification_figures.py --quick on its clean row: the CAD-built Premium 1.5,
 identified on the shipped model from excite's trajectory (20 s, instantaneous torques, no
 noise), judged against bounds from elsewhere: the prior's error recomputed here, and the
-accuracy tests/identification/test_general_structure.py documents for a NOISY log of a device of the
+accuracy tests/identification/structure/test_structures.py documents for a NOISY log of a device of the
 same kind (0.068 % on 500 states, friction within 1.3 %): a clean log must do at least as well."""
 
 import os

@@ -61,8 +61,8 @@ def kernel_sensitive() -> dict:
 
 
 #: The child process: kernel_sensitive() as JSON on stdout.
-CHILD = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); import test_kernels; "
-         "json.dump(test_kernels.kernel_sensitive(), sys.stdout)")
+CHILD = (f"import json, sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); import test_blas; "
+         "json.dump(test_blas.kernel_sensitive(), sys.stdout)")
 
 
 def _other_kernel(here: str) -> str:
