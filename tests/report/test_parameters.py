@@ -49,13 +49,13 @@ def test_the_links_are_the_reports_bodies_in_base_links_axes():
 def test_the_rotors_move_to_the_armature():
     """J r_i^2 leaves the turret's vertical moment (r_1), BE's and DF's moment about the
     shoulder axis (r_2, r_3), and nothing else (1e-18 kg m^2)."""
-    j = 1e-6
-    with_rotors, without = links(P, NO_PIN, j, RATIOS), links(P, NO_PIN, 0.0, RATIOS)
+    j, ratios = 1e-6, (13.0, 11.0, 9.0)            # three ratios apart (the shipped r_2 = r_3)
+    with_rotors, without = links(P, NO_PIN, j, ratios), links(P, NO_PIN, 0.0, ratios)
     moved = {name: np.subtract(without[name].inertia, with_rotors[name].inertia) for name in without}
     expected = dict.fromkeys(without, np.zeros(6))
-    expected["turret_link"] = np.array([0, 0, 0, 0, 0, j * RATIOS[0] ** 2])
-    expected["upper_arm_link"] = np.array([0, 0, 0, j * RATIOS[1] ** 2, 0, 0])
-    expected["crank_link"] = np.array([0, 0, 0, j * RATIOS[2] ** 2, 0, 0])
+    expected["turret_link"] = np.array([0, 0, 0, 0, 0, j * ratios[0] ** 2])
+    expected["upper_arm_link"] = np.array([0, 0, 0, j * ratios[1] ** 2, 0, 0])
+    expected["crank_link"] = np.array([0, 0, 0, j * ratios[2] ** 2, 0, 0])
     for name in without:
         np.testing.assert_allclose(moved[name], expected[name], rtol=0, atol=1e-18, err_msg=name)
 
