@@ -8,8 +8,17 @@ import numpy as np
 import pytest
 
 from phantom_pin import InvalidInputError, PhantomPinError
-from phantom_pin._validation import (as_state, as_states, finite_result, fixed_rate, output_path, same_batch,
-                                     uneven, within_box, wrap_angle)
+from phantom_pin._validation import (
+    as_state,
+    as_states,
+    finite_result,
+    fixed_rate,
+    output_path,
+    same_batch,
+    uneven,
+    within_box,
+    wrap_angle,
+)
 
 
 def test_states_keep_their_shape_and_batch_axes():

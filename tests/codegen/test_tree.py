@@ -11,7 +11,6 @@ import yourdfpy
 from phantom_pin import ParameterFileError, config
 from phantom_pin.codegen.tree import ARM_JOINTS, read_tree
 
-
 GIMBAL = ("joint4", "joint5", "joint6")
 
 
@@ -63,7 +62,8 @@ def test_the_joints_it_does_not_cover_are_refused():
     """A prismatic joint, a joint that mimics no arm joint: ParameterFileError naming the joint;
     a revolute one mimicking joint1 is its coordinate 0 with its multiplier, the axis
     normalised (0 0 2 -> 0 0 1), origin and axis defaults 0 0 0 and 1 0 0."""
-    with pytest.raises(ParameterFileError, match="^joint slide: codegen covers revolute and fixed joints, not prismatic"):
+    with pytest.raises(ParameterFileError, match="^joint slide: codegen covers revolute and fixed joints, "
+                                                   "not prismatic"):
         read_tree(URDF.format(kind="prismatic", mimic=""), "", ("joint1",))
     with pytest.raises(ParameterFileError, match="^joint slide: codegen covers the joints joint1 .*not elbow"):
         read_tree(URDF.format(kind="revolute", mimic='<mimic joint="elbow"/>'), "", ("joint1",))

@@ -9,8 +9,14 @@ import pinocchio as pin
 import pytest
 
 from phantom_pin import config, describe
-from phantom_pin.dynamics.build import (build_model, gravity_of, has_rotors, load_rotor_parameters, rooted_at,
-                                        rooted_at_frame)
+from phantom_pin.dynamics.build import (
+    build_model,
+    gravity_of,
+    has_rotors,
+    load_rotor_parameters,
+    rooted_at,
+    rooted_at_frame,
+)
 
 DESCRIPTION = describe()
 
@@ -53,7 +59,8 @@ def test_the_rotors_armature_is_rotor_inertia_times_ratio_squared():
 def test_a_model_rooted_at_a_frame_is_the_original_seen_from_it():
     """rooted_at(model, X): every frame's world pose is X times the original's (1e-12) at seeded
     angles; gravity rotated alike, so the joint torques of inverse dynamics are the same (1e-12
-    N m), also rooted twice (at x, then at y: at y x); rooted_at_frame puts its frame at the origin at the neutral configuration."""
+    N m), also rooted twice (at x, then at y: at y x); rooted_at_frame puts its frame at the
+    origin at the neutral configuration."""
     model = build_model(DESCRIPTION.urdf, DESCRIPTION.config)
     x = pin.SE3(pin.rpy.rpyToMatrix(0.3, -0.5, 1.1), np.array([0.1, -0.2, 0.3]))
     y = pin.SE3(pin.rpy.rpyToMatrix(-0.7, 0.2, 0.4), np.array([-0.3, 0.05, 0.2]))
