@@ -1,6 +1,6 @@
-"""The regressor in the report's coordinates against Phantom.inverse_dynamics, and the
-report parameters' affine map (computed from the configuration alone) against the URDF that
-describe() generates through xacro and Pinocchio reads."""
+"""The regressor in the report's coordinates against Phantom.inverse_dynamics: its friction
+columns, its batch and single states, the known parameters' zero torque, what each column is
+(the report parameters' affine map against the generated URDF: test_parameterization.py)."""
 
 import numpy as np
 import pytest
