@@ -19,22 +19,7 @@ TESTS = Path(__file__).resolve().parent
 #: the command line's tests run them).
 EXEMPT = {
     "_paths.py": "constants alone (where the description folder and the driver profiles are)",
-    # No test of its own yet (issue 51, item 5): each is exercised through the tests named.
-    "_integration.py": "no test of its own: device/test_plant.py checks the plant's RK4 step",
-    "_validation.py": "no test of its own: every public function's bad-input tests (dynamics/test_fast.py)",
-    "codegen/c.py": "no test of its own: codegen/test_generate.py compiles and runs its C text",
-    "codegen/tree.py": "no test of its own: codegen/test_generate.py, the header of every model",
-    "description/mimic.py": "no test of its own: dynamics/test_coupling.py reads the mimic tags",
-    "description/mjcf.py": "no test of its own: describe()'s MJCF in MuJoCo (config/test_reader.py, "
-                           "config/test_friction_per_joint.py, device/test_mujoco_plant.py)",
-    "description/urdf.py": "no test of its own: the URDF's readers (description/test_gimbal.py and others)",
-    "device/controllers.py": "no test of its own: cli/test_device.py's tracking simulate",
-    "dynamics/build.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py, test_loader.py)",
-    "dynamics/pinocchio_models.py": "no test of its own: Phantom's and load's models (dynamics/test_phantom.py)",
-    "interfaces/openhaptics/plant.py": "no test of its own: the stand-in runs it (openhaptics/test_stand_in.py)",
-    "interfaces/openhaptics/protocol.py": "no test of its own: the stand-in's records (openhaptics/test_stand_in.py)",
     "report/appendix.py": "the appendix's printed torques, the reference report/test_closed_form.py checks against",
-    "report/parameters.py": "no test of its own: the report's numbers (config/test_builders.py)",
 }
 #: The subpackages another change restructures.
 EXEMPT_PACKAGES: dict[str, str] = {}

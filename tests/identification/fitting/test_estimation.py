@@ -244,17 +244,12 @@ def test_the_identification_api_checks_its_input(tmp_path):
 
 
 @pytest.mark.parametrize("call, argument", [
-    (lambda: excitation_optimise(period=-1.0), "period"), (lambda: excitation_optimise(harmonics=1), "harmonics"),
-    (lambda: excitation_optimise(harmonics=2.5), "harmonics"), (lambda: excitation_optimise(margin=np.nan), "margin"),
-    (lambda: excitation_optimise(torque_share=-1.0), "torque_share"),
-    (lambda: excitation_optimise(restarts=0), "restarts"),
-    (lambda: excitation_optimise(seed=-1), "seed"), (lambda: excitation_optimise(times=[np.nan]), "times"),
     (lambda: io.read_log(None), "path"), (lambda: io.Log(np.arange(10.0), np.zeros((9, 3)), np.zeros((10, 3))), "log"),
     (lambda: io.Log(np.arange(10.0)[::-1], np.zeros((10, 3)), np.zeros((10, 3))), "log"),
     (lambda: estimation.estimate(log(end=3.0), PHANTOM, cutoff=1e-9), "cutoff"),
     (lambda: estimation.estimate(log(end=3.0), PHANTOM, progress=5), "progress"),
 ])
-def test_the_excitation_and_the_log_check_their_arguments(call, argument):
+def test_the_log_checks_its_arguments(call, argument):
     """Each bad argument a new user tried (a review): one PhantomPinError and ValueError naming
     it, before any work (before: LinAlgError, TypeError, RuntimeError, a silent result)."""
     from phantom_pin import PhantomPinError
@@ -262,11 +257,6 @@ def test_the_excitation_and_the_log_check_their_arguments(call, argument):
     with pytest.raises(PhantomPinError, match=f"^{argument}: ") as error:
         call()
     assert isinstance(error.value, ValueError)
-
-
-def excitation_optimise(**kwargs):
-    from phantom_pin.identification.fitting import excitation
-    return excitation.optimise(PHANTOM, **kwargs)
 
 
 # -- each threshold against a log built here with a known truth (helpers.sines) ----------------

@@ -18,7 +18,7 @@ from helpers import LAB_RATE as RATE
 from phantom_pin import Device, Phantom, describe
 from phantom_pin.config.sampling import random_states
 from phantom_pin.identification.data import io, simulation
-from phantom_pin.identification.fitting import estimation, excitation, least_squares, prediction
+from phantom_pin.identification.fitting import estimation, excitation, prediction
 from phantom_pin.identification.structure.structures import General
 
 PRIOR = lab_prior()
@@ -190,46 +190,6 @@ def test_the_cad_device_identified_on_the_report_model_is_never_worse_than_the_p
     assert narrow.problems == () and wide.problems == ()
 
 
-def test_the_estimate_with_the_prior_is_the_gauss_markov_formula():
-    """least_squares.fit with a prior (beta_0, P) against the textbook formula on a seeded problem,
-    beta = (A + P^-1)^-1 (Phi_w^T y_w / s^2 + P^-1 beta_0), covariance (A + P^-1)^-1, A the log's
-    information (its own output, checked as Phi_w^T Phi_w / s^2 by the log alone's covariance):
-    within 1e-9; a prior 1e6 times looser gives the log alone's beta within 1e-6 of its standard
-    deviations, one 1e-6 times tighter the prior's within 1e-6 of the prior's."""
-    rng = np.random.default_rng(2)
-    phi = rng.normal(size=(200, 3, 5))
-    truth = rng.normal(size=5)
-    y = phi @ truth + rng.normal(size=(200, 3)) * [0.1, 0.2, 0.05]
-    root = rng.normal(size=(5, 5))
-    spread, beta0 = root @ root.T * 0.01, truth + rng.normal(size=5) * 0.3
-    beta, covariance, _, weight, information, alone = least_squares.fit(phi, y, prior=(beta0, spread))
-    inverse = np.linalg.inv(spread)
-    log_covariance = least_squares.fit(phi, y)[1]
-    np.testing.assert_allclose(np.linalg.inv(log_covariance), information, rtol=1e-9)
-    expected = np.linalg.solve(information + inverse, information @ alone + inverse @ beta0)
-    np.testing.assert_allclose(beta, expected, rtol=1e-9)
-    np.testing.assert_allclose(covariance, np.linalg.inv(information + inverse), rtol=1e-9, atol=1e-15)
-    sigma = np.sqrt(np.diag(log_covariance))
-    loose = least_squares.fit(phi, y, prior=(beta0, spread * 1e12))[0]
-    assert (np.abs(loose - alone) < 1e-6 * sigma).all()
-    tight = least_squares.fit(phi, y, prior=(beta0, spread * 1e-12))[0]
-    np.testing.assert_allclose(tight, beta0, rtol=1e-6)
-
-
-def test_the_log_alones_covariance_is_infinite_where_it_sees_nothing():
-    """least_squares.inverse_information: the inverse of a nonsingular information (units 1e-12 to
-    1e6 apart) within 1e-9, in the units that balance its diagonal; a singular one gives inf on
-    the variance of each parameter its null direction (a + b) involves, the inverse elsewhere."""
-    rng = np.random.default_rng(4)
-    root = rng.normal(size=(3, 3)) * [1e3, 1.0, 1e-6]
-    information = root.T @ root
-    d = np.sqrt(np.diag(information))                  # compared in the units that balance it
-    scaled = (least_squares.inverse_information(information) * np.outer(d, d)) @ (information / np.outer(d, d))
-    np.testing.assert_allclose(scaled, np.eye(3), atol=1e-9)
-    v = np.array([[1, 1, 0], [1, -1, 0], [0, 0, np.sqrt(2)]]) / np.sqrt(2)
-    singular = v.T @ np.diag([0.0, 4.0, 100.0]) @ v
-    variance = np.diag(least_squares.inverse_information(singular))
-    assert np.isinf(variance[:2]).all() and variance[2] == pytest.approx(0.01, rel=1e-12)
 
 
 def test_a_prior_without_friction_lets_the_log_give_it(lab):

@@ -1,13 +1,12 @@
-"""The regressor in the report's coordinates against Phantom.inverse_dynamics, and the
-report parameters' affine map (computed from the configuration alone) against the URDF that
-describe() generates through xacro and Pinocchio reads."""
+"""The regressor in the report's coordinates against Phantom.inverse_dynamics: its friction
+columns, its batch and single states, the known parameters' zero torque, what each column is
+(the report parameters' affine map against the generated URDF: test_parameterization.py)."""
 
 import numpy as np
 import pytest
 
-from helpers import CONFIG, seeded_states
-from phantom_pin import Phantom, closed_form, describe
-from phantom_pin.dynamics.coupling import Coupling
+from helpers import seeded_states
+from phantom_pin import Phantom
 from phantom_pin.identification.structure import parameterization as pz
 from phantom_pin.identification.structure.regressor import Regressor
 
@@ -47,27 +46,6 @@ def test_single_state_equals_the_batch_row(regressor):
                                   regressor(theta, dtheta, ddtheta)[1])
 
 
-def _urdf_parameters(x: np.ndarray) -> np.ndarray:
-    """pi without friction of the URDF that describe() generates for the report parameters x:
-    Pinocchio's tree inertias, then J r_i^2."""
-    description = describe(overrides=pz.overrides(x, CONFIG))
-    tree = Coupling(description.urdf).tree
-    ratios = np.array(description.config.actuation.ratios)
-    inertial = [tree.inertias[i].toDynamicParameters() for i in range(1, tree.njoints)]
-    return np.concatenate(inertial + [x[pz.ROTOR] * ratios**2])
-
-
-def test_affine_map_reproduces_the_generated_urdf(regressor):
-    description = regressor.phantom.description
-    affine, offset = pz.affine_map(description, regressor.bodies)
-    x0 = pz.report_vector(description.config)
-    # each parameter 0.2 % below its value, another point than the map's (0.1 % above); more
-    # would leave the thin forearm rod (Izz 0.4 % of Ixx = Iyy) non-physical, which describe() refuses
-    for k in range(len(x0)):
-        x = x0.copy()
-        x[k] *= 0.998
-        urdf_pi = _urdf_parameters(x)
-        assert np.abs(affine @ x + offset - urdf_pi).max() <= 1e-12 * np.abs(urdf_pi).max(), pz.NAMES[k]
 
 
 def test_the_known_parameters_give_no_torque(regressor):
@@ -76,20 +54,6 @@ def test_the_known_parameters_give_no_torque(regressor):
     y = regressor.stacked(*seeded_states(regressor, 200, 4))
     assert np.abs(y[:, :len(offset)] @ offset).max() < 1e-12  # N m, against torques of 0.1 N m
 
-
-def test_affine_map_times_the_regressor_is_the_closed_form_at_other_parameters(regressor):
-    """Y (A x + b) is the report's closed-form inverse dynamics of x (which counts the rotors
-    inside I_bexx, I_dfxx and I_baseyy, as the report prints them), at x moved 5-15 % from the
-    shipped values, rotor inertia J included: the map splits each rotor out of its link as
-    J r^2 and back into the armature, exactly."""
-    description = regressor.phantom.description
-    affine, offset = pz.affine_map(description, regressor.bodies)
-    x = pz.report_vector(description.config) * np.random.default_rng(7).uniform(0.85, 1.15, len(pz.NAMES))
-    theta, dtheta, ddtheta = seeded_states(regressor, 200, 8)
-    pi = np.concatenate([affine @ x + offset, np.zeros(6)])      # no friction
-    tau = closed_form.inverse_dynamics(theta, dtheta, ddtheta, pz.report_parameters(x, description.config))
-    predicted = regressor(theta, dtheta, ddtheta) @ pi
-    assert np.abs(predicted - tau).max() <= 1e-11 * np.abs(tau).max()
 
 
 def test_every_column_is_what_its_name_says(regressor):
