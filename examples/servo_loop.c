@@ -4,7 +4,7 @@
  * dtheta - N(theta), the torque held over each 1 ms period (zero-order hold, as a servo
  * callback's) and integrated by one RK4 step per period (no friction, stops nor saturation:
  * simulate()'s plant with friction=False, hard_stops=False, saturation=False, substeps=1,
- * which tests/test_codegen.py runs against this program's output).
+ * which tests/codegen/test_generate.py runs against this program's output).
  *
  * Build and run (C99, only the header and <math.h>; the Premium 1.5 by default):
  *     gcc -std=c99 -O2 -I robots/phantom_description/include examples/servo_loop.c -o servo_loop -lm

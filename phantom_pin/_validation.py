@@ -11,6 +11,18 @@ import numpy as np
 from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 
 
+def _has_bool(values: object) -> bool:
+    """Whether a (nested) sequence holds a boolean anywhere: NumPy reads [1.0, True] as floats."""
+    stack = [values]
+    while stack:
+        for item in stack.pop():
+            if isinstance(item, (bool, np.bool_)):
+                return True
+            if isinstance(item, (list, tuple, np.ndarray)):
+                stack.append(item)
+    return False
+
+
 def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, bool]:
     """Return ``value`` as a float array of shape (width,) or (..., width): one state, or a
     batch with any number of leading axes (each result keeps them).
@@ -23,8 +35,8 @@ def as_states(value: object, name: str, width: int = 3) -> tuple[np.ndarray, boo
         array = np.asarray(value)
         if array.dtype.kind == "c":
             raise InvalidInputError("expected real numbers, got complex values", argument=name)
-        if array.dtype.kind == "b" or (array.dtype.kind == "O" and any(isinstance(x, (bool, np.bool_))
-                                                                        for x in array.flat)):
+        if array.dtype.kind == "b" or ((array.dtype.kind == "O" or isinstance(value, (list, tuple)))
+                                       and _has_bool(value if array.dtype.kind != "O" else array.flat)):
             raise InvalidInputError("expected real numbers, got booleans", argument=name)
         if array.dtype.kind not in "iufO":  # strings, bytes, dates
             raise TypeError(array.dtype)

@@ -37,7 +37,8 @@ def test_states_keep_their_shape_and_batch_axes():
     ([1.0, 2.0], r"shape \(3,\)"), (np.zeros((4, 2)), r"shape \(3,\)"), (1.0, r"shape \(3,\)"),
     (np.zeros((0, 3)), "at least one state"), ([[1, 2, 3], [1, 2]], "numbers"),
     ([True, False, True], "booleans"), (np.array([1, 2, 3], dtype=object) == 2, "booleans"),
-    (np.array([1.0, True, 2.0], dtype=object), "booleans"), ([1j, 0, 0], "complex"), (["a", "b", "c"], "numbers"),
+    (np.array([1.0, True, 2.0], dtype=object), "booleans"), ([1.0, True, 2.0], "booleans"),
+    ([[1.0, 2.0, 3.0], (1.0, False, 2.0)], "booleans"), ([1j, 0, 0], "complex"), (["a", "b", "c"], "numbers"),
     ([1.0, np.nan, 0.0], "NaN or inf"), ([[0, 0, 0], [0, 0, np.inf]], "NaN or inf"), (None, r"shape \(3,\)"),
 ])
 def test_a_bad_state_is_refused_naming_its_argument(value, match):

@@ -65,13 +65,17 @@ def refusal(problems: tuple[str, ...] | list[str]) -> str:
     return f"{problems[0]}{more}"
 
 
+#: The stop coordinates' names, in the order of config.types.STOP_COORDINATES (the fourth: the
+#: parallelogram's coupled stop).
+STOP_NAMES = ("theta1", "theta2", "theta3", "theta2 - theta3")
+
 def refuse_log(log: Log, phantom: Phantom) -> None:
     """LogError for a log no arithmetic should touch: angles more than NO_POSTURE beyond the
     stops (degrees?), torques above MAX_TORQUE N m (mN m?), a joint's torque constant throughout."""
     beyond = np.abs(phantom.config.limits.stops.penetration(log.theta)).max(axis=0)
     if (beyond > NO_POSTURE).any():  # before any arithmetic on them (1e300 rad: no SVD converges)
         j = int(np.argmax(beyond))
-        raise LogError(f"theta{j + 1}: the log's angles reach {beyond[j]:.3g} rad beyond the stops, more than a "
+        raise LogError(f"{STOP_NAMES[j]}: the log's angles reach {beyond[j]:.3g} rad beyond the stops, more than a "
                        "turn: no posture of the arm; are they in degrees? (the log holds the report's theta in rad, "
                        "or use --convention openhaptics)")
     huge = np.abs(log.tau).max(axis=0)

@@ -41,7 +41,7 @@ MIN_SPEEDS, FOLDS = (0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.5), 4
 #: A timing whose held-out residual is within TIE of the other's counts as as good, and so does a
 #: threshold within SPEED_TIE of the best's. The thresholds are judged on the fastest equations
 #: only, where sticking shows least: on the tests' 30 s sum of sines with a Stribeck peak
-#: (tests/identification/test_timing.py) the scores from 0.02 to 0.5 rad/s lay within 2 %, and a
+#: (tests/identification/data/test_timing.py) the scores from 0.02 to 0.5 rad/s lay within 2 %, and a
 #: 2 % tie chose 0.02 rad/s, whose fit was 0.82 % off on 500 states (viscous friction 10 % low);
 #: within 1 %, 0.05 rad/s and 0.41 % (2 %).
 TIE, SPEED_TIE = 0.02, 0.01

@@ -5,7 +5,7 @@ coulomb1..3 in N m). The first eight are the constants of the report's eqs 81-94
 as closed_form): M11 = K1 + K2/8 cos 2t2 + K3/8 cos 2t3 + L cos t2 sin t3, M22, M33,
 M23 = -L/2 sin(t2 - t3), N2 = n2 cos t2, N3 = n3 sin t3. They are linear in the report
 parameters (lengths fixed): constants = C x (``constants_matrix``), and they span exactly
-the base parameters of the report's structure (tests/identification/test_base.py).
+the base parameters of the report's structure (tests/identification/structure/test_constants.py).
 The friction columns are dtheta_i and sign(dtheta_i) (config.Friction in motion).
 """
 

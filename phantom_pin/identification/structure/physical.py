@@ -34,7 +34,7 @@ from phantom_pin.report.parameters import links
 #: a rounding apart). Issue 42, L14, measured: with a gap of 1e-7 the written link numbers were
 #: up to 7 % of their typical size off the optimum, and one log identified in two conventions
 #: up to 0.3 % (OpenHaptics' CSV) and 16 % (a bag, read back within 1e-9 s) of its link's size
-#: apart; with 1e-15, 7e-10 and 6e-8 (tests/identification/test_bags.py), the bodies and the check's
+#: apart; with 1e-15, 7e-10 and 6e-8 (tests/identification/data/test_bags.py), the bodies and the check's
 #: margin in the barrier (margined), for 0.65 times the CPU (the blocks evaluated at once).
 GAP = 1e-15
 #: Newton steps per barrier weight, and the weight's growth.

@@ -42,6 +42,7 @@ import math
 import os
 import struct
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -53,8 +54,9 @@ from phantom_pin.interfaces.openhaptics.protocol import COMMAND, ENABLED, QUIT, 
 PERIOD = 1e-3
 
 
-def _numbers(name: str, default: list[float]) -> list[float]:
-    text = os.environ.get(name)
+def _numbers(env: Mapping[str, str], name: str, default: list[float]) -> list[float]:
+    """Three numbers of the environment variable ``name`` of ``env``, or ``default`` where unset."""
+    text = env.get(name)
     if text is None or not text.strip():
         return default
     try:
@@ -85,10 +87,11 @@ class Server:
         self.has_gimbal = config.gimbal is not None
         if not self.has_gimbal and env.get("PHANTOM_PIN_HD_GIMBAL", "").strip():
             raise InvalidInputError(f"the model {config.name!r} has no stylus gimbal", argument="PHANTOM_PIN_HD_GIMBAL")
-        self.gimbal = _numbers("PHANTOM_PIN_HD_GIMBAL", list(config.gimbal.locked_at) if config.gimbal else [0.0] * 3)
+        locked = list(config.gimbal.locked_at) if config.gimbal else [0.0] * 3
+        self.gimbal = _numbers(env, "PHANTOM_PIN_HD_GIMBAL", locked)
         phantom = Phantom(held(description, self.gimbal) if self.has_gimbal else description)
         self.device = device = Device(phantom)
-        theta0 = _numbers("PHANTOM_PIN_HD_THETA0", list(config.limits.postures["zero"]))
+        theta0 = _numbers(env, "PHANTOM_PIN_HD_THETA0", list(config.limits.postures["zero"]))
         if not device.within_limits(np.array(theta0)):
             raise InvalidInputError(f"{theta0!r} rad is outside the stops", argument="PHANTOM_PIN_HD_THETA0")
         hold_text = env.get("PHANTOM_PIN_HD_HOLD", "0").strip() or "0"
@@ -101,7 +104,7 @@ class Server:
         self.plant, self.steps = servo_plant(device, np.array(theta0), PERIOD)
         self.q, self.v = list(theta0), [0.0, 0.0, 0.0]
         self.theta0 = list(theta0)
-        self.hand = np.array(_numbers("PHANTOM_PIN_HD_HAND", [0.0, 0.0, 0.0]))
+        self.hand = np.array(_numbers(env, "PHANTOM_PIN_HD_HAND", [0.0, 0.0, 0.0]))
         self._jacobian = device.tip_jacobian(np.array(theta0))    # J_p at (q, v), m/rad: state() keeps it
         self.time, self.tick_count = 0.0, 0
         self.to_theta = openhaptics_from_theta(np.eye(3)).T      # da/dtheta (OpenHaptics' angles are linear in theta)

@@ -31,6 +31,14 @@ def test_a_log_no_arithmetic_should_touch_is_refused_naming_its_joint():
     with pytest.raises(LogError, match="^theta1: .*28.4 rad beyond the stops.*in degrees") as refused:
         checks.refuse_log(_log(theta=degrees), PHANTOM)
     assert isinstance(refused.value, ValueError) and isinstance(refused.value, PhantomPinError)
+    # theta2 at 40 deg read as rad: past its own stop (2.08 rad) and further past the coupled
+    # stop theta2 - theta3 <= 65 deg (1.13 rad) wherever theta3 < 0.94 rad: that stop is named
+    # (before: "theta4", the fourth stop coordinate's index)
+    coupled = _log().theta.copy()
+    coupled[:, 1] = 40.0
+    assert (coupled[:, 2] < 0.94).all()
+    with pytest.raises(LogError, match="^theta2 - theta3: .* rad beyond the stops"):
+        checks.refuse_log(_log(theta=coupled), PHANTOM)
     huge = _log().tau.copy()
     huge[5, 2] = 2000.0
     with pytest.raises(LogError, match="^tau3: .*2e\\+03 N m"):

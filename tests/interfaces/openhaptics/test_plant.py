@@ -25,12 +25,16 @@ THETA0 = "0.1 0.4 0.6"
     ("PHANTOM_PIN_HD_MODEL", "premium_9", "premium_9"),
 ])
 def test_a_bad_environment_is_refused_naming_its_variable(variable, value, match, monkeypatch):
-    """(Set in os.environ: Server's ``environ`` does not reach the three-number variables, which
-    _numbers reads from os.environ.)"""
+    """Read from os.environ by default, and from ``environ`` where given (every variable: the
+    three-number ones had been read from os.environ whatever ``environ`` said)."""
     monkeypatch.setenv("PHANTOM_PIN_HD_MODEL", "premium_1_5")
     monkeypatch.setenv(variable, value)
     with pytest.raises(InvalidInputError, match=match) as refused:
         Server()
+    assert refused.value.argument == variable
+    monkeypatch.delenv(variable)
+    with pytest.raises(InvalidInputError, match=match) as refused:
+        Server({"PHANTOM_PIN_HD_MODEL": "premium_1_5", variable: value})
     assert refused.value.argument == variable
 
 
