@@ -4,7 +4,9 @@ finiteness of inputs and results, angle wrapping, output paths."""
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -13,7 +15,7 @@ from phantom_pin.exceptions import InvalidInputError, PhantomPinError
 
 def _has_bool(values: object) -> bool:
     """Whether a (nested) sequence holds a boolean anywhere: NumPy reads [1.0, True] as floats."""
-    stack = [values]
+    stack: list[Iterable[object]] = [cast("Iterable[object]", values)]
     while stack:
         for item in stack.pop():
             if isinstance(item, (bool, np.bool_)):
