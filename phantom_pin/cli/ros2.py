@@ -7,7 +7,8 @@ import argparse
 import dataclasses
 import math
 
-from phantom_pin.cli.common import description, overrides
+from phantom_pin.cli.common import description
+from phantom_pin.description.build import held
 from phantom_pin.dynamics.phantom import Phantom
 from phantom_pin.exceptions import MissingDataError, PhantomPinError
 from phantom_pin.interfaces import profiles
@@ -96,10 +97,10 @@ def sim_driver(args: argparse.Namespace) -> int:
     from phantom_pin.interfaces.ros2.node import message_type
 
     profile = profiles.load(args.driver)
-    probe = description(args)
-    gimbal = probe.config.gimbal
+    made = description(args, prefix=args.prefix)
+    gimbal = made.config.gimbal
     if gimbal is None:
-        raise PhantomPinError(f"the drivers' profiles are the Touch's; {probe.config.name} has no stylus gimbal "
+        raise PhantomPinError(f"the drivers' profiles are the Touch's; {made.config.name} has no stylus gimbal "
                               "(use --model touch)", argument="--driver")
     angles = gimbal.locked_at if args.gimbal is None else tuple(args.gimbal)
     outside = [k for k, (a, lo, hi) in enumerate(zip(angles, gimbal.lower, gimbal.upper)) if not lo <= a <= hi]
@@ -110,8 +111,7 @@ def sim_driver(args: argparse.Namespace) -> int:
         if not 0 < args.rate <= 10000:
             raise PhantomPinError(f"expected a rate in (0, 10000] Hz, got {args.rate!r}", argument="--rate")
         profile = dataclasses.replace(profile, joint_states=dataclasses.replace(profile.joint_states, rate=args.rate))
-    held = {f"gimbal.locked_at.{k}": float(a) for k, a in enumerate(angles)}  # the plant carries the stylus there
-    device = Device(Phantom(description(args, given={**overrides(args), **held}, prefix=args.prefix)))
+    device = Device(Phantom(held(made, angles)))    # the plant carries the stylus there
     theta0 = args.theta0 if args.theta0 is not None else (0.0, 0.5, 0.6)
     message_type(profile.force.type)
     simulation = simulated.DriverSimulation(device, profile, theta0, args.hold)
