@@ -302,8 +302,9 @@ class MujocoArm:
     """A MuJoCo model with its joints addressed in the coupling's tree order."""
 
     def __init__(self, model, coupling: object, case: object = None) -> None:
-        import mujoco  # the MuJoCo tests only
+        import mujoco  # the MuJoCo tests only: imported by the first arm
 
+        self.mujoco = mujoco
         self.model, self.data, self.coupling, self.case = model, mujoco.MjData(model), coupling, case
         names = [model.joint(i).name for i in range(model.njnt)]
         assert sorted(names) == sorted(coupling.tree.names[1:])
@@ -312,18 +313,14 @@ class MujocoArm:
 
     def set(self, theta: np.ndarray) -> None:
         full = theta if self.case is None else self.case.full(theta)  # a model without a gimbal: theta
-        import mujoco
-
         self.data.qpos[self.qpos] = self.coupling.configuration(full)
         self.data.qvel[:] = 0
-        mujoco.mj_forward(self.model, self.data)
+        self.mujoco.mj_forward(self.model, self.data)
 
     def reduced_mass_and_gravity(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         self.set(theta)
-        import mujoco
-
         full = np.zeros((self.model.nv, self.model.nv))
-        mujoco.mj_fullM(self.model, self.data, full)
+        self.mujoco.mj_fullM(self.model, self.data, full)
         tree = full[np.ix_(self.dof, self.dof)]
         G = self.coupling.matrix  # the arm's block: the gimbal held (locked) at rest
         return (G.T @ tree @ G)[:3, :3], (G.T @ self.data.qfrc_bias[self.dof])[:3]  # bias at rest = gravity
