@@ -81,28 +81,28 @@ class Identification:
         write_yaml(path, self.text(), force=force)
 
     def text(self) -> str:
-        """The overlay: dotted --params keys (SI units) with the fit in comments, as YAML text."""
+        """The overlay: dotted --params keys (SI units) with the fit in comments (yaml_text), as YAML text."""
         fit = self.fit
-        lines = [f"# Identified by phantom-pin identify from {self.source} ({fit.structure} structure): a --params",
-                 "# overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
-                 "# (docs/identification.md). SI units.",
-                 f"# {fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
+        lines = [f"Identified by phantom-pin identify from {self.source} ({fit.structure} structure): a --params",
+                 "overlay for phantom-pin urdf/srdf/mjcf/simulate/... and describe(overrides=read_overrides(...))",
+                 "(docs/identification.md). SI units.",
+                 f"{fit.samples} samples, base regressor condition number {fit.condition:.3g} (a diagnostic); "
                  "residual RMS per joint [N m]: " + " ".join(f"{v:.3g}" for v in fit.rms)]
-        lines += [f"# {line}" for line in timing_lines(fit) + [speed_line(fit)] + gain_lines(fit)]
-        lines += [f"# warning: {w}" for w in fit_warnings(fit)]
-        lines += [f"# {line}" for line in fit.prediction.lines()]
-        lines += [f"# warning: {line}" for line in fit.prediction.warnings()]
-        lines += ["# base parameters (estimate with the prior +- standard deviation; of the written parameters; "
+        lines += timing_lines(fit) + [speed_line(fit)] + gain_lines(fit)
+        lines += [f"warning: {w}" for w in fit_warnings(fit)]
+        lines += fit.prediction.lines()
+        lines += [f"warning: {line}" for line in fit.prediction.warnings()]
+        lines += ["base parameters (estimate with the prior +- standard deviation; of the written parameters; "
                   "of the log alone; the prior's):"]
-        lines += [f"#   beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written {fit.written[k]:.6g}; "
+        lines += [f"  beta{k + 1} = {fit.beta[k]:.6g} +- {fit.sigma[k]:.2g} {unit}; written {fit.written[k]:.6g}; "
                   f"log alone {fit.log_beta[k]:.6g}; prior {fit.prior_beta[k]:.6g}: {name}"
                   for k, (name, unit) in enumerate(zip(fit.names, fit.units))]
-        lines += [f"# {note}" for note in self.notes]
-        lines += [f"# problem, written with --accept: {problem}" for problem in fit.problems]
-        lines += ["# What the log does not excite comes from the model's values (the prior, within its stated "
+        lines += list(self.notes)
+        lines += [f"problem, written with --accept: {problem}" for problem in fit.problems]
+        lines += ["What the log does not excite comes from the model's values (the prior, within its stated "
                   f"{100 * fit.prediction.spread:.0f} % spread)." if np.isfinite(fit.prediction.spread) else
-                  "# Directions the torques do not determine are kept near the model's values (the prior)."]
-        return yaml_text([line[2:] for line in lines], self.keys)
+                  "Directions the torques do not determine are kept near the model's values (the prior)."]
+        return yaml_text(lines, self.keys)
 
 
 def identify(log: Log, phantom: Phantom, *, cutoff: float = CUTOFF, structure: str = "general",
